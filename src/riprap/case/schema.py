@@ -1,0 +1,556 @@
+"""The one table of every key of a riprap case file (TOML, ``format_version = 1``).
+
+Each :class:`Key` says where the key lives, its kind, unit, default, allowed values and a
+one-line meaning. The validator in :mod:`riprap.case.load` and the reference page
+``docs/case-file.md`` are both generated from :data:`KEYS` and :data:`TABLES`; nothing about a key
+is written down anywhere else. Run ``python -m riprap.case.schema > docs/case-file.md`` after a
+change here (a unit test fails while the page is out of date).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = [
+    "FORMAT_VERSION",
+    "MINIMUM_QUATERNION_NORM",
+    "MINIMUM_DIRECTION_NORM",
+    "MINIMUM_BODY_COUNT",
+    "MAXIMUM_REPORTED_PROBLEMS",
+    "REQUIRED",
+    "KINDS",
+    "Range",
+    "Key",
+    "Table",
+    "TABLES",
+    "KEYS",
+    "table",
+    "keys_of",
+    "key",
+    "default_of",
+    "describe_expected",
+    "format_toml_value",
+    "render_markdown",
+]
+
+#: The case-file format this version of riprap reads.
+FORMAT_VERSION = 1
+
+#: A quaternion shorter than this cannot be normalised reliably into a rotation.
+MINIMUM_QUATERNION_NORM = 1e-6
+
+#: A direction (wall normal) shorter than this is treated as the zero vector.
+MINIMUM_DIRECTION_NORM = 1e-12
+
+#: A case must create at least this many bodies from ``[[bodies]]`` and ``[[body_grids]]``.
+MINIMUM_BODY_COUNT = 1
+
+#: At most this many problems are listed in one error message; the rest are counted.
+MAXIMUM_REPORTED_PROBLEMS = 20
+
+
+class _Required:
+    """Marker for a key without a default: the case file must give it."""
+
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
+#: Default of a key that the case file must give.
+REQUIRED = _Required()
+
+#: Value kinds and how they read in the docs and in error messages.
+KINDS = {
+    "integer": "an integer",
+    "number": "a number",
+    "boolean": "true or false",
+    "string": "a string",
+    "vector": "3 numbers [x, y, z]",
+    "integer_vector": "3 integers [x, y, z]",
+    "quaternion": (
+        f"4 numbers [w, x, y, z] (normalised on load; norm >= {MINIMUM_QUATERNION_NORM:g})"
+    ),
+    "direction": "3 numbers [x, y, z], not all zero (normalised on load)",
+    "string_list": "a non-empty list of strings",
+    "path": "a file path (string)",
+}
+
+_VECTOR_KINDS = frozenset({"vector", "integer_vector", "quaternion", "direction"})
+
+
+@dataclass(frozen=True)
+class Range:
+    """An interval of allowed numbers; ``None`` means unbounded on that side.
+
+    For vector kinds the interval applies to each component.
+    """
+
+    minimum: float | None = None
+    maximum: float | None = None
+    minimum_inclusive: bool = True
+    maximum_inclusive: bool = True
+
+    def contains(self, value: float) -> bool:
+        """Whether ``value`` lies in the interval."""
+        if self.minimum is not None:
+            if value < self.minimum or (value == self.minimum and not self.minimum_inclusive):
+                return False
+        if self.maximum is not None:
+            if value > self.maximum or (value == self.maximum and not self.maximum_inclusive):
+                return False
+        return True
+
+    def describe(self) -> str:
+        """The interval as an engineer writes it: ``> 0``, ``>= 1``, ``(0, 1]``, ``exactly 1``."""
+        low, high = self.minimum, self.maximum
+        if low is not None and high is not None:
+            if low == high:
+                return f"exactly {low:g}"
+            left = "[" if self.minimum_inclusive else "("
+            right = "]" if self.maximum_inclusive else ")"
+            return f"{left}{low:g}, {high:g}{right}"
+        if low is not None:
+            return f"{'>=' if self.minimum_inclusive else '>'} {low:g}"
+        if high is not None:
+            return f"{'<=' if self.maximum_inclusive else '<'} {high:g}"
+        return "any"
+
+
+@dataclass(frozen=True)
+class Table:
+    """A top-level part of the case file.
+
+    Attributes
+    ----------
+    name : str
+        TOML name; ``""`` is the top level itself (keys written before any table header).
+    is_array : bool
+        True for arrays of tables, written ``[[name]]`` once per entry.
+    minimum_count : int
+        For arrays, the fewest entries allowed.
+    variant_key : str or None
+        Name of the key whose value selects extra keys (``type`` for shapes and walls).
+    meaning : str
+        One line for the docs.
+    """
+
+    name: str
+    is_array: bool
+    minimum_count: int
+    variant_key: str | None
+    meaning: str
+
+    @property
+    def header(self) -> str:
+        """How the table is written in TOML: ``[name]``, ``[[name]]``, or ``top level``."""
+        if not self.name:
+            return "top level"
+        return f"[[{self.name}]]" if self.is_array else f"[{self.name}]"
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of the case file.
+
+    Attributes
+    ----------
+    table : str
+        Name of the :class:`Table` holding the key.
+    name : str
+        TOML key, identical to the Python field or parameter name.
+    kind : str
+        One of :data:`KINDS`.
+    unit : str
+        SI unit, ``-`` for dimensionless or not a physical quantity.
+    meaning : str
+        One line for the docs.
+    default : object
+        Value used when the key is absent, or :data:`REQUIRED`. Vectors are tuples.
+    valid_range : Range or None
+        Allowed numbers (each component for vector kinds).
+    choices : tuple of str or None
+        Allowed strings.
+    variant : str or None
+        The key exists only when the table's variant key (``type``) has this value.
+    references : str or None
+        The value (each element for lists) must be the ``name`` of an entry of this table.
+    unique : bool
+        No two entries of the table may share this value.
+    extensions : tuple of str
+        Allowed file name endings for ``path`` keys (lower case, with the dot).
+    greater_than : str or None
+        Name of a vector key of the same entry that this one must exceed in every component.
+    """
+
+    table: str
+    name: str
+    kind: str
+    unit: str
+    meaning: str
+    default: object = REQUIRED
+    valid_range: Range | None = None
+    choices: tuple[str, ...] | None = None
+    variant: str | None = None
+    references: str | None = None
+    unique: bool = False
+    extensions: tuple[str, ...] = ()
+    greater_than: str | None = None
+
+    @property
+    def required(self) -> bool:
+        """Whether the case file must give this key."""
+        return self.default is REQUIRED
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"schema key {self.table}.{self.name}: unknown kind {self.kind!r}")
+
+
+_POSITIVE = Range(minimum=0.0, minimum_inclusive=False)
+_NON_NEGATIVE = Range(minimum=0.0)
+_FRACTION = Range(minimum=0.0, maximum=1.0, minimum_inclusive=False)
+_ZERO = (0.0, 0.0, 0.0)
+_SHAPE_TYPES = ("sphere", "box", "cube", "random_rock", "tetrapod", "l_shape", "mesh_file")
+_WALL_TYPES = ("plane", "box")
+_MESH_EXTENSIONS = (".stl", ".obj", ".ply", ".msh", ".vtu")
+
+#: Every table of the case file, in the order the docs list them.
+TABLES: tuple[Table, ...] = (
+    Table("", False, 1, None, "Keys written before any table header."),
+    Table("simulation", False, 1, None, "Clock, time step, gravity, damping and stopping rules."),
+    Table("materials", True, 1, None,
+          "Contact materials; bodies and walls refer to them by name."),
+    Table("shapes", True, 1, "type",
+          "Body shapes, meshed into tetrahedra; bodies and grids refer to them by name."),
+    Table("bodies", True, 0, None, "Single bodies, each placed by its centroid."),
+    Table("body_grids", True, 0, None,
+          "Rectangular grids of bodies (counts[0] x counts[1] x counts[2] bodies each)."),
+    Table("walls", True, 0, "type",
+          "Fixed analytic boundaries; the side the normal points to is free space."),
+    Table("output", False, 1, None, "Where and what riprap writes."),
+)
+
+#: Every key of the case file.
+KEYS: tuple[Key, ...] = (
+    Key("", "format_version", "integer", "-",
+        "Version of the case-file format; this riprap reads version 1.",
+        valid_range=Range(minimum=FORMAT_VERSION, maximum=FORMAT_VERSION)),
+    # [simulation]
+    Key("simulation", "end_time", "number", "s", "Simulated time at which the run stops.",
+        valid_range=_POSITIVE),
+    Key("simulation", "time_step", "number", "s",
+        "Time step; 0 chooses it automatically from the body masses and contact stiffness.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("simulation", "time_step_safety", "number", "-",
+        "Fraction of the critical time step used when the time step is automatic.",
+        default=0.2, valid_range=_FRACTION),
+    Key("simulation", "gravity", "vector", "m/s^2", "Gravitational acceleration.",
+        default=(0.0, 0.0, -9.81)),
+    Key("simulation", "output_interval", "number", "s",
+        "Simulated time between two ParaView frames.", default=0.05, valid_range=_POSITIVE),
+    Key("simulation", "checkpoint_interval", "number", "s",
+        "Simulated time between checkpoints; 0 writes one only at the end and on failure.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("simulation", "local_damping", "number", "-",
+        "Cundall's non-viscous local damping: numerical damping, not physics; 0 switches it off.",
+        default=0.0, valid_range=Range(minimum=0.0, maximum=1.0, maximum_inclusive=False)),
+    Key("simulation", "rest_speed", "number", "m/s",
+        "If > 0, stop early once every free body is slower than this; 0 never stops early.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("simulation", "seed", "integer", "-",
+        "Seed of the random orientations, shape choices and jitter of body grids.",
+        default=0, valid_range=_NON_NEGATIVE),
+    # [[materials]]
+    Key("materials", "name", "string", "-", "Name that bodies and walls use to refer to it.",
+        unique=True),
+    Key("materials", "density", "number", "kg/m^3", "Mass density.",
+        default=2650.0, valid_range=_POSITIVE),
+    Key("materials", "friction_coefficient", "number", "-", "Coulomb friction coefficient.",
+        default=0.6, valid_range=_NON_NEGATIVE),
+    Key("materials", "restitution", "number", "-",
+        "Normal coefficient of restitution; sets the contact damping.",
+        default=0.5, valid_range=_FRACTION),
+    Key("materials", "contact_penalty", "number", "Pa",
+        "Penalty of Munjiza's distributed potential contact.",
+        default=1.0e9, valid_range=_POSITIVE),
+    Key("materials", "tangential_stiffness_ratio", "number", "-",
+        "Tangential over normal contact stiffness (2/7 by default).",
+        default=2.0 / 7.0, valid_range=_POSITIVE),
+    # [[shapes]], keys of every type
+    Key("shapes", "name", "string", "-", "Name that bodies and grids use to refer to it.",
+        unique=True),
+    Key("shapes", "type", "string", "-", "Kind of shape; selects the keys below.",
+        choices=_SHAPE_TYPES),
+    Key("shapes", "mesh_size", "number", "m",
+        "Target tetrahedron edge length; 0 uses the shape's own default.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    # [[shapes]] by type
+    Key("shapes", "radius", "number", "m", "Sphere radius.",
+        valid_range=_POSITIVE, variant="sphere"),
+    Key("shapes", "lengths", "vector", "m", "Edge lengths along x, y and z.",
+        valid_range=_POSITIVE, variant="box"),
+    Key("shapes", "side", "number", "m", "Edge length.", valid_range=_POSITIVE, variant="cube"),
+    Key("shapes", "size", "number", "m", "Nominal size (diameter of the generating ellipsoid).",
+        valid_range=_POSITIVE, variant="random_rock"),
+    Key("shapes", "elongation", "number", "-", "Longest over middle axis of the rock.",
+        default=1.0, valid_range=Range(minimum=1.0), variant="random_rock"),
+    Key("shapes", "flatness", "number", "-", "Shortest over middle axis of the rock.",
+        default=1.0, valid_range=_FRACTION, variant="random_rock"),
+    Key("shapes", "seed", "integer", "-", "Seed of the random vertices.",
+        default=0, valid_range=_NON_NEGATIVE, variant="random_rock"),
+    Key("shapes", "n_vertices", "integer", "-", "Number of vertices of the convex hull.",
+        default=24, valid_range=Range(minimum=8), variant="random_rock"),
+    Key("shapes", "height", "number", "m", "Overall height of the tetrapod.",
+        valid_range=_POSITIVE, variant="tetrapod"),
+    Key("shapes", "length", "number", "m", "Length of each leg of the L.",
+        valid_range=_POSITIVE, variant="l_shape"),
+    Key("shapes", "width", "number", "m", "Width of the L (extrusion depth).",
+        valid_range=_POSITIVE, variant="l_shape"),
+    Key("shapes", "thickness", "number", "m", "Thickness of each leg of the L.",
+        valid_range=_POSITIVE, variant="l_shape"),
+    Key("shapes", "file", "path", "-",
+        "Surface or volume mesh, relative to the case file's folder; must exist.",
+        extensions=_MESH_EXTENSIONS, variant="mesh_file"),
+    Key("shapes", "scale", "number", "-", "Factor applied to the file's coordinates.",
+        default=1.0, valid_range=_POSITIVE, variant="mesh_file"),
+    # [[bodies]]
+    Key("bodies", "shape", "string", "-", "Name of the body's shape.", references="shapes"),
+    Key("bodies", "material", "string", "-", "Name of the body's material.",
+        references="materials"),
+    Key("bodies", "position", "vector", "m", "Position of the body's centroid."),
+    Key("bodies", "orientation", "quaternion", "-",
+        "Rotation from the shape's own frame as built, as a unit quaternion.",
+        default=(1.0, 0.0, 0.0, 0.0)),
+    Key("bodies", "velocity", "vector", "m/s", "Initial velocity of the centroid.",
+        default=_ZERO),
+    Key("bodies", "angular_velocity", "vector", "rad/s",
+        "Initial angular velocity, in the world frame.", default=_ZERO),
+    Key("bodies", "fixed", "boolean", "-",
+        "A fixed body never moves (infinite mass).", default=False),
+    # [[body_grids]]
+    Key("body_grids", "shapes", "string_list", "-",
+        "Names of the shapes placed in the grid.", references="shapes"),
+    Key("body_grids", "shape_choice", "string", "-",
+        "Assign the shapes to grid points in turn (cycle) or at random (random).",
+        default="cycle", choices=("cycle", "random")),
+    Key("body_grids", "material", "string", "-", "Name of the material of every body.",
+        references="materials"),
+    Key("body_grids", "origin", "vector", "m", "Centroid of the first body of the grid."),
+    Key("body_grids", "spacing", "vector", "m", "Distance between neighbouring centroids.",
+        valid_range=_POSITIVE),
+    Key("body_grids", "counts", "integer_vector", "-", "Number of bodies along x, y and z.",
+        valid_range=Range(minimum=1)),
+    Key("body_grids", "orientation", "string", "-",
+        "Orientation of each body: uniform random rotation or the shape's own frame.",
+        default="random", choices=("random", "identity")),
+    Key("body_grids", "velocity", "vector", "m/s", "Initial velocity of every body.",
+        default=_ZERO),
+    Key("body_grids", "jitter", "number", "m",
+        "Random offset of each centroid, uniform in [-jitter, jitter] per axis.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    # [[walls]]
+    Key("walls", "type", "string", "-", "Kind of wall; selects the keys below.",
+        choices=_WALL_TYPES),
+    Key("walls", "material", "string", "-", "Name of the wall's material.",
+        references="materials"),
+    Key("walls", "point", "vector", "m", "A point on the plane.", variant="plane"),
+    Key("walls", "normal", "direction", "-", "Normal of the plane, pointing into the free space.",
+        variant="plane"),
+    Key("walls", "min", "vector", "m", "Lower corner of the box; the inside is free space.",
+        variant="box"),
+    Key("walls", "max", "vector", "m", "Upper corner of the box.", variant="box",
+        greater_than="min"),
+    Key("walls", "open_top", "boolean", "-",
+        "Leave out the top plane (5 planes instead of 6).", default=True, variant="box"),
+    # [output]
+    Key("output", "directory", "string", "-",
+        "Output folder, relative to the current directory unless the command line overrides it.",
+        default="riprap-out"),
+    Key("output", "paraview", "boolean", "-", "Write ParaView frames (.pvd + .vtu).",
+        default=True),
+    Key("output", "picture", "boolean", "-", "Write a PNG picture of the final state.",
+        default=True),
+)
+
+
+def table(name: str) -> Table:
+    """The :class:`Table` called ``name`` (``""`` for the top level)."""
+    for candidate in TABLES:
+        if candidate.name == name:
+            return candidate
+    raise KeyError(f"the case schema has no table {name!r}")
+
+
+def keys_of(table_name: str, *, variant: str | None = None) -> tuple[Key, ...]:
+    """Keys of a table: the common ones, plus those of ``variant`` when given."""
+    return tuple(
+        entry for entry in KEYS
+        if entry.table == table_name and (entry.variant is None or entry.variant == variant)
+    )
+
+
+def key(table_name: str, name: str) -> Key:
+    """The :class:`Key` ``name`` of table ``table_name`` (any variant)."""
+    for entry in KEYS:
+        if entry.table == table_name and entry.name == name:
+            return entry
+    raise KeyError(f"the case schema has no key {name!r} in table {table_name!r}")
+
+
+def default_of(table_name: str, name: str) -> object:
+    """Default value of a key; raises ``KeyError`` for required keys."""
+    entry = key(table_name, name)
+    if entry.required:
+        raise KeyError(f"{table_name}.{name} is required and has no default")
+    return entry.default
+
+
+def format_toml_value(value: object) -> str:
+    """Write a value the way it would appear in a TOML file (for docs and error messages)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        if value != 0.0 and (abs(value) >= 1e6 or abs(value) < 1e-4):
+            return f"{value:.6g}"
+        return repr(value)
+    if isinstance(value, str):
+        escaped = value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+        return f'"{escaped}"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(format_toml_value(item) for item in value) + "]"
+    if isinstance(value, dict):
+        inner = ", ".join(f"{name} = {format_toml_value(item)}" for name, item in value.items())
+        return "{ " + inner + " }" if inner else "{}"
+    if hasattr(value, "isoformat"):
+        return value.isoformat()
+    return str(value)
+
+
+def describe_expected(entry: Key) -> str:
+    """What the key accepts, in words: kind, unit, range or choices (for error messages)."""
+    parts = [KINDS[entry.kind]]
+    if entry.unit != "-":
+        parts.append(f"in {entry.unit}")
+    text = " ".join(parts)
+    if entry.choices is not None:
+        text = "one of " + ", ".join(format_toml_value(choice) for choice in entry.choices)
+    if entry.valid_range is not None:
+        prefix = "each " if entry.kind in _VECTOR_KINDS else ""
+        text += f", {prefix}{entry.valid_range.describe()}"
+    if entry.extensions:
+        text += ", ending in " + " ".join(entry.extensions)
+    if entry.greater_than is not None:
+        text += f", each component > {entry.greater_than}"
+    if entry.references is not None:
+        text += f", the name of a [[{entry.references}]] entry"
+    return text
+
+
+def _allowed_cell(entry: Key) -> str:
+    notes = []
+    if entry.choices is not None:
+        notes.append("one of " + ", ".join(f"`{format_toml_value(c)}`" for c in entry.choices))
+    if entry.valid_range is not None:
+        prefix = "each " if entry.kind in _VECTOR_KINDS else ""
+        notes.append(prefix + entry.valid_range.describe())
+    if entry.references is not None:
+        notes.append(f"name of a `[[{entry.references}]]` entry")
+    if entry.unique:
+        notes.append(f"unique among `[[{entry.table}]]`")
+    if entry.extensions:
+        notes.append(" ".join(f"`{extension}`" for extension in entry.extensions))
+    if entry.greater_than is not None:
+        notes.append(f"each component > `{entry.greater_than}`")
+    return "; ".join(notes) if notes else "any"
+
+
+def _markdown_cell(text: str) -> str:
+    return text.replace("|", "\\|")
+
+
+def _markdown_key_table(entries: tuple[Key, ...]) -> list[str]:
+    lines = [
+        "| key | type | unit | default | allowed | meaning |",
+        "|---|---|---|---|---|---|",
+    ]
+    for entry in entries:
+        default = "required" if entry.required else f"`{format_toml_value(entry.default)}`"
+        cells = (
+            f"`{entry.name}`", KINDS[entry.kind], entry.unit, default, _allowed_cell(entry),
+            entry.meaning,
+        )
+        lines.append("| " + " | ".join(_markdown_cell(cell) for cell in cells) + " |")
+    return lines
+
+
+def render_markdown() -> str:
+    """The reference page ``docs/case-file.md``, generated from :data:`TABLES` and :data:`KEYS`.
+
+    Returns
+    -------
+    str
+        Markdown text ending in a newline.
+    """
+    lines = [
+        "# Case file reference",
+        "",
+        "<!-- Generated by `python -m riprap.case.schema > docs/case-file.md` from",
+        "     src/riprap/case/schema.py. Do not edit by hand. -->",
+        "",
+        f"A riprap case is a TOML file with `format_version = {FORMAT_VERSION}`. Units are SI;",
+        "`-` marks a dimensionless or non-physical value. Integers are accepted where a number is",
+        "expected, `true`/`false` never are. Unknown tables and keys, wrong types, values out of",
+        "range, duplicate names and names that refer to nothing are errors: `riprap` reports all",
+        f"of them at once (up to {MAXIMUM_REPORTED_PROBLEMS}), each as `file:line: key path = "
+        "value: what was expected`,",
+        "for example `case.toml:14: bodies[1].position = [0.0, 1.0]: expected 3 numbers [x, y, z] "
+        "in m`.",
+        "Entries of arrays of tables are counted from 0 in key paths.",
+        "",
+        "Rules that involve more than one key:",
+        "",
+        f"- `[[bodies]]` and `[[body_grids]]` together must create at least {MINIMUM_BODY_COUNT} "
+        "body.",
+        "- `name` is unique among `[[materials]]` and among `[[shapes]]`; `shape`, `shapes` and "
+        "`material` must name an entry that exists.",
+        "- Keys listed under a `type` exist only for that type: giving one for another type is an "
+        "error, and a required one must be given.",
+        "- Relative file paths are relative to the folder of the case file.",
+        "",
+    ]
+    for part in TABLES:
+        lines.append(f"## {part.header}")
+        lines.append("")
+        count_note = ""
+        if part.is_array:
+            count_note = (
+                f" At least {part.minimum_count} entry." if part.minimum_count
+                else " Optional; any number of entries."
+            )
+        lines.append(part.meaning + count_note)
+        lines.append("")
+        lines.extend(_markdown_key_table(keys_of(part.name)))
+        lines.append("")
+        if part.variant_key is not None:
+            for variant in key(part.name, part.variant_key).choices:
+                lines.append(f"### {part.header} with {part.variant_key} = \"{variant}\"")
+                lines.append("")
+                specific = tuple(entry for entry in KEYS
+                                 if entry.table == part.name and entry.variant == variant)
+                if specific:
+                    lines.extend(_markdown_key_table(specific))
+                else:
+                    lines.append("No further keys.")
+                lines.append("")
+    return "\n".join(lines).rstrip("\n") + "\n"
+
+
+if __name__ == "__main__":
+    print(render_markdown(), end="")

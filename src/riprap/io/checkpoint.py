@@ -1,0 +1,230 @@
+"""Checkpoints: the full state in one ``.npz`` file, written so a crash never destroys the last one.
+
+A checkpoint is a plain numpy ``.npz`` archive holding named arrays, plus one reserved entry
+(``__riprap_metadata__``) with a JSON string of metadata (simulated time, step count, case file
+name, ...). The metadata always carries ``"checkpoint_format": 1``; a file written by a
+different format version is refused with a message saying so instead of being half-read.
+
+The archive is first written to a temporary file in the same folder and then moved over the
+target with :func:`os.replace`, which is atomic on POSIX and Windows when both paths are on the
+same file system. A run killed while writing therefore leaves either the previous complete
+checkpoint or the new complete one, never a truncated file under the checkpoint's name.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import zipfile
+from collections.abc import Iterator, Mapping
+from pathlib import Path
+
+import numpy as np
+
+from riprap.errors import CaseFileError, RiprapError
+
+__all__ = ["CheckpointError", "CHECKPOINT_FORMAT", "save_checkpoint", "load_checkpoint"]
+
+#: Version of the checkpoint layout written by :func:`save_checkpoint`.
+CHECKPOINT_FORMAT = 1
+
+_METADATA_KEY = "__riprap_metadata__"
+
+
+class CheckpointError(RiprapError):
+    """A checkpoint or restart file is missing, corrupt, or written in another format version."""
+
+
+@contextlib.contextmanager
+def _atomic_target(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; move it onto ``path`` only if the block succeeds.
+
+    The temporary file lives in the same folder so that :func:`os.replace` stays on one file
+    system and is atomic. On any exception the temporary file is removed and ``path`` is left
+    untouched.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Final location of the file. Its parent folder is created if missing.
+
+    Yields
+    ------
+    pathlib.Path
+        Where the caller must write the complete file.
+    """
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    temporary = target.with_name(f".{target.name}.{os.getpid()}.tmp")
+    try:
+        yield temporary
+        # Flush to disk before the rename so that a power loss cannot leave the new name
+        # pointing at an empty file.
+        with open(temporary, "rb+") as handle:
+            os.fsync(handle.fileno())
+        os.replace(temporary, target)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            temporary.unlink()
+
+
+def _json_default(value):
+    """Convert numpy scalars and arrays met in metadata to plain JSON types."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+def save_checkpoint(
+    path: str | os.PathLike,
+    *,
+    arrays: Mapping[str, np.ndarray],
+    metadata: Mapping[str, object],
+) -> Path:
+    """Write arrays and metadata to one ``.npz`` checkpoint, atomically.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Checkpoint file to write (conventionally ending in ``.npz``; the name is used as given).
+        Its folder is created if missing. An existing file is replaced only once the new one is
+        complete.
+    arrays : mapping of str to numpy.ndarray
+        State arrays of any shape and any numeric or boolean dtype, e.g. ``positions
+        (n_bodies, 3)``, ``quaternions (n_bodies, 4)``. They are stored bit-exactly. Object
+        arrays are refused because loading them would need pickle.
+    metadata : mapping of str to JSON-serialisable values
+        Scalars, strings, lists and dicts (numpy scalars are converted). The key
+        ``"checkpoint_format"`` is set to :data:`CHECKPOINT_FORMAT`.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    CaseFileError
+        If an array name is reserved, an array has object dtype, or the metadata cannot be
+        written as JSON.
+
+    Examples
+    --------
+    >>> import tempfile, numpy as np
+    >>> folder = tempfile.mkdtemp()
+    >>> path = save_checkpoint(f"{folder}/state.npz", arrays={"positions": np.zeros((2, 3))},
+    ...                        metadata={"time": 0.5})
+    >>> arrays, metadata = load_checkpoint(path)
+    >>> arrays["positions"].shape, metadata["time"], metadata["checkpoint_format"]
+    ((2, 3), 0.5, 1)
+    """
+    path = Path(path)
+    if _METADATA_KEY in arrays:
+        raise CaseFileError(
+            f"checkpoint {path}: the array name {_METADATA_KEY!r} is reserved for riprap's "
+            "metadata; rename that array."
+        )
+    stored: dict[str, np.ndarray] = {}
+    for name, array in arrays.items():
+        array = np.asarray(array)
+        if array.dtype.hasobject:
+            raise CaseFileError(
+                f"checkpoint {path}: array {name!r} has dtype object, which cannot be stored "
+                "without pickle; convert it to a numeric, boolean or fixed-width string array."
+            )
+        stored[name] = array
+
+    full_metadata = dict(metadata)
+    full_metadata["checkpoint_format"] = CHECKPOINT_FORMAT
+    try:
+        # allow_nan=False: NaN and infinity are not JSON and other readers would reject them.
+        text = json.dumps(full_metadata, default=_json_default, allow_nan=False, sort_keys=True)
+    except (TypeError, ValueError) as error:
+        raise CaseFileError(
+            f"checkpoint {path}: metadata cannot be written as JSON ({error}); keep metadata to "
+            "finite numbers, strings, lists and dicts, and put arrays in `arrays`."
+        ) from error
+    stored[_METADATA_KEY] = np.array(text)
+
+    with _atomic_target(path) as temporary:
+        # A file object, not a name: np.savez would append ".npz" to a name lacking it.
+        with open(temporary, "wb") as handle:
+            np.savez(handle, **stored)
+    return path
+
+
+def load_checkpoint(path: str | os.PathLike) -> tuple[dict[str, np.ndarray], dict]:
+    """Read a checkpoint written by :func:`save_checkpoint`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Checkpoint file.
+
+    Returns
+    -------
+    arrays : dict of str to numpy.ndarray
+        The stored arrays, with their original dtypes and shapes.
+    metadata : dict
+        The stored metadata, including ``"checkpoint_format"``.
+
+    Raises
+    ------
+    CheckpointError
+        If the file is missing, truncated or corrupt, is not a riprap checkpoint, or was
+        written in another checkpoint format version.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise CheckpointError(
+            f"checkpoint {path} does not exist; check the path, or start the run from the case "
+            "file instead of restarting."
+        )
+    try:
+        # allow_pickle=False: a checkpoint must never execute code when loaded.
+        loaded = np.load(path, allow_pickle=False)
+        if not isinstance(loaded, np.lib.npyio.NpzFile):
+            raise CheckpointError(
+                f"{path} holds a single numpy array, not a riprap checkpoint archive; pass a "
+                "file written by riprap.io.checkpoint.save_checkpoint."
+            )
+        with loaded as archive:
+            # Read every member now so that a damaged member fails here, inside the try.
+            contents = {name: archive[name] for name in archive.files}
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+        raise CheckpointError(
+            f"checkpoint {path} is truncated or corrupt ({type(error).__name__}: {error}); "
+            "restart from an earlier checkpoint."
+        ) from error
+
+    if _METADATA_KEY not in contents:
+        raise CheckpointError(
+            f"{path} is a numpy archive but not a riprap checkpoint (no {_METADATA_KEY!r} "
+            "entry); pass a file written by riprap.io.checkpoint.save_checkpoint."
+        )
+    try:
+        metadata = json.loads(str(contents.pop(_METADATA_KEY)))
+    except json.JSONDecodeError as error:
+        raise CheckpointError(
+            f"checkpoint {path}: the metadata is not valid JSON ({error}); the file is corrupt, "
+            "restart from an earlier checkpoint."
+        ) from error
+    if not isinstance(metadata, dict):
+        raise CheckpointError(
+            f"checkpoint {path}: the metadata is not a JSON object; the file is corrupt, "
+            "restart from an earlier checkpoint."
+        )
+
+    version = metadata.get("checkpoint_format")
+    if version != CHECKPOINT_FORMAT:
+        raise CheckpointError(
+            f"checkpoint {path} has checkpoint_format {version!r}, but this riprap reads "
+            f"checkpoint_format {CHECKPOINT_FORMAT}; use the riprap version that wrote it, or "
+            "start the run again from the case file."
+        )
+    return contents, metadata

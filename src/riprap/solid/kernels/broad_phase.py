@@ -1,0 +1,94 @@
+"""Candidate pairs: bodies whose world bounding boxes overlap, and bodies near walls.
+
+Sweep and prune along the axis with the largest spread of body centres. In a heap of bodies of
+similar size each body overlaps a bounded number of others along that axis, so the cost grows about
+linearly with the number of bodies (plus an N log N sort that is negligible at 1e4 bodies).
+"""
+import numpy as np
+
+from riprap._jit import kernel
+from riprap.solid.kernels.geometry_ops import rotation_matrix
+
+
+@kernel
+def world_boxes(positions, quaternions, shape_index, local_box_min, local_box_max, margin):
+    """Axis-aligned world boxes of every body, (n, 3) lower and upper corners, grown by ``margin``."""
+    n = positions.shape[0]
+    lo = np.empty((n, 3))
+    hi = np.empty((n, 3))
+    for b in range(n):
+        r = rotation_matrix(quaternions[b])
+        s = shape_index[b]
+        for i in range(3):
+            centre = positions[b, i]
+            half = 0.0
+            for j in range(3):
+                c = 0.5 * (local_box_min[s, j] + local_box_max[s, j])
+                h = 0.5 * (local_box_max[s, j] - local_box_min[s, j])
+                centre += r[i, j] * c
+                half += abs(r[i, j]) * h
+            lo[b, i] = centre - half - margin
+            hi[b, i] = centre + half + margin
+    return lo, hi
+
+
+@kernel
+def overlapping_pairs(lo, hi, fixed):
+    """Pairs (i < j) of boxes that overlap, skipping pairs of two fixed bodies. (k, 2) int64."""
+    n = lo.shape[0]
+    if n < 2:
+        return np.zeros((0, 2), dtype=np.int64)
+    spread = np.zeros(3)
+    for a in range(3):
+        spread[a] = np.var(lo[:, a] + hi[:, a])
+    axis = int(np.argmax(spread))
+    order = np.argsort(lo[:, axis])
+    capacity = 8 * n
+    pairs = np.empty((capacity, 2), dtype=np.int64)
+    count = 0
+    for oi in range(n):
+        i = order[oi]
+        for oj in range(oi + 1, n):
+            j = order[oj]
+            if lo[j, axis] > hi[i, axis]:
+                break
+            if fixed[i] and fixed[j]:
+                continue
+            overlap = True
+            for a in range(3):
+                if lo[i, a] > hi[j, a] or lo[j, a] > hi[i, a]:
+                    overlap = False
+                    break
+            if not overlap:
+                continue
+            if count == capacity:
+                grown = np.empty((2 * capacity, 2), dtype=np.int64)
+                grown[:capacity] = pairs
+                pairs = grown
+                capacity *= 2
+            pairs[count, 0] = min(i, j)
+            pairs[count, 1] = max(i, j)
+            count += 1
+    return pairs[:count].copy()
+
+
+@kernel
+def near_wall_pairs(positions, shape_index, bounding_radius, fixed, wall_points, wall_normals, margin):
+    """(body, wall) pairs whose bounding sphere reaches into the wall half-space. (k, 2) int64."""
+    n = positions.shape[0]
+    n_walls = wall_points.shape[0]
+    pairs = np.empty((n * max(n_walls, 1), 2), dtype=np.int64)
+    count = 0
+    for b in range(n):
+        if fixed[b]:
+            continue
+        r = bounding_radius[shape_index[b]] + margin
+        for w in range(n_walls):
+            distance = 0.0
+            for c in range(3):
+                distance += wall_normals[w, c] * (positions[b, c] - wall_points[w, c])
+            if distance < r:
+                pairs[count, 0] = b
+                pairs[count, 1] = w
+                count += 1
+    return pairs[:count].copy()

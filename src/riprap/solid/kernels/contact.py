@@ -1,0 +1,448 @@
+"""Munjiza's distributed potential contact between rigid tetrahedral bodies: the fast path.
+
+Symbols (Munjiza 2004; seed paper eq. 6):
+
+============  ===============================================================
+``p``         contact penalty (Pa), ``contact_penalty``
+``phi``       potential of a tet: 4 min_k lambda_k (0 on its faces, 1 at its centroid)
+``lam``       barycentric coordinates lambda_k of a point in a tet
+``n``         unit outward normal of a boundary triangle
+============  ===============================================================
+
+The force on body A from body B is  F_A = p sum_{c in A, t in B} int_{c cap t} (grad phi_c - grad
+phi_t) dV.  By the divergence theorem it equals the boundary form
+
+    F_A = -p int_{dA cap B} phi_B n_A dS  +  p int_{dB cap A} phi_A n_B dS,
+
+where phi_B is the piecewise potential of B's tets. Faces shared by two tets of the same body cancel
+(same points, same phi, opposite normals), so only the *boundary* triangles of each body enter. The
+moments agree too (int x x grad phi dV = oint phi x x n dS), so force and torque are exact, not an
+approximation of the volume form: ``kernels/reference.py`` evaluates the volume form tet by tet and
+the tests require agreement to round-off. The integrand is linear on each (triangle, sub-tet) piece
+and is integrated in closed form.
+
+For rigid bodies everything is evaluated in the frame of the body whose potential is used, where the
+barycentric maps, triangle clusters and the tet lookup grid are precomputed (``solid/shape.py``).
+"""
+import numpy as np
+
+from riprap._jit import kernel
+from riprap.solid.kernels.geometry_ops import (MAX_POLYGON, clip_polygon, integrate_linear_on_polygon,
+                                               integrate_tet_potential_on_polygon, mat3_mul_transposed,
+                                               mat3_vec, mat3_transposed_vec)
+
+MAX_CANDIDATE_TETS = 1024
+# Result layout of one directional evaluation (surface of S in the potential of P), in P's frame.
+R_FORCE = 0        # 3: force on the surface body
+R_MOMENT = 3       # 3: moment of that force about P's centroid
+R_WEIGHT = 6       # p int phi dS (force-weighted point denominator)
+R_POINT = 7        # 3: p int x phi dS
+R_STIFFNESS = 10   # p int |grad phi . n| dS
+R_AREA = 11        # area of the surface inside P
+R_OVERFLOW = 12    # > 0 if the candidate buffer overflowed
+R_SIZE = 13
+
+
+@kernel
+def surface_in_potential(surface_shape, potential_shape, rotation, translation, penalty,
+                         node_offset, nodes, tet_offset, tets, barycentric,
+                         triangle_offset, triangles, triangle_normals, triangle_centres,
+                         triangle_radii, cluster_offset, cluster_begin, cluster_end,
+                         cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
+                         cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets,
+                         cell_clearance, local_box_min, local_box_max, result):
+    """Boundary triangles of ``surface_shape`` inside the tets of ``potential_shape``.
+
+    ``rotation``, ``translation`` map the surface body's frame into the potential body's frame.
+    Adds to ``result`` (layout R_*), all in the potential body's frame:
+    force -p int phi n dS on the surface body, its moment about the potential body's centroid, etc.
+    """
+    sp = potential_shape
+    ss = surface_shape
+    origin = grid_origin[sp]
+    cell = grid_cell_size[sp]
+    nx = grid_dims[sp, 0]
+    ny = grid_dims[sp, 1]
+    nz = grid_dims[sp, 2]
+    box_lo = origin
+    box_hi = np.empty(3)
+    box_hi[0] = origin[0] + nx * cell
+    box_hi[1] = origin[1] + ny * cell
+    box_hi[2] = origin[2] + nz * cell
+    coff = cell_offset[sp]
+    csoff = cell_start_offset[sp]
+    ctoff = cell_tets_offset[sp]
+    noff_s = node_offset[ss]
+    toff_p = tet_offset[sp]
+    troff = triangle_offset[ss]
+
+    polygon = np.empty((MAX_POLYGON, 7))
+    work_a = np.empty((MAX_POLYGON, 7))
+    work_b = np.empty((MAX_POLYGON, 7))
+    signed = np.empty(MAX_POLYGON)
+    moments = np.zeros(6)
+    vertices = np.empty((3, 3))
+    lam = np.empty((3, 4))
+    normal = np.empty(3)
+    centre = np.empty(3)
+    candidates = np.empty(MAX_CANDIDATE_TETS, dtype=np.int64)
+    i_lo = np.empty(3, dtype=np.int64)
+    i_hi = np.empty(3, dtype=np.int64)
+
+    for cl in range(cluster_offset[ss], cluster_offset[ss + 1]):
+        for c in range(3):
+            centre[c] = (rotation[c, 0] * cluster_centres[cl, 0] + rotation[c, 1] * cluster_centres[cl, 1]
+                         + rotation[c, 2] * cluster_centres[cl, 2] + translation[c])
+        if _sphere_far(centre, cluster_radii[cl], box_lo, box_hi, origin, cell, nx, ny, nz,
+                       cell_clearance, coff, local_box_min[sp], local_box_max[sp]):
+            continue
+        for tri_local in range(cluster_begin[cl], cluster_end[cl]):
+            tri = troff + tri_local
+            for c in range(3):
+                centre[c] = (rotation[c, 0] * triangle_centres[tri, 0] + rotation[c, 1] * triangle_centres[tri, 1]
+                             + rotation[c, 2] * triangle_centres[tri, 2] + translation[c])
+            if _sphere_far(centre, triangle_radii[tri], box_lo, box_hi, origin, cell, nx, ny, nz,
+                           cell_clearance, coff, local_box_min[sp], local_box_max[sp]):
+                continue
+            for v in range(3):
+                node = noff_s + triangles[tri, v]
+                for c in range(3):
+                    vertices[v, c] = (rotation[c, 0] * nodes[node, 0] + rotation[c, 1] * nodes[node, 1]
+                                      + rotation[c, 2] * nodes[node, 2] + translation[c])
+            for c in range(3):
+                normal[c] = (rotation[c, 0] * triangle_normals[tri, 0] + rotation[c, 1] * triangle_normals[tri, 1]
+                             + rotation[c, 2] * triangle_normals[tri, 2])
+            # Candidate tets: those listed in the grid cells the triangle's box touches.
+            n_candidates = 0
+            for c in range(3):
+                lo = min(vertices[0, c], min(vertices[1, c], vertices[2, c]))
+                hi = max(vertices[0, c], max(vertices[1, c], vertices[2, c]))
+                a = int(np.floor((lo - origin[c]) / cell))
+                b = int(np.floor((hi - origin[c]) / cell))
+                n_axis = grid_dims[sp, c]
+                i_lo[c] = max(a, 0)
+                i_hi[c] = min(b, n_axis - 1)
+            if i_lo[0] > i_hi[0] or i_lo[1] > i_hi[1] or i_lo[2] > i_hi[2]:
+                continue
+            for ix in range(i_lo[0], i_hi[0] + 1):
+                for iy in range(i_lo[1], i_hi[1] + 1):
+                    for iz in range(i_lo[2], i_hi[2] + 1):
+                        cell_id = (ix * ny + iy) * nz + iz
+                        for e in range(cell_start[csoff + cell_id], cell_start[csoff + cell_id + 1]):
+                            t = cell_tets[ctoff + e]
+                            seen = False
+                            for q in range(n_candidates):
+                                if candidates[q] == t:
+                                    seen = True
+                                    break
+                            if not seen:
+                                if n_candidates < MAX_CANDIDATE_TETS:
+                                    candidates[n_candidates] = t
+                                    n_candidates += 1
+                                else:
+                                    result[R_OVERFLOW] += 1.0
+            for q in range(n_candidates):
+                t = toff_p + candidates[q]
+                # Barycentrics of the three vertices; a face plane with all three outside rejects.
+                outside = False
+                for k in range(4):
+                    all_out = True
+                    for v in range(3):
+                        value = (barycentric[t, k, 0] * vertices[v, 0] + barycentric[t, k, 1] * vertices[v, 1]
+                                 + barycentric[t, k, 2] * vertices[v, 2] + barycentric[t, k, 3])
+                        lam[v, k] = value
+                        if value > 0.0:
+                            all_out = False
+                    if all_out:
+                        outside = True
+                        break
+                if outside:
+                    continue
+                for v in range(3):
+                    for c in range(3):
+                        polygon[v, c] = vertices[v, c]
+                    for k in range(4):
+                        polygon[v, 3 + k] = lam[v, k]
+                for m in range(6):
+                    moments[m] = 0.0
+                integrate_tet_potential_on_polygon(polygon, 3, barycentric[t, :, 0:3], normal,
+                                                   work_a, work_b, signed, moments)
+                if moments[0] <= 0.0:
+                    continue
+                # Force on the surface body: -p phi n dS; moment about the potential body's centroid.
+                fx = -penalty * moments[0] * normal[0]
+                fy = -penalty * moments[0] * normal[1]
+                fz = -penalty * moments[0] * normal[2]
+                result[R_FORCE + 0] += fx
+                result[R_FORCE + 1] += fy
+                result[R_FORCE + 2] += fz
+                mx = moments[1]
+                my = moments[2]
+                mz = moments[3]
+                result[R_MOMENT + 0] += -penalty * (my * normal[2] - mz * normal[1])
+                result[R_MOMENT + 1] += -penalty * (mz * normal[0] - mx * normal[2])
+                result[R_MOMENT + 2] += -penalty * (mx * normal[1] - my * normal[0])
+                result[R_WEIGHT] += penalty * moments[0]
+                result[R_POINT + 0] += penalty * mx
+                result[R_POINT + 1] += penalty * my
+                result[R_POINT + 2] += penalty * mz
+                result[R_STIFFNESS] += penalty * moments[5]
+                result[R_AREA] += moments[4]
+
+
+@kernel
+def _sphere_far(centre, radius, box_lo, box_hi, origin, cell, nx, ny, nz, clearance, coff,
+                shape_lo, shape_hi):
+    """True when a sphere cannot touch the body (outside its box, or in a cell far from it)."""
+    gap2 = 0.0
+    for c in range(3):
+        if centre[c] < shape_lo[c]:
+            d = shape_lo[c] - centre[c]
+            gap2 += d * d
+        elif centre[c] > shape_hi[c]:
+            d = centre[c] - shape_hi[c]
+            gap2 += d * d
+    if gap2 > radius * radius:
+        return True
+    ix = int(np.floor((centre[0] - origin[0]) / cell))
+    iy = int(np.floor((centre[1] - origin[1]) / cell))
+    iz = int(np.floor((centre[2] - origin[2]) / cell))
+    if ix < 0 or iy < 0 or iz < 0 or ix >= nx or iy >= ny or iz >= nz:
+        return False
+    return clearance[coff + (ix * ny + iy) * nz + iz] > radius
+
+
+@kernel
+def body_pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
+                              penalty, shape_arrays, out):
+    """Potential (normal) contact between two rigid bodies, both directions of the boundary form.
+
+    ``out`` (14,): [0:3] force on A (world), [3:6] torque on A about its centroid, [6:9] torque on B
+    about its centroid, [9:12] force-weighted contact point, [12] stiffness (N/m), [13] overflow.
+    """
+    (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
+     triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
+     cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
+     cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets, cell_clearance,
+     local_box_min, local_box_max, wall_potential_depth) = shape_arrays
+    for i in range(14):
+        out[i] = 0.0
+    weight = 0.0
+    point = np.zeros(3)
+    stiffness = 0.0
+    d = position_a - position_b
+    # Direction 1: A's surface in B's potential, evaluated in B's frame.
+    rel_rotation = mat3_mul_transposed(rotation_b, rotation_a)
+    rel_translation = mat3_transposed_vec(rotation_b, d)
+    res = np.zeros(R_SIZE)
+    surface_in_potential(shape_a, shape_b, rel_rotation, rel_translation, penalty,
+                         node_offset, nodes, tet_offset, tets, barycentric, triangle_offset,
+                         triangles, triangle_normals, triangle_centres, triangle_radii,
+                         cluster_offset, cluster_begin, cluster_end, cluster_centres,
+                         cluster_radii, grid_origin, grid_cell_size, grid_dims, cell_offset,
+                         cell_start_offset, cell_start, cell_tets_offset, cell_tets,
+                         cell_clearance, local_box_min, local_box_max, res)
+    force1 = mat3_vec(rotation_b, res[R_FORCE:R_FORCE + 3])          # on A
+    moment1 = mat3_vec(rotation_b, res[R_MOMENT:R_MOMENT + 3])       # about B's centroid
+    # torque on A about its centroid: moment about B's centroid + (x_B - x_A) x F
+    torque_a = moment1 + np.cross(-d, force1)
+    torque_b = -moment1
+    force_a = force1.copy()
+    if res[R_WEIGHT] > 0.0:
+        weight += res[R_WEIGHT]
+        point += mat3_vec(rotation_b, res[R_POINT:R_POINT + 3]) + position_b * res[R_WEIGHT]
+    stiffness += res[R_STIFFNESS]
+    overflow = res[R_OVERFLOW]
+    # Direction 2: B's surface in A's potential, evaluated in A's frame.
+    rel_rotation = mat3_mul_transposed(rotation_a, rotation_b)
+    rel_translation = mat3_transposed_vec(rotation_a, -d)
+    res[:] = 0.0
+    surface_in_potential(shape_b, shape_a, rel_rotation, rel_translation, penalty,
+                         node_offset, nodes, tet_offset, tets, barycentric, triangle_offset,
+                         triangles, triangle_normals, triangle_centres, triangle_radii,
+                         cluster_offset, cluster_begin, cluster_end, cluster_centres,
+                         cluster_radii, grid_origin, grid_cell_size, grid_dims, cell_offset,
+                         cell_start_offset, cell_start, cell_tets_offset, cell_tets,
+                         cell_clearance, local_box_min, local_box_max, res)
+    force2 = mat3_vec(rotation_a, res[R_FORCE:R_FORCE + 3])          # on B
+    moment2 = mat3_vec(rotation_a, res[R_MOMENT:R_MOMENT + 3])       # about A's centroid
+    force_a -= force2
+    torque_a -= moment2
+    torque_b += moment2 + np.cross(d, force2)
+    if res[R_WEIGHT] > 0.0:
+        weight += res[R_WEIGHT]
+        point += mat3_vec(rotation_a, res[R_POINT:R_POINT + 3]) + position_a * res[R_WEIGHT]
+    stiffness += res[R_STIFFNESS]
+    overflow += res[R_OVERFLOW]
+    out[0:3] = force_a
+    out[3:6] = torque_a
+    out[6:9] = torque_b
+    if weight > 0.0:
+        out[9:12] = point / weight
+    out[12] = stiffness
+    out[13] = overflow
+
+
+@kernel
+def body_wall_potential_force(shape, position, rotation, wall_point, wall_normal, penalty,
+                              shape_arrays, out):
+    """Potential contact between a rigid body and a half-space wall.
+
+    The wall is {x : n.(x - point) < 0}; its potential rises linearly with depth over the body's
+    ``wall_potential_depth`` (as if the wall were meshed like the body). Boundary form:
+    F = -p int_{dA in wall} phi_W n_A dS + p int_{wall plane in A} phi_A n dS.
+    ``out`` as for :func:`body_pair_potential_force` with [6:9] unused.
+    """
+    (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
+     triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
+     cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
+     cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets, cell_clearance,
+     local_box_min, local_box_max, wall_potential_depth) = shape_arrays
+    for i in range(14):
+        out[i] = 0.0
+    # The plane in the body frame: n_b . y = offset; inside the wall where n_b . y < offset.
+    n_b = mat3_transposed_vec(rotation, wall_normal)
+    offset = 0.0
+    for c in range(3):
+        offset += wall_normal[c] * (wall_point[c] - position[c])
+    h_wall = wall_potential_depth[shape]
+    force = np.zeros(3)
+    moment = np.zeros(3)
+    point = np.zeros(3)
+    weight = 0.0
+    stiffness = 0.0
+    polygon = np.empty((MAX_POLYGON, 7))
+    work_a = np.empty((MAX_POLYGON, 7))
+    work_b = np.empty((MAX_POLYGON, 7))
+    signed = np.empty(MAX_POLYGON)
+    moments = np.zeros(6)
+    noff = node_offset[shape]
+    # (i) boundary triangles inside the wall, weighted by the wall potential depth / h_wall.
+    for tri in range(triangle_offset[shape], triangle_offset[shape + 1]):
+        depth_centre = offset - (n_b[0] * triangle_centres[tri, 0] + n_b[1] * triangle_centres[tri, 1]
+                                 + n_b[2] * triangle_centres[tri, 2])
+        if depth_centre < -triangle_radii[tri]:
+            continue
+        for v in range(3):
+            node = noff + triangles[tri, v]
+            for c in range(3):
+                polygon[v, c] = nodes[node, c]
+            depth = offset - (n_b[0] * nodes[node, 0] + n_b[1] * nodes[node, 1] + n_b[2] * nodes[node, 2])
+            polygon[v, 3] = depth
+            for c in range(4, 7):
+                polygon[v, c] = 0.0
+            signed[v] = depth
+        m = clip_polygon(polygon, 3, signed, work_a)
+        if m < 3:
+            continue
+        for i in range(6):
+            moments[i] = 0.0
+        normal = triangle_normals[tri]
+        integrate_linear_on_polygon(work_a, m, 3, 1.0 / h_wall, normal, moments)
+        if moments[0] <= 0.0:
+            continue
+        for c in range(3):
+            force[c] -= penalty * moments[0] * normal[c]
+        moment[0] -= penalty * (moments[2] * normal[2] - moments[3] * normal[1])
+        moment[1] -= penalty * (moments[3] * normal[0] - moments[1] * normal[2])
+        moment[2] -= penalty * (moments[1] * normal[1] - moments[2] * normal[0])
+        weight += penalty * moments[0]
+        for c in range(3):
+            point[c] += penalty * moments[1 + c]
+        cos = abs(n_b[0] * normal[0] + n_b[1] * normal[1] + n_b[2] * normal[2])
+        stiffness += penalty * moments[4] * cos / h_wall
+    # (ii) the wall plane inside the body's tets, weighted by the body's potential.
+    toff = tet_offset[shape]
+    depths = np.empty(4)
+    for t_local in range(tet_offset[shape + 1] - toff):
+        t = toff + t_local
+        n_in = 0
+        for k in range(4):
+            node = noff + tets[t, k]
+            depths[k] = offset - (n_b[0] * nodes[node, 0] + n_b[1] * nodes[node, 1] + n_b[2] * nodes[node, 2])
+            if depths[k] > 0.0:
+                n_in += 1
+        if n_in == 0 or n_in == 4:
+            continue
+        m = _plane_section(nodes, noff, tets, t, depths, n_b, polygon)
+        if m < 3:
+            continue
+        for i in range(6):
+            moments[i] = 0.0
+        integrate_tet_potential_on_polygon(polygon, m, barycentric[t, :, 0:3], n_b,
+                                           work_a, work_b, signed, moments)
+        if moments[0] <= 0.0:
+            continue
+        for c in range(3):
+            force[c] += penalty * moments[0] * n_b[c]
+        moment[0] += penalty * (moments[2] * n_b[2] - moments[3] * n_b[1])
+        moment[1] += penalty * (moments[3] * n_b[0] - moments[1] * n_b[2])
+        moment[2] += penalty * (moments[1] * n_b[1] - moments[2] * n_b[0])
+        weight += penalty * moments[0]
+        for c in range(3):
+            point[c] += penalty * moments[1 + c]
+        stiffness += penalty * moments[5]
+    out[0:3] = mat3_vec(rotation, force)
+    out[3:6] = mat3_vec(rotation, moment)
+    if weight > 0.0:
+        out[9:12] = mat3_vec(rotation, point / weight) + position
+    out[12] = stiffness
+
+
+@kernel
+def _plane_section(nodes, noff, tets, t, depths, normal, polygon):
+    """Polygon where the plane depth = 0 cuts tet t, counter-clockwise about ``normal``, with the
+    barycentric coordinates of each vertex in columns 3-6. Returns the vertex count (3 or 4)."""
+    m = 0
+    for a in range(4):
+        for b in range(a + 1, 4):
+            da = depths[a]
+            db = depths[b]
+            if (da > 0.0) != (db > 0.0):
+                s = da / (da - db)
+                na = noff + tets[t, a]
+                nb = noff + tets[t, b]
+                for c in range(3):
+                    polygon[m, c] = nodes[na, c] + s * (nodes[nb, c] - nodes[na, c])
+                for k in range(4):
+                    polygon[m, 3 + k] = 0.0
+                polygon[m, 3 + a] = 1.0 - s
+                polygon[m, 3 + b] = s
+                m += 1
+    if m == 4:
+        # Order the quadrilateral by angle about its centre in the plane.
+        cx = 0.25 * (polygon[0, 0] + polygon[1, 0] + polygon[2, 0] + polygon[3, 0])
+        cy = 0.25 * (polygon[0, 1] + polygon[1, 1] + polygon[2, 1] + polygon[3, 1])
+        cz = 0.25 * (polygon[0, 2] + polygon[1, 2] + polygon[2, 2] + polygon[3, 2])
+        ux = polygon[0, 0] - cx
+        uy = polygon[0, 1] - cy
+        uz = polygon[0, 2] - cz
+        vx = normal[1] * uz - normal[2] * uy
+        vy = normal[2] * ux - normal[0] * uz
+        vz = normal[0] * uy - normal[1] * ux
+        angles = np.empty(4)
+        for i in range(4):
+            px = polygon[i, 0] - cx
+            py = polygon[i, 1] - cy
+            pz = polygon[i, 2] - cz
+            angles[i] = np.arctan2(px * vx + py * vy + pz * vz, px * ux + py * uy + pz * uz)
+        order = np.argsort(angles)
+        copy = polygon[:4, :].copy()
+        for i in range(4):
+            for c in range(7):
+                polygon[i, c] = copy[order[i], c]
+    elif m == 3:
+        ax = polygon[1, 0] - polygon[0, 0]
+        ay = polygon[1, 1] - polygon[0, 1]
+        az = polygon[1, 2] - polygon[0, 2]
+        bx = polygon[2, 0] - polygon[0, 0]
+        by = polygon[2, 1] - polygon[0, 1]
+        bz = polygon[2, 2] - polygon[0, 2]
+        orient = ((ay * bz - az * by) * normal[0] + (az * bx - ax * bz) * normal[1]
+                  + (ax * by - ay * bx) * normal[2])
+        if orient < 0.0:
+            for c in range(7):
+                tmp = polygon[1, c]
+                polygon[1, c] = polygon[2, c]
+                polygon[2, c] = tmp
+    return m

@@ -1,0 +1,362 @@
+"""SolidSolver: the rigid FEMDEM engine. Holds the body state as flat arrays, owns the step order,
+calls the kernels and turns their status into named errors.
+
+Step (velocity Verlet): kick(dt/2) with the forces of the previous step, drift(dt), new forces
+(broad phase, potential contact, damping, friction, gravity), kick(dt/2).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from riprap.errors import CaseFileError, InstabilityError, KernelOverflowError, OverlapError
+from riprap.solid.kernels import integrate, interactions, stepper
+from riprap.solid.kernels.geometry_ops import rotation_matrix
+from riprap.solid.materials import Material, pair_tables
+from riprap.solid.shape import RigidShape, ShapeTable
+from riprap.solid.walls import Wall
+
+# Boxes are grown by this fraction of the largest bounding radius so that contacts about to start
+# are found (the pair list is rebuilt every step, so this only has to cover one step's motion).
+_BROAD_PHASE_MARGIN = 0.02
+
+
+@dataclass
+class ContactRecords:
+    """Contacts of the last force evaluation, one row per touching pair.
+
+    ``body_j`` is -1 - w for a contact with wall w. Forces act on ``body_i`` (N); body j receives the
+    opposite. ``points`` is the force-weighted contact point (m).
+    """
+
+    body_i: np.ndarray
+    body_j: np.ndarray
+    points: np.ndarray
+    normal_forces: np.ndarray
+    tangential_forces: np.ndarray
+    stiffness: np.ndarray
+
+    def __len__(self):
+        return len(self.body_i)
+
+
+class SolidSolver:
+    """Rigid bodies with tetrahedral shapes, walls, gravity and Munjiza potential contact."""
+
+    def __init__(self, *, gravity=(0.0, 0.0, -9.81), local_damping: float = 0.0):
+        self.gravity = np.asarray(gravity, dtype=np.float64)
+        if not 0.0 <= local_damping < 1.0:
+            raise CaseFileError(f"local_damping = {local_damping!r} must be in [0, 1)")
+        self.local_damping = float(local_damping)
+        self.shapes: list[RigidShape] = []
+        self.materials: list[Material] = []
+        self.walls: list[Wall] = []
+        self._body_rows: list[tuple] = []
+        self.time = 0.0
+        self.step_count = 0
+        # Time is step_count * time_step counted from the last restart, so that it carries no
+        # accumulated round-off and a restarted run reproduces the unbroken one exactly.
+        self._time_origin = None
+        self._step_origin = 0
+        self.time_step = None
+        self._ready = False
+
+    # ------------------------------------------------------------------ building
+    def add_shape(self, shape: RigidShape) -> int:
+        self.shapes.append(shape)
+        self._ready = False
+        return len(self.shapes) - 1
+
+    def add_material(self, material: Material) -> int:
+        if any(m.name == material.name for m in self.materials):
+            raise CaseFileError(f"material '{material.name}' defined twice")
+        self.materials.append(material)
+        self._ready = False
+        return len(self.materials) - 1
+
+    def material_index(self, name: str) -> int:
+        for i, m in enumerate(self.materials):
+            if m.name == name:
+                return i
+        known = ", ".join(m.name for m in self.materials)
+        raise CaseFileError(f"unknown material '{name}' (defined: {known})")
+
+    def add_walls(self, walls) -> None:
+        for wall in walls:
+            self.material_index(wall.material)
+            self.walls.append(wall)
+        self._ready = False
+
+    def add_body(self, *, shape: int, material: int, position, orientation=(1.0, 0.0, 0.0, 0.0),
+                 velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0), fixed: bool = False,
+                 frame: str = "shape") -> int:
+        """Add a body; returns its index.
+
+        ``position`` is the centroid (m). ``orientation`` (w, x, y, z) rotates the shape *as built*
+        (``frame="shape"``) or its principal frame (``frame="principal"``).
+        """
+        q = np.asarray(orientation, dtype=np.float64)
+        norm = np.linalg.norm(q)
+        if not np.isfinite(norm) or norm < 1e-6:
+            raise CaseFileError(f"body {len(self._body_rows)}: orientation {tuple(q)} is not a rotation")
+        q = q / norm
+        if frame == "shape":
+            q = _quaternion_multiply(q, _quaternion_from_matrix(self.shapes[shape].frame_rotation))
+        self._body_rows.append((int(shape), int(material), np.asarray(position, float), q,
+                                np.asarray(velocity, float), np.asarray(angular_velocity, float),
+                                bool(fixed)))
+        self._ready = False
+        return len(self._body_rows) - 1
+
+    @property
+    def n_bodies(self) -> int:
+        return len(self._body_rows) if not self._ready else len(self.positions)
+
+    def finalize(self) -> None:
+        """Build the flat arrays, choose the time step and evaluate the initial forces; called
+        automatically before the first step."""
+        if self._ready:
+            return
+        self._build_arrays()
+        if self.time_step is None:
+            self.time_step = self.stable_time_step()
+        self._ready = True
+        self._compute_forces(self.time_step)
+
+    def _build_arrays(self) -> None:
+        if not self._body_rows:
+            raise CaseFileError("no bodies: add at least one body")
+        rows = self._body_rows
+        n = len(rows)
+        self.shape_index = np.array([r[0] for r in rows], dtype=np.int64)
+        self.material_index_of_body = np.array([r[1] for r in rows], dtype=np.int64)
+        self.positions = np.array([r[2] for r in rows], dtype=np.float64).reshape(n, 3)
+        self.quaternions = np.array([r[3] for r in rows], dtype=np.float64).reshape(n, 4)
+        self.velocities = np.array([r[4] for r in rows], dtype=np.float64).reshape(n, 3)
+        self.fixed = np.array([r[6] for r in rows], dtype=np.bool_)
+        densities = np.array([self.materials[m].density for m in self.material_index_of_body])
+        volumes = np.array([self.shapes[s].volume for s in self.shape_index])
+        self.masses = densities * volumes
+        self.principal_inertia = densities[:, None] * np.array(
+            [self.shapes[s].unit_principal_moments for s in self.shape_index]).reshape(n, 3)
+        self.inverse_masses = np.where(self.fixed, 0.0, 1.0 / self.masses)
+        self.inverse_principal_inertia = np.where(self.fixed[:, None], 0.0, 1.0 / self.principal_inertia)
+        self.velocities[self.fixed] = 0.0
+        omegas = np.array([r[5] for r in rows], dtype=np.float64).reshape(n, 3)
+        omegas[self.fixed] = 0.0
+        self.angular_momenta = np.zeros((n, 3))
+        for b in range(n):
+            r = rotation_matrix(self.quaternions[b])
+            self.angular_momenta[b] = r @ (self.principal_inertia[b] * (r.T @ omegas[b]))
+        self.forces = np.zeros((n, 3))
+        self.torques = np.zeros((n, 3))
+        self.table = ShapeTable.build(self.shapes)
+        self._shape_arrays = self.table.kernel_arrays()
+        self.bounding_radius = np.array([s.bounding_radius for s in self.shapes])
+        tables = pair_tables(self.materials)
+        self._pair_penalty = tables["penalty"]
+        self._pair_friction = tables["friction"]
+        self._pair_damping = tables["damping_ratio"]
+        self._pair_tangential = tables["tangential_ratio"]
+        self.wall_points = np.array([w.point for w in self.walls], dtype=np.float64).reshape(-1, 3)
+        self.wall_normals = np.array([w.normal for w in self.walls], dtype=np.float64).reshape(-1, 3)
+        self.wall_materials = np.array([self.material_index(w.material) for w in self.walls], dtype=np.int64)
+        self.history_keys = np.zeros(0, dtype=np.int64)
+        self.history_springs = np.zeros((0, 3))
+        self._margin = _BROAD_PHASE_MARGIN * float(self.bounding_radius.max())
+
+    # ------------------------------------------------------------------ physics
+    def stable_time_step(self, safety: float = 0.2) -> float:
+        """Time step from body masses and the largest plausible contact stiffness.
+
+        For each free body: k = 2 p A / h with A = V^(2/3) (a face-to-face contact of the whole
+        body), h the 10th-percentile boundary sub-tet height, and the smaller of the translational
+        mass and the rotational mass I_min / r_max^2; Delta t = safety * 2 sqrt(m / k) (the
+        critical step of an undamped spring is 2/omega). References: Munjiza (2004) ch. 3; the
+        check Delta t <= 0.2 * 2 sqrt(m/k) follows the Y3D practice summarised in
+        shared/research/munjiza.md.
+        """
+        if not self._ready:
+            self._build_arrays()
+        best = np.inf
+        for b in range(len(self.shape_index)):
+            if self.fixed[b]:
+                continue
+            shape = self.shapes[self.shape_index[b]]
+            penalty = self._pair_penalty[self.material_index_of_body[b]].max()
+            stiffness = 2.0 * penalty * shape.volume ** (2.0 / 3.0) / shape.min_subtet_height
+            rotational_mass = self.principal_inertia[b].min() / shape.bounding_radius ** 2
+            mass = min(self.masses[b], rotational_mass)
+            best = min(best, 2.0 * np.sqrt(mass / stiffness))
+        if not np.isfinite(best):
+            best = 1e-3
+        return safety * best
+
+    def _common_arguments(self):
+        return (self.masses, self.inverse_masses, self.inverse_principal_inertia, self.fixed,
+                self.shape_index, self.material_index_of_body, self.gravity, self.wall_points,
+                self.wall_normals, self.wall_materials, self.bounding_radius, self._pair_penalty,
+                self._pair_friction, self._pair_damping, self._pair_tangential)
+
+    def _compute_forces(self, step: float) -> None:
+        (self.history_keys, self.history_springs, results, body_pairs, wall_pairs, self._omegas,
+         overflow) = stepper.compute_forces(
+            self.positions, self.quaternions, self.velocities, self.angular_momenta, self.forces,
+            self.torques, *self._common_arguments(), self.history_keys, self.history_springs,
+            self._margin, step, self._shape_arrays)
+        self._store_results(results, body_pairs, wall_pairs)
+        if overflow:
+            self._raise_overflow()
+
+    def _store_results(self, results, body_pairs, wall_pairs) -> None:
+        self._last = (results, body_pairs, wall_pairs)
+        self._contacts = None
+        self._n_candidates = len(results)
+
+    def _raise_overflow(self):
+        raise KernelOverflowError(
+            "contact candidate buffer overflowed: a shape has too many tets per lookup cell; "
+            "re-mesh it more uniformly or report this as a bug")
+
+    def advance(self, n_steps: int) -> None:
+        """Advance ``n_steps`` time steps in compiled code.
+
+        Raises InstabilityError (naming the body and time) when the state stops being finite; the
+        state is then left as it was at the failing step.
+        """
+        self.finalize()
+        if n_steps <= 0:
+            return
+        (done, status, self.history_keys, self.history_springs, results, body_pairs, wall_pairs,
+         self._omegas) = stepper.advance(
+            int(n_steps), self.positions, self.quaternions, self.velocities, self.angular_momenta,
+            self.forces, self.torques, self._omegas, *self._common_arguments(),
+            self.history_keys, self.history_springs, self._margin, self.time_step,
+            self.local_damping, self._shape_arrays)
+        self.step_count += int(done)
+        self.time = self.step_count * self.time_step if self._time_origin is None else self._time_origin + (self.step_count - self._step_origin) * self.time_step
+        self._store_results(results, body_pairs, wall_pairs)
+        if status == stepper.STATUS_OVERFLOW:
+            self._raise_overflow()
+        if status == stepper.STATUS_NOT_FINITE:
+            self.check_finite()
+
+    def step(self) -> None:
+        """Advance by one time step."""
+        self.advance(1)
+
+    # ------------------------------------------------------------------ diagnostics
+    @property
+    def contacts(self) -> ContactRecords:
+        """Contacts of the last force evaluation."""
+        self.finalize()
+        if self._contacts is None:
+            results, body_pairs, wall_pairs = self._last
+            active = results[:, interactions.C_ACTIVE] > 0
+            body_i = np.concatenate([body_pairs[:, 0], wall_pairs[:, 0]])[active]
+            body_j = np.concatenate([body_pairs[:, 1], -1 - wall_pairs[:, 1]])[active]
+            r = results[active]
+            self._contacts = ContactRecords(
+                body_i=body_i, body_j=body_j,
+                points=r[:, interactions.C_POINT:interactions.C_POINT + 3],
+                normal_forces=r[:, interactions.C_NORMAL_FORCE:interactions.C_NORMAL_FORCE + 3],
+                tangential_forces=r[:, interactions.C_TANGENTIAL_FORCE:interactions.C_TANGENTIAL_FORCE + 3],
+                stiffness=r[:, interactions.C_STIFFNESS])
+        return self._contacts
+
+    @property
+    def angular_velocities(self) -> np.ndarray:
+        return integrate.angular_velocities(self.quaternions, self.angular_momenta,
+                                            self.inverse_principal_inertia)
+
+    def kinetic_energy(self) -> float:
+        omega = self.angular_velocities
+        translational = 0.5 * np.sum(self.masses[~self.fixed] * np.sum(self.velocities[~self.fixed] ** 2, axis=1))
+        rotational = 0.5 * np.sum(np.sum(omega * self.angular_momenta, axis=1)[~self.fixed])
+        return float(translational + rotational)
+
+    def potential_energy(self) -> float:
+        return float(-np.sum(self.masses[~self.fixed] * (self.positions[~self.fixed] @ self.gravity)))
+
+    def rotation_matrices(self) -> np.ndarray:
+        return np.array([rotation_matrix(q) for q in self.quaternions]).reshape(-1, 3, 3)
+
+    def overlaps(self, tolerance: float = 0.0) -> list[tuple[int, int, float]]:
+        """Touching pairs whose mean overlap depth (potential force / stiffness) exceeds
+        ``tolerance`` (m). Walls appear as j = -1 - wall index."""
+        c = self.contacts
+        found = []
+        for k in range(len(c)):
+            potential = np.linalg.norm(c.normal_forces[k])
+            depth = potential / c.stiffness[k] if c.stiffness[k] > 0 else 0.0
+            if depth > tolerance:
+                found.append((int(c.body_i[k]), int(c.body_j[k]), float(depth)))
+        return found
+
+    def check_no_initial_overlap(self, tolerance: float) -> None:
+        """Raise OverlapError listing every pair that overlaps deeper than ``tolerance`` (m)."""
+        found = self.overlaps(tolerance)
+        if found:
+            lines = []
+            for i, j, depth in found[:20]:
+                other = f"wall {-1 - j}" if j < 0 else f"body {j}"
+                lines.append(f"  body {i} and {other}: overlap depth {depth:.3e} m")
+            more = f"\n  ... and {len(found) - 20} more" if len(found) > 20 else ""
+            raise OverlapError(
+                f"{len(found)} overlapping pair(s) at the start (tolerance {tolerance:.1e} m):\n"
+                + "\n".join(lines) + more
+                + "\nMove the bodies apart (larger grid spacing or a higher start) and run again.")
+
+    def check_finite(self) -> None:
+        """Raise InstabilityError naming the first body whose state is not finite."""
+        bad = ~(np.isfinite(self.positions).all(axis=1) & np.isfinite(self.velocities).all(axis=1)
+                & np.isfinite(self.quaternions).all(axis=1) & np.isfinite(self.angular_momenta).all(axis=1))
+        if bad.any():
+            first = int(np.argmax(bad))
+            raise InstabilityError(
+                f"body {first} has a non-finite state at t = {self.time:.6g} s (step {self.step_count}); "
+                f"{int(bad.sum())} bodies affected. The time step {self.time_step:.3e} s is probably too "
+                "large for the contact stiffness: lower time_step (or time_step_safety) or contact_penalty.")
+
+    # ------------------------------------------------------------------ state I/O (arrays only)
+    STATE_ARRAYS = ("positions", "quaternions", "velocities", "angular_momenta", "forces", "torques",
+                    "history_keys", "history_springs")
+
+    def state_arrays(self) -> dict[str, np.ndarray]:
+        self.finalize()
+        arrays = {name: getattr(self, name).copy() for name in self.STATE_ARRAYS}
+        arrays["clock"] = np.array([self.time, float(self.step_count), self.time_step])
+        return arrays
+
+    def load_state_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        self.finalize()
+        for name in self.STATE_ARRAYS:
+            current = getattr(self, name)
+            value = np.asarray(arrays[name])
+            if name not in ("history_keys", "history_springs") and value.shape != current.shape:
+                raise CaseFileError(f"checkpoint array '{name}' has shape {value.shape}, "
+                                    f"the case has {current.shape}: the checkpoint is from another case")
+            setattr(self, name, np.ascontiguousarray(value.copy()))
+        self.time = float(arrays["clock"][0])
+        self.step_count = int(arrays["clock"][1])
+        self.time_step = float(arrays["clock"][2])
+        self._time_origin = None if self.time == self.step_count * self.time_step else self.time
+        self._step_origin = self.step_count
+        self._omegas = integrate.angular_velocities(self.quaternions, self.angular_momenta,
+                                                    self.inverse_principal_inertia)
+
+
+def _quaternion_multiply(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def _quaternion_from_matrix(m) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+    x, y, z, w = Rotation.from_matrix(np.asarray(m)).as_quat()
+    return np.array([w, x, y, z])

@@ -1,0 +1,130 @@
+"""Checkpoints: bit-exact round trips, atomic replacement, and named errors on bad files."""
+
+import numpy as np
+import pytest
+
+from riprap.errors import CaseFileError, RiprapError
+from riprap.io.checkpoint import (
+    CHECKPOINT_FORMAT,
+    CheckpointError,
+    load_checkpoint,
+    save_checkpoint,
+)
+
+
+def _example_arrays():
+    rng = np.random.default_rng(3)
+    return {
+        "positions": rng.normal(size=(5, 3)),
+        "quaternions": rng.normal(size=(5, 4)).astype(np.float32),
+        "tets": rng.integers(0, 100, size=(7, 4)).astype(np.int32),
+        "body_of_node": np.arange(11, dtype=np.int64),
+        "in_contact": rng.random(9) > 0.5,
+        "special_values": np.array([np.nan, np.inf, -np.inf, -0.0, 5e-324]),
+        "step": np.array(12345, dtype=np.uint64),
+        "empty": np.zeros((0, 3)),
+    }
+
+
+def test_checkpoint_round_trip_is_bit_exact(tmp_path):
+    arrays = _example_arrays()
+    metadata = {"time": 0.1 + 0.2, "step": 42, "case_file": "case.toml", "bodies": [1, 2]}
+    path = save_checkpoint(tmp_path / "state.npz", arrays=arrays, metadata=metadata)
+    loaded, loaded_metadata = load_checkpoint(path)
+
+    assert set(loaded) == set(arrays)
+    for name, array in arrays.items():
+        assert loaded[name].dtype == array.dtype, name
+        assert loaded[name].shape == array.shape, name
+        # Compare raw bytes: NaN payloads and the sign of zero must survive too.
+        assert loaded[name].tobytes() == np.ascontiguousarray(array).tobytes(), name
+    assert loaded_metadata == {**metadata, "checkpoint_format": CHECKPOINT_FORMAT}
+
+
+def test_checkpoint_metadata_accepts_numpy_scalars(tmp_path):
+    path = save_checkpoint(tmp_path / "state.npz", arrays={},
+                           metadata={"time": np.float64(0.25), "step": np.int64(7)})
+    _, metadata = load_checkpoint(path)
+    assert metadata["time"] == 0.25 and metadata["step"] == 7
+
+
+def test_checkpoint_overwrite_replaces_previous_and_leaves_no_temporary(tmp_path):
+    path = tmp_path / "state.npz"
+    save_checkpoint(path, arrays={"x": np.zeros(3)}, metadata={"step": 1})
+    save_checkpoint(path, arrays={"x": np.ones(3)}, metadata={"step": 2})
+    arrays, metadata = load_checkpoint(path)
+    assert metadata["step"] == 2
+    assert np.array_equal(arrays["x"], np.ones(3))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["state.npz"]
+
+
+def test_checkpoint_failed_write_keeps_previous_file(tmp_path):
+    path = tmp_path / "state.npz"
+    save_checkpoint(path, arrays={"x": np.arange(4)}, metadata={"step": 1})
+    before = path.read_bytes()
+    with pytest.raises(CaseFileError, match="metadata"):
+        save_checkpoint(path, arrays={"x": np.arange(5)}, metadata={"bad": object()})
+    with pytest.raises(CaseFileError, match="object"):
+        save_checkpoint(path, arrays={"x": np.array([None, 1])}, metadata={})
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["state.npz"]
+
+
+def test_checkpoint_reserved_array_name_is_refused(tmp_path):
+    with pytest.raises(CaseFileError, match="reserved"):
+        save_checkpoint(tmp_path / "s.npz", arrays={"__riprap_metadata__": np.zeros(1)},
+                        metadata={})
+
+
+def test_missing_checkpoint_raises_named_error(tmp_path):
+    path = tmp_path / "nowhere.npz"
+    with pytest.raises(CheckpointError, match="nowhere.npz"):
+        load_checkpoint(path)
+
+
+@pytest.mark.parametrize("kept_fraction", [0.0, 0.3, 0.7, 0.95])
+def test_truncated_checkpoint_raises_named_error(tmp_path, kept_fraction):
+    path = tmp_path / "state.npz"
+    save_checkpoint(path, arrays=_example_arrays(), metadata={"step": 3})
+    data = path.read_bytes()
+    path.write_bytes(data[: int(kept_fraction * len(data))])
+    with pytest.raises(CheckpointError, match="state.npz") as caught:
+        load_checkpoint(path)
+    assert isinstance(caught.value, RiprapError)
+
+
+def test_corrupted_checkpoint_bytes_raise_named_error(tmp_path):
+    path = tmp_path / "state.npz"
+    save_checkpoint(path, arrays={"positions": np.arange(4000, dtype=np.float64)}, metadata={})
+    data = bytearray(path.read_bytes())
+    middle = len(data) // 2
+    data[middle: middle + 64] = bytes(64)
+    path.write_bytes(bytes(data))
+    with pytest.raises(CheckpointError, match="corrupt"):
+        load_checkpoint(path)
+
+
+def test_foreign_npz_is_not_a_checkpoint(tmp_path):
+    path = tmp_path / "other.npz"
+    np.savez(path, x=np.zeros(2))
+    with pytest.raises(CheckpointError, match="not a riprap checkpoint"):
+        load_checkpoint(path)
+
+
+def test_plain_text_file_is_not_a_checkpoint(tmp_path):
+    path = tmp_path / "notes.npz"
+    path.write_text("hello")
+    with pytest.raises(CheckpointError, match="notes.npz"):
+        load_checkpoint(path)
+
+
+def test_other_checkpoint_format_version_is_refused(tmp_path):
+    path = tmp_path / "future.npz"
+    save_checkpoint(path, arrays={"x": np.zeros(1)}, metadata={})
+    # Rewrite the metadata entry as a future riprap would.
+    with np.load(path) as archive:
+        contents = {name: archive[name] for name in archive.files}
+    contents["__riprap_metadata__"] = np.array('{"checkpoint_format": 2}')
+    np.savez(path, **contents)
+    with pytest.raises(CheckpointError, match="checkpoint_format 2"):
+        load_checkpoint(path)
