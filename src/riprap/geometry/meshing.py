@@ -6,17 +6,19 @@ which initialises gmsh only if nobody else has, works in a model of its own, and
 model (and finalises gmsh if it initialised it) even when meshing fails.
 
 Mesh size. The default element size is ``nominal_diameter / 3.8`` (the constant
-``DEFAULT_DIVISIONS_PER_NOMINAL_DIAMETER``) with ``nominal_diameter = volume ** (1/3)``. Because it scales with the body, the tetrahedron count
-does not depend on the body's size: about 300-600 tetrahedra for a rock of moderate elongation,
-about 500 for a cube. A volume-based rule is used rather than a fraction of the
-bounding-box diagonal because an elongated or flat body would otherwise get far fewer tetrahedra
-across its thickness.
+``DEFAULT_DIVISIONS_PER_NOMINAL_DIAMETER``) with ``nominal_diameter = volume ** (1/3)``. Because it
+scales with the body, the tetrahedron count does not depend on the body's size: about 300-600
+tetrahedra for a rock of moderate elongation (up to ~700 at 2.5 : 1 : 0.5), about 600 for a cube.
+A volume-based rule is used rather than a fraction of the bounding-box diagonal because an
+elongated or flat body would otherwise get far fewer tetrahedra across its thickness.
 
 Slivers. The contact stiffness of a tetrahedron scales with 1 / (its smallest height), so one
 flat tetrahedron on the boundary sets a tiny stable time step for the whole run. Every mesh made
-here is optimised by gmsh (its default optimiser, then Netgen's) until the minimum signed inverse
-condition number (SICN, 1 for a regular tetrahedron, 0 for a flat one) is at least
-``MIN_ACCEPTED_QUALITY``; :func:`min_boundary_height` gives the length the time step uses.
+here is optimised by gmsh (its default optimiser and Netgen's); if the minimum signed inverse
+condition number (SICN, 1 for a regular tetrahedron, 0 for a flat one) is still below
+``OPTIMISE_BELOW_QUALITY``, further optimisation passes run, and a mesh whose minimum stays below
+``MIN_ACCEPTED_QUALITY`` is rejected with a :class:`MeshError`. :func:`min_boundary_height` gives
+the length the contact time step uses.
 """
 from __future__ import annotations
 

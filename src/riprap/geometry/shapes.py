@@ -14,8 +14,9 @@ from riprap.errors import CaseFileError
 from riprap.geometry.meshing import default_mesh_size, mesh_occ_shape, tetrahedralize_surface
 from riprap.geometry.tetmesh import TetMesh
 
-# Sphere element size as a fraction of the radius. The generic rule (0.36 r) loses 4.4 % of the
-# volume to the polyhedral surface; 0.3 r keeps the loss near 3 % at ~700 tetrahedra.
+# Sphere element size as a fraction of the radius. The generic rule (nominal diameter / 3.8 =
+# 0.42 r) would lose about 6 % of the volume to the inscribed polyhedral surface; 0.3 r keeps the
+# loss near 3 % at ~850 tetrahedra.
 _SPHERE_MESH_SIZE_PER_RADIUS = 0.3
 
 # Random rocks: relative jitter of the sample radii (points lie within +-10 % of the ellipsoid,
@@ -46,7 +47,7 @@ def sphere(*, radius: float, mesh_size: float | None = None) -> TetMesh:
     radius : float
         Radius in metres.
     mesh_size : float, optional
-        Largest element edge in metres; default ``0.3 * radius`` (about 700 tetrahedra, volume
+        Largest element edge in metres; default ``0.3 * radius`` (about 850 tetrahedra, volume
         about 3 % below the exact sphere because the surface is a polyhedron inscribed in it).
 
     Returns
@@ -81,12 +82,14 @@ def box(*, lengths: tuple[float, float, float], mesh_size: float | None = None) 
     if len(lengths) != 3:
         raise CaseFileError(f"box: lengths must be three edge lengths (x, y, z) in m, got {lengths}")
     lx, ly, lz = (_positive(length, "lengths", "box") for length in lengths)
+    return _box(lx, ly, lz, mesh_size, f"box(lengths=({lx:g}, {ly:g}, {lz:g}))")
+
+
+def _box(lx: float, ly: float, lz: float, mesh_size: float | None, name: str) -> TetMesh:
     if mesh_size is None:
         mesh_size = min(default_mesh_size(lx * ly * lz), lx, ly, lz)
     return mesh_occ_shape(
-        lambda occ: occ.addBox(-lx / 2, -ly / 2, -lz / 2, lx, ly, lz),
-        mesh_size=mesh_size,
-        name=f"box(lengths=({lx:g}, {ly:g}, {lz:g}))",
+        lambda occ: occ.addBox(-lx / 2, -ly / 2, -lz / 2, lx, ly, lz), mesh_size=mesh_size, name=name
     )
 
 
@@ -98,14 +101,14 @@ def cube(*, side: float, mesh_size: float | None = None) -> TetMesh:
     side : float
         Edge length in metres.
     mesh_size : float, optional
-        Largest element edge in metres; default ``side / 3.8`` (about 500 tetrahedra).
+        Largest element edge in metres; default ``side / 3.8`` (about 600 tetrahedra).
 
     Returns
     -------
     TetMesh
     """
     side = _positive(side, "side", "cube")
-    return box(lengths=(side, side, side), mesh_size=mesh_size)
+    return _box(side, side, side, mesh_size, f"cube(side={side:g})")
 
 
 def _spaced_directions(rng: np.random.Generator, count: int) -> np.ndarray:
@@ -184,7 +187,8 @@ def random_rock(
     n_vertices : int
         Number of sampled points (at least 8); about as many hull vertices.
     mesh_size : float, optional
-        Largest element edge in metres; default ``size / 3.8`` (about 300-600 tetrahedra).
+        Largest element edge in metres; default ``size / 3.8`` (about 300-600 tetrahedra for
+        elongation up to ~1.5, up to ~700 for elongation 2.5 and flatness 0.5).
 
     Returns
     -------

@@ -1,0 +1,5 @@
+import sys
+
+from riprap.cli import main
+
+sys.exit(main())

@@ -1,0 +1,104 @@
+"""Build a :class:`riprap.simulation.Simulation` from a validated :class:`riprap.case.load.Case`.
+
+Everything here is available from Python too: the case file and the API use the same names.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from riprap.geometry import shapes as builtin_shapes
+from riprap.geometry.tetmesh import TetMesh
+from riprap.simulation import Simulation
+from riprap.solid import walls as wall_builders
+from riprap.solid.materials import Material
+
+
+def build_shape(spec) -> TetMesh:
+    """The tetrahedral mesh of a ``[[shapes]]`` entry."""
+    p = dict(spec.parameters)
+    mesh_size = spec.mesh_size if spec.mesh_size > 0 else None
+    if spec.type == "mesh_file":
+        from riprap.io.mesh_files import read_mesh
+
+        mesh = read_mesh(p["file"], mesh_size=mesh_size)
+        scale = float(p.get("scale", 1.0))
+        if scale != 1.0:
+            mesh = TetMesh(nodes=mesh.nodes * scale, tets=mesh.tets, name=mesh.name)
+        return mesh
+    builders = {
+        "sphere": lambda: builtin_shapes.sphere(radius=p["radius"], mesh_size=mesh_size),
+        "box": lambda: builtin_shapes.box(lengths=tuple(p["lengths"]), mesh_size=mesh_size),
+        "cube": lambda: builtin_shapes.cube(side=p["side"], mesh_size=mesh_size),
+        "random_rock": lambda: builtin_shapes.random_rock(
+            size=p["size"], elongation=p["elongation"], flatness=p["flatness"], seed=p["seed"],
+            n_vertices=p["n_vertices"], mesh_size=mesh_size),
+        "tetrapod": lambda: builtin_shapes.tetrapod(height=p["height"], mesh_size=mesh_size),
+        "l_shape": lambda: builtin_shapes.l_shape(length=p["length"], width=p["width"],
+                                                  thickness=p["thickness"], mesh_size=mesh_size),
+    }
+    return builders[spec.type]()
+
+
+def build_simulation(case, *, output_directory: str | Path | None = None,
+                     progress: bool = True) -> Simulation:
+    """Shapes, materials, bodies and walls of ``case`` in a ready-to-run Simulation."""
+    settings = case.simulation
+    sim = Simulation(
+        end_time=settings.end_time, time_step=settings.time_step,
+        time_step_safety=settings.time_step_safety, gravity=settings.gravity,
+        output_interval=settings.output_interval, checkpoint_interval=settings.checkpoint_interval,
+        local_damping=settings.local_damping, rest_speed=settings.rest_speed,
+        output_directory=output_directory or case.output.directory,
+        paraview=case.output.paraview, picture=case.output.picture, progress=progress)
+    for m in case.materials:
+        sim.add_material(Material(name=m.name, density=m.density,
+                                  friction_coefficient=m.friction_coefficient,
+                                  restitution=m.restitution, contact_penalty=m.contact_penalty,
+                                  tangential_stiffness_ratio=m.tangential_stiffness_ratio))
+    for spec in case.shapes:
+        sim.add_shape(spec.name, build_shape(spec))
+    for body in case.bodies:
+        sim.add_body(shape=body.shape, material=body.material, position=body.position,
+                     orientation=body.orientation, velocity=body.velocity,
+                     angular_velocity=body.angular_velocity, fixed=body.fixed)
+    rng = np.random.default_rng(settings.seed)
+    for grid in case.body_grids:
+        add_body_grid(sim, grid, rng)
+    for wall in case.walls:
+        if wall.type == "plane":
+            sim.add_walls(wall_builders.plane(point=wall.parameters["point"],
+                                              normal=wall.parameters["normal"],
+                                              material=wall.material))
+        else:
+            lo, hi = wall.parameters["min"], wall.parameters["max"]
+            sim.add_walls(wall_builders.box(min=lo, max=hi, material=wall.material,
+                                            open_top=wall.parameters["open_top"]),
+                          container_box=(tuple(lo), tuple(hi)))
+    return sim
+
+
+def add_body_grid(sim: Simulation, grid, rng: np.random.Generator) -> None:
+    """Bodies on a rectangular grid, with random or identity orientations and optional jitter."""
+    nx, ny, nz = grid.counts
+    k = 0
+    for iz in range(nz):
+        for iy in range(ny):
+            for ix in range(nx):
+                if grid.shape_choice == "random":
+                    shape = grid.shapes[int(rng.integers(len(grid.shapes)))]
+                else:
+                    shape = grid.shapes[k % len(grid.shapes)]
+                position = np.asarray(grid.origin) + np.asarray(grid.spacing) * (ix, iy, iz)
+                if grid.jitter > 0:
+                    position = position + rng.uniform(-grid.jitter, grid.jitter, 3)
+                if grid.orientation == "random":
+                    x, y, z, w = Rotation.random(random_state=rng).as_quat()
+                    orientation = (w, x, y, z)
+                else:
+                    orientation = (1.0, 0.0, 0.0, 0.0)
+                sim.add_body(shape=shape, material=grid.material, position=position,
+                             orientation=orientation, velocity=grid.velocity)
+                k += 1

@@ -1,0 +1,411 @@
+"""Simulation: the user-facing run of a rigid FEMDEM case.
+
+It owns the clock and the schedule of periodic work (ParaView frames, checkpoints, progress, the
+rest check) around :class:`riprap.solid.solver.SolidSolver`, which owns the physics. A run that
+fails (non-finite state) writes a checkpoint of the last good state and says which body and when.
+"""
+from __future__ import annotations
+
+import math
+import time as wallclock
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from riprap.errors import CaseFileError, InstabilityError, RiprapError
+from riprap.geometry.tetmesh import TetMesh
+from riprap.solid.materials import Material
+from riprap.solid.shape import RigidShape
+from riprap.solid.solver import SolidSolver
+from riprap.solid.walls import Wall
+
+# Bodies may touch but not overlap at the start: a mean overlap depth above this fraction of the
+# smallest boundary sub-tet height is reported (a just-touching placement gives exactly zero).
+_INITIAL_OVERLAP_FRACTION = 0.01
+# A speed above this (m/s) means the explicit scheme has blown up even if numbers are still finite.
+_RUNAWAY_SPEED = 1.0e3
+# A body rests when its net force is below this fraction of its weight (and it is slow).
+_REST_FORCE_RATIO = 0.1
+# Wall-clock seconds between progress updates (and rest checks).
+_PROGRESS_PERIOD = 0.25
+
+
+@dataclass
+class RunSummary:
+    """What a run did. Written as ``summary.json`` in the output directory."""
+
+    end_reason: str
+    simulated_time: float
+    steps: int
+    time_step: float
+    wall_time: float
+    body_steps_per_second: float
+    bodies: int
+    contacts: int
+    kinetic_energy: float
+    max_speed: float
+    frames: int
+    outputs: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+class Simulation:
+    """A rigid-body run: shapes, materials, bodies, walls, a clock and outputs.
+
+    Parameters (keyword-only, SI units; the same names as the ``[simulation]`` and ``[output]``
+    tables of a case file)
+    ----------
+    end_time : float
+        Simulated time to reach (s).
+    time_step : float
+        Time step (s); 0 means automatic: ``time_step_safety`` times the critical step estimated
+        from body masses and contact stiffness.
+    gravity : (3,) float
+        m/s^2.
+    output_interval : float
+        Simulated seconds between ParaView frames.
+    checkpoint_interval : float
+        Simulated seconds between checkpoints; 0 writes one only at the end (and on failure).
+    local_damping : float
+        Cundall's non-viscous numerical damping in [0, 1); 0 for physics, ~0.3 to settle packs.
+    rest_speed : float
+        If > 0, the run stops once every free body moves slower than this (m/s, including the
+        rotational speed at its bounding radius).
+    output_directory : str or Path
+    paraview, picture : bool
+        Write a ``.pvd`` series / a PNG of the final state.
+    progress : bool
+        Show a progress bar on the terminal.
+    """
+
+    def __init__(self, *, end_time: float, time_step: float = 0.0, time_step_safety: float = 0.2,
+                 gravity=(0.0, 0.0, -9.81), output_interval: float = 0.05,
+                 checkpoint_interval: float = 0.0, local_damping: float = 0.0,
+                 rest_speed: float = 0.0, output_directory="riprap-out", paraview: bool = True,
+                 picture: bool = True, progress: bool = True):
+        _require(end_time > 0, "end_time", end_time, "> 0 s")
+        _require(time_step >= 0, "time_step", time_step, ">= 0 s (0 = automatic)")
+        _require(0 < time_step_safety <= 1, "time_step_safety", time_step_safety, "in (0, 1]")
+        _require(output_interval > 0, "output_interval", output_interval, "> 0 s")
+        _require(checkpoint_interval >= 0, "checkpoint_interval", checkpoint_interval, ">= 0 s")
+        _require(rest_speed >= 0, "rest_speed", rest_speed, ">= 0 m/s")
+        self.end_time = float(end_time)
+        self.requested_time_step = float(time_step)
+        self.time_step_safety = float(time_step_safety)
+        self.output_interval = float(output_interval)
+        self.checkpoint_interval = float(checkpoint_interval)
+        self.rest_speed = float(rest_speed)
+        self.output_directory = Path(output_directory)
+        self.paraview = bool(paraview)
+        self.picture = bool(picture)
+        self.progress = bool(progress)
+        self.solver = SolidSolver(gravity=gravity, local_damping=local_damping)
+        self._shape_names: dict[str, int] = {}
+        self._meshes: list[TetMesh] = []
+        self.container_box = None
+        self._frame_index = 0
+        self._checkpoint_index = 1
+        self._restarted = False
+
+    # ------------------------------------------------------------------ building
+    def add_material(self, material: Material) -> None:
+        self.solver.add_material(material)
+
+    def add_shape(self, name: str, mesh: TetMesh) -> None:
+        if name in self._shape_names:
+            raise CaseFileError(f"shape '{name}' defined twice")
+        self._shape_names[name] = self.solver.add_shape(RigidShape.from_mesh(mesh, name=name))
+        self._meshes.append(mesh)
+
+    def shape(self, name: str) -> RigidShape:
+        return self.solver.shapes[self._shape_index(name)]
+
+    def _shape_index(self, name: str) -> int:
+        if name not in self._shape_names:
+            raise CaseFileError(f"unknown shape '{name}' (defined: {', '.join(self._shape_names)})")
+        return self._shape_names[name]
+
+    def add_body(self, *, shape: str, material: str, position, orientation=(1.0, 0.0, 0.0, 0.0),
+                 velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
+                 fixed: bool = False) -> int:
+        """Add a body; ``position`` is its centroid (m), ``orientation`` a quaternion (w, x, y, z)
+        applied to the shape as built. Returns the body index."""
+        return self.solver.add_body(shape=self._shape_index(shape),
+                                    material=self.solver.material_index(material),
+                                    position=position, orientation=orientation, velocity=velocity,
+                                    angular_velocity=angular_velocity, fixed=fixed)
+
+    def add_walls(self, walls: list[Wall], *, container_box=None) -> None:
+        self.solver.add_walls(walls)
+        if container_box is not None:
+            self.container_box = container_box
+
+    # ------------------------------------------------------------------ running
+    def prepare(self) -> None:
+        """Choose the time step, evaluate initial forces and check that nothing overlaps."""
+        solver = self.solver
+        if solver._ready:
+            return
+        solver._build_arrays()
+        if self.requested_time_step > 0:
+            solver.time_step = self.requested_time_step
+        else:
+            solver.time_step = solver.stable_time_step(self.time_step_safety)
+        solver.finalize()
+        if not self._restarted:
+            smallest = min(s.min_subtet_height for s in solver.shapes)
+            solver.check_no_initial_overlap(_INITIAL_OVERLAP_FRACTION * smallest)
+
+    def run(self, *, restart_from=None) -> RunSummary:
+        """Run to ``end_time`` (or rest); write frames, checkpoints, picture and summary."""
+        from riprap.io import checkpoint as checkpoint_io
+        from riprap.io import vtk
+
+        if restart_from is not None:
+            self.restart(restart_from)
+        self.prepare()
+        solver = self.solver
+        out = self.output_directory
+        out.mkdir(parents=True, exist_ok=True)
+        series = contact_series = None
+        if self.paraview:
+            series = vtk.ParaViewSeries(out, "bodies", append=self._restarted)
+            contact_series = vtk.ParaViewSeries(out, "contacts", append=self._restarted)
+            if not self._restarted:
+                self._write_frame(series, contact_series)
+        dt = solver.time_step
+        total_steps = int(round(self.end_time / dt))
+        start_wall = wallclock.perf_counter()
+        start_steps = solver.step_count
+        end_reason = "end_time"
+        good = solver.state_arrays()
+        chunk = 10
+        with _Progress(self.progress, self.end_time) as progress:
+            while solver.step_count < total_steps:
+                next_frame = self._steps_at(self._frame_index * self.output_interval)
+                targets = [total_steps, next_frame]
+                if self.checkpoint_interval > 0:
+                    targets.append(self._steps_at(self._checkpoint_index * self.checkpoint_interval))
+                target = min(t for t in targets if t > solver.step_count)
+                n = min(target - solver.step_count, chunk)
+                tick = wallclock.perf_counter()
+                try:
+                    solver.advance(n)
+                    self._check_runaway()
+                except InstabilityError as error:
+                    path = self._write_checkpoint(checkpoint_io, good, "failure_checkpoint.npz")
+                    raise InstabilityError(f"{error}\nThe last good state (t = {good['clock'][0]:.6g} s) "
+                                           f"was written to {path}; restart from it with a smaller "
+                                           "time step.") from None
+                elapsed = wallclock.perf_counter() - tick
+                chunk = max(1, min(100000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
+                good = solver.state_arrays()
+                if solver.step_count >= next_frame and series is not None:
+                    self._write_frame(series, contact_series)
+                elif solver.step_count >= next_frame:
+                    self._frame_index += 1
+                if (self.checkpoint_interval > 0 and solver.step_count
+                        >= self._steps_at(self._checkpoint_index * self.checkpoint_interval)):
+                    self._checkpoint_index += 1
+                    self._write_checkpoint(checkpoint_io, good, "checkpoint.npz")
+                progress.update(solver, start_wall, start_steps)
+                if self.rest_speed > 0 and self.at_rest():
+                    end_reason = "at_rest"
+                    break
+        wall = wallclock.perf_counter() - start_wall
+        if series is not None and series.frames and series.frames[-1][0] < solver.time - 0.5 * dt:
+            self._write_frame(series, contact_series)
+        outputs = {"checkpoint": str(self._write_checkpoint(checkpoint_io, solver.state_arrays(),
+                                                            "checkpoint.npz"))}
+        if series is not None:
+            outputs["paraview"] = str(out / "bodies.pvd")
+            outputs["contacts"] = str(out / "contacts.pvd")
+        if self.picture:
+            outputs["picture"] = str(self.write_picture(out / "final_state.png"))
+        steps = solver.step_count - start_steps
+        summary = RunSummary(end_reason=end_reason, simulated_time=solver.time, steps=steps,
+                             time_step=dt, wall_time=wall,
+                             body_steps_per_second=steps * solver.n_bodies / max(wall, 1e-9),
+                             bodies=solver.n_bodies, contacts=len(solver.contacts),
+                             kinetic_energy=solver.kinetic_energy(), max_speed=self.max_speed(),
+                             frames=self._frame_index, outputs=outputs)
+        from riprap.io.summary import write_json
+        write_json(out / "summary.json", summary.as_dict())
+        return summary
+
+    def _steps_at(self, time: float) -> int:
+        return int(math.ceil(time / self.solver.time_step - 1e-9))
+
+    def _check_runaway(self) -> None:
+        speeds = np.linalg.norm(self.solver.velocities, axis=1)
+        if speeds.max(initial=0.0) > _RUNAWAY_SPEED:
+            body = int(np.argmax(speeds))
+            raise InstabilityError(
+                f"body {body} moves at {speeds[body]:.3g} m/s at t = {self.solver.time:.6g} s: the "
+                "time step is too large for the contact stiffness; lower time_step or contact_penalty")
+
+    def at_rest(self) -> bool:
+        """Every free body slower than ``rest_speed`` and, under gravity, with a net force below
+        ``_REST_FORCE_RATIO`` of its weight (a body at the top of a bounce is slow but not at rest)."""
+        if self.max_speed() >= self.rest_speed:
+            return False
+        s = self.solver
+        g = float(np.linalg.norm(s.gravity))
+        free = ~s.fixed
+        if g == 0.0 or not free.any():
+            return True
+        ratio = np.linalg.norm(s.forces[free], axis=1) / (s.masses[free] * g)
+        return bool(ratio.max() < _REST_FORCE_RATIO)
+
+    def max_speed(self) -> float:
+        """Largest speed of a free body including rotation at its bounding radius (m/s)."""
+        s = self.solver
+        free = ~s.fixed
+        if not free.any():
+            return 0.0
+        radius = s.bounding_radius[s.shape_index]
+        speed = np.linalg.norm(s.velocities, axis=1) + np.linalg.norm(s.angular_velocities, axis=1) * radius
+        return float(speed[free].max())
+
+    # ------------------------------------------------------------------ outputs
+    def surface_arrays(self):
+        """World boundary surfaces of all bodies: points (n, 3), triangles (m, 3), body of each
+        triangle (m,)."""
+        s = self.solver
+        rotations = s.rotation_matrices()
+        points, triangles, owners = [], [], []
+        offset = 0
+        for b in range(s.n_bodies):
+            shape = s.shapes[s.shape_index[b]]
+            used = np.unique(shape.triangles)
+            remap = np.full(len(shape.mesh.nodes), -1, dtype=np.int64)
+            remap[used] = np.arange(len(used))
+            points.append(shape.mesh.nodes[used] @ rotations[b].T + s.positions[b])
+            triangles.append(remap[shape.triangles] + offset)
+            owners.append(np.full(len(shape.triangles), b, dtype=np.int64))
+            offset += len(used)
+        return np.concatenate(points), np.concatenate(triangles), np.concatenate(owners)
+
+    def contact_forces_on_bodies(self) -> np.ndarray:
+        """Total contact force on each body (N), i.e. the force without gravity."""
+        s = self.solver
+        gravity = np.where(s.fixed[:, None], 0.0, s.masses[:, None] * s.gravity)
+        return s.forces - gravity
+
+    def _write_frame(self, series, contact_series) -> None:
+        s = self.solver
+        points, triangles, owners = self.surface_arrays()
+        omegas = s.angular_velocities
+        contact = self.contact_forces_on_bodies()
+        series.add(s.time, points=points, cells=triangles, cell_type="triangle",
+                   cell_data={"body_id": owners, "velocity": s.velocities[owners],
+                              "speed": np.linalg.norm(s.velocities, axis=1)[owners],
+                              "angular_velocity": omegas[owners],
+                              "contact_force": contact[owners],
+                              "fixed": s.fixed[owners].astype(np.int64)})
+        c = s.contacts
+        contact_series.add(s.time, points=c.points, cells=np.arange(len(c)).reshape(-1, 1),
+                           cell_type="vertex",
+                           point_data={"normal_force": c.normal_forces,
+                                       "tangential_force": c.tangential_forces,
+                                       "body_i": c.body_i, "body_j": c.body_j})
+        self._frame_index += 1
+
+    def write_picture(self, path) -> Path:
+        from riprap.io.picture import render_bodies_png
+
+        s = self.solver
+        points, triangles, owners = self.surface_arrays()
+        free = ~s.fixed[owners]
+        return render_bodies_png(path, triangles_world=points[triangles][free], body_ids=owners[free],
+                                 title=f"{s.n_bodies} bodies at t = {s.time:.3f} s",
+                                 walls_box=self.container_box)
+
+    # ------------------------------------------------------------------ checkpoints
+    def _write_checkpoint(self, checkpoint_io, state: dict, name: str) -> Path:
+        arrays = dict(state)
+        s = self.solver
+        arrays["shape_index"] = s.shape_index
+        arrays["material_index"] = s.material_index_of_body
+        arrays["fixed"] = s.fixed
+        for k, mesh in enumerate(self._meshes):
+            arrays[f"shape_{k}_nodes"] = mesh.nodes
+            arrays[f"shape_{k}_tets"] = mesh.tets
+        metadata = {"kind": "riprap rigid run", "frame_index": self._frame_index,
+                    "checkpoint_index": self._checkpoint_index, "n_bodies": int(s.n_bodies),
+                    "shapes": list(self._shape_names), "time": float(state["clock"][0])}
+        return checkpoint_io.save_checkpoint(self.output_directory / name, arrays=arrays,
+                                             metadata=metadata)
+
+    def restart(self, path) -> None:
+        """Continue from a checkpoint written by a run of the same case."""
+        from riprap.io import checkpoint as checkpoint_io
+
+        arrays, metadata = checkpoint_io.load_checkpoint(path)
+        s = self.solver
+        s._build_arrays()
+        problems = []
+        if metadata.get("n_bodies") != s.n_bodies:
+            problems.append(f"it has {metadata.get('n_bodies')} bodies, the case {s.n_bodies}")
+        if metadata.get("shapes") != list(self._shape_names):
+            problems.append(f"its shapes {metadata.get('shapes')} differ from the case's {list(self._shape_names)}")
+        else:
+            for k, mesh in enumerate(self._meshes):
+                if not (np.array_equal(arrays[f"shape_{k}_nodes"], mesh.nodes)
+                        and np.array_equal(arrays[f"shape_{k}_tets"], mesh.tets)):
+                    problems.append(f"shape '{list(self._shape_names)[k]}' was meshed differently")
+        if problems:
+            raise RiprapError(f"{path}: cannot restart this case from that checkpoint: "
+                              + "; ".join(problems))
+        s.time_step = float(arrays["clock"][2])
+        s._ready = True
+        s.load_state_arrays(arrays)
+        s._last = (np.zeros((0, 24)), np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64))
+        s._contacts = None
+        self._frame_index = int(metadata["frame_index"])
+        self._checkpoint_index = int(metadata["checkpoint_index"])
+        self._restarted = True
+
+
+def _require(ok: bool, key: str, value, expected: str) -> None:
+    if not ok:
+        raise CaseFileError(f"simulation.{key} = {value!r}: expected {expected}")
+
+
+class _Progress:
+    """A rich progress bar: simulated time, steps/s, kinetic energy, contacts."""
+
+    def __init__(self, enabled: bool, end_time: float):
+        self.enabled = enabled
+        self.end_time = end_time
+        self._progress = None
+
+    def __enter__(self):
+        if self.enabled:
+            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+            self._progress = Progress(
+                TextColumn("[bold]t = {task.completed:.4f} / {task.total:.4f} s"), BarColumn(),
+                TextColumn("{task.fields[rate]} steps/s"), TextColumn("KE {task.fields[energy]} J"),
+                TextColumn("{task.fields[contacts]} contacts"), TimeRemainingColumn(),
+                transient=False)
+            self._progress.__enter__()
+            self._task = self._progress.add_task("run", total=self.end_time, rate="-",
+                                                 energy="-", contacts="-")
+        return self
+
+    def update(self, solver, start_wall, start_steps):
+        if self._progress is None:
+            return
+        rate = (solver.step_count - start_steps) / max(wallclock.perf_counter() - start_wall, 1e-9)
+        self._progress.update(self._task, completed=min(solver.time, self.end_time),
+                              rate=f"{rate:,.0f}", energy=f"{solver.kinetic_energy():.3g}",
+                              contacts=str(len(solver.contacts)))
+
+    def __exit__(self, *exc):
+        if self._progress is not None:
+            self._progress.__exit__(*exc)
+        return False

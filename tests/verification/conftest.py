@@ -1,0 +1,107 @@
+"""Shared fixtures of the verification tests: small solver set-ups and contact timing.
+
+The verification cases hold one to a dozen bodies. For so few candidate pairs the thread launch of
+the parallel pair loop (``interactions.evaluate_candidates``) costs far more than the pair work, and
+on a 2-core machine shared with other jobs a parallel region can wait a whole scheduler slice for
+its second thread (measured here: 5000 steps of a cube on a plane took 0.06 s on one thread and
+1.6-4 s on two). The results do not depend on the thread count (every pair writes its own row), so
+the verification tests run numba on one thread and restore the previous setting afterwards.
+"""
+import numba
+import numpy as np
+import pytest
+
+from riprap.solid import walls
+from riprap.solid.materials import Material
+from riprap.solid.shape import RigidShape
+from riprap.solid.solver import SolidSolver
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _one_numba_thread():
+    previous = numba.get_num_threads()
+    numba.set_num_threads(1)
+    yield
+    numba.set_num_threads(previous)
+
+
+def _material(*, name="m", density=2650.0, friction_coefficient=0.0, restitution=1.0,
+              contact_penalty=1.0e8, tangential_stiffness_ratio=2.0 / 7.0):
+    return Material(name=name, density=density, friction_coefficient=friction_coefficient,
+                    restitution=restitution, contact_penalty=contact_penalty,
+                    tangential_stiffness_ratio=tangential_stiffness_ratio)
+
+
+@pytest.fixture
+def body_on_plane():
+    """Factory: a solver with one free body above the plane z = 0 (or no plane).
+
+    ``body_on_plane(mesh, position=..., velocity=..., gravity=..., plane=True, time_step_factor=1,
+    time_step=None, **material)`` returns the finalized solver; ``time_step_factor`` scales the
+    automatic step, ``time_step`` (s) replaces it.
+    """
+
+    def build(mesh, *, position, velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
+              orientation=(1.0, 0.0, 0.0, 0.0), gravity=(0.0, 0.0, 0.0), plane=True,
+              time_step_factor=1.0, time_step=None, local_damping=0.0, shape=None, **material):
+        solver = SolidSolver(gravity=gravity, local_damping=local_damping)
+        k = solver.add_shape(shape if shape is not None else RigidShape.from_mesh(mesh))
+        m = solver.add_material(_material(**material))
+        if plane:
+            solver.add_walls(walls.plane(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), material="m"))
+        solver.add_body(shape=k, material=m, position=position, orientation=orientation,
+                        velocity=velocity, angular_velocity=angular_velocity)
+        solver.time_step = (time_step if time_step is not None
+                            else time_step_factor * solver.stable_time_step())
+        solver.finalize()
+        return solver
+
+    return build
+
+
+@pytest.fixture
+def run_through_contact():
+    """Function: step a solver one step at a time until a contact has started and ended.
+
+    ``run_through_contact(solver, max_steps)`` returns the number of steps during which at least
+    one contact was active (the contact duration is that times the time step). Fails the test if no
+    contact starts or if it does not end within ``max_steps``.
+    """
+
+    def run(solver, max_steps):
+        first = last = None
+        for n in range(1, max_steps + 1):
+            solver.step()
+            if len(solver.contacts):
+                first = n if first is None else first
+                last = n
+            elif first is not None:
+                return last - first + 1
+        pytest.fail(f"contact {'never started' if first is None else 'did not end'} within "
+                    f"{max_steps} steps (time step {solver.time_step:.3e} s)")
+
+    return run
+
+
+def hertz_contact_time(*, effective_modulus, effective_radius, effective_mass, approach_speed):
+    """Hertz contact duration t_c = 2.868 (m*^2 / (E*^2 R* v))^(1/5), s (Chung & Ooi 2011)."""
+    return 2.868 * (effective_mass ** 2 / (effective_modulus ** 2 * effective_radius
+                                           * approach_speed)) ** 0.2
+
+
+@pytest.fixture
+def hertz():
+    """The Hertz contact-time formula as a fixture (conftest helpers are not importable)."""
+    return hertz_contact_time
+
+
+@pytest.fixture
+def rotation_about():
+    """Function: quaternion (w, x, y, z) of a rotation by ``angle`` (rad) about ``axis``."""
+
+    def quaternion(axis, angle):
+        axis = np.asarray(axis, dtype=float)
+        axis = axis / np.linalg.norm(axis)
+        return np.concatenate([[np.cos(0.5 * angle)], np.sin(0.5 * angle) * axis])
+
+    return quaternion
