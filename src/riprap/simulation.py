@@ -320,9 +320,15 @@ class Simulation:
         s = self.solver
         points, triangles, owners = self.surface_arrays()
         free = ~s.fixed[owners]
+        box = None
+        if self.container_box is not None:
+            # Show the container only up to a little above the bodies, not its full height.
+            lo, hi = (np.array(v, dtype=float) for v in self.container_box)
+            top = points[:, 2].max() if len(points) else hi[2]
+            hi[2] = min(hi[2], top + 0.15 * (top - lo[2]))
+            box = (tuple(lo), tuple(hi))
         return render_bodies_png(path, triangles_world=points[triangles][free], body_ids=owners[free],
-                                 title=f"{s.n_bodies} bodies at t = {s.time:.3f} s",
-                                 walls_box=self.container_box)
+                                 title=f"{s.n_bodies} bodies at t = {s.time:.3f} s", walls_box=box)
 
     # ------------------------------------------------------------------ checkpoints
     def _write_checkpoint(self, checkpoint_io, state: dict, name: str) -> Path:

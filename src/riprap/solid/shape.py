@@ -20,13 +20,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.tetmesh import TetMesh
+from riprap.solid.kernels.geometry_ops import surface_clearance
 
-# Cells per axis of the tet lookup grid are chosen so that a cell is about one median tet edge.
-_GRID_MAX_CELLS_PER_AXIS = 48
+# The tet lookup grid has cells of 3/4 of a median tet edge (at most this many per axis), so that a
+# cell lists few tets and the clearance bound is tight near the surface.
+_GRID_MAX_CELLS_PER_AXIS = 64
+_GRID_CELL_OVER_EDGE = 0.75
 # Boundary triangles per cluster: small enough that a contact touches few clusters, large enough
 # that the cluster loop is short.
 _TRIANGLES_PER_CLUSTER = 12
@@ -77,6 +79,7 @@ class RigidShape:
     cluster_start: np.ndarray      # (n_clusters + 1,) triangle ranges
     cluster_centres: np.ndarray    # (n_clusters, 3)
     cluster_radii: np.ndarray      # (n_clusters,)
+    tet_boxes: np.ndarray          # (n_tets, 6) lower and upper corners of each tet
     grid_origin: np.ndarray        # (3,) lower corner
     grid_cell_size: float
     grid_dims: np.ndarray          # (3,) int
@@ -113,7 +116,7 @@ class RigidShape:
         triangles, cluster_start = _cluster_triangles(nodes, faces)
         normals, centres, radii = _triangle_spheres(nodes, triangles)
         cluster_centres, cluster_radii = _cluster_spheres(nodes, triangles, cluster_start)
-        grid = _tet_grid(nodes, tets)
+        grid = _tet_grid(nodes, tets, barycentric, triangles)
         return cls(
             name=name or mesh.name,
             mesh=principal,
@@ -161,24 +164,28 @@ def _boundary_subtet_heights(nodes, tets, faces) -> np.ndarray:
 
 
 def _cluster_triangles(nodes, faces):
-    """Order triangles so that spatial neighbours are contiguous, and cut them into clusters."""
+    """Group triangles into compact clusters by recursive bisection of their centres; the
+    triangles are reordered so that each cluster is a contiguous range."""
     centres = nodes[faces].mean(axis=1)
-    order = _recursive_bisection_order(centres, np.arange(len(faces)))
+    leaves = []
+    _bisect(centres, np.arange(len(faces)), leaves)
+    order = np.concatenate(leaves)
     triangles = np.ascontiguousarray(faces[order], dtype=np.int64)
-    n_clusters = max(1, int(np.ceil(len(triangles) / _TRIANGLES_PER_CLUSTER)))
-    cluster_start = np.linspace(0, len(triangles), n_clusters + 1).round().astype(np.int64)
+    sizes = np.array([len(leaf) for leaf in leaves], dtype=np.int64)
+    cluster_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
     return triangles, cluster_start
 
 
-def _recursive_bisection_order(points, indices):
+def _bisect(points, indices, leaves):
     if len(indices) <= _TRIANGLES_PER_CLUSTER:
-        return indices
+        leaves.append(indices)
+        return
     p = points[indices]
     axis = int(np.argmax(p.max(axis=0) - p.min(axis=0)))
     sorted_idx = indices[np.argsort(p[:, axis], kind="stable")]
     half = len(sorted_idx) // 2
-    return np.concatenate([_recursive_bisection_order(points, sorted_idx[:half]),
-                           _recursive_bisection_order(points, sorted_idx[half:])])
+    _bisect(points, sorted_idx[:half], leaves)
+    _bisect(points, sorted_idx[half:], leaves)
 
 
 def _triangle_spheres(nodes, triangles):
@@ -202,14 +209,14 @@ def _cluster_spheres(nodes, triangles, cluster_start):
     return centres, radii
 
 
-def _tet_grid(nodes, tets):
+def _tet_grid(nodes, tets, barycentric, triangles):
     """Uniform grid over the shape listing the tets whose boxes touch each cell."""
     x = nodes[tets]
     lo_t, hi_t = x.min(axis=1), x.max(axis=1)
     edge = np.median(np.linalg.norm(x[:, 1] - x[:, 0], axis=1))
     lo, hi = nodes.min(axis=0), nodes.max(axis=0)
     extent = float(np.max(hi - lo))
-    cell = max(edge, extent / _GRID_MAX_CELLS_PER_AXIS)
+    cell = max(_GRID_CELL_OVER_EDGE * edge, extent / _GRID_MAX_CELLS_PER_AXIS)
     origin = lo - cell
     dims = np.maximum(np.ceil((hi - origin) / cell).astype(np.int64) + 1, 1)
     i0 = np.clip(np.floor((lo_t - origin) / cell).astype(np.int64), 0, dims - 1)
@@ -223,12 +230,14 @@ def _tet_grid(nodes, tets):
     counts = np.array([len(o) for o in owners], dtype=np.int64)
     cell_start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
     cell_tets = np.array([t for o in owners for t in o], dtype=np.int64)
-    occupied = counts.reshape(tuple(dims)) > 0
-    # Centre-to-centre distance to the nearest occupied cell, minus one cell diagonal (both the query
-    # point and the body point can sit anywhere in their cells) gives a safe lower bound.
-    distance = ndimage.distance_transform_edt(~occupied) * cell
-    clearance = np.maximum(distance - np.sqrt(3.0) * cell, 0.0).ravel()
-    return dict(grid_origin=origin.astype(np.float64), grid_cell_size=float(cell),
+    # Exact distance from each cell centre to the body, less half a cell diagonal: a lower bound of
+    # the distance from any point of the cell to the body.
+    ix, iy, iz = np.meshgrid(*[np.arange(d) for d in dims], indexing="ij")
+    centres = origin + (np.stack([ix.ravel(), iy.ravel(), iz.ravel()], axis=1) + 0.5) * cell
+    distance = surface_clearance(centres, nodes, triangles, tets, barycentric, cell_start, cell_tets)
+    clearance = np.maximum(distance - 0.5 * np.sqrt(3.0) * cell, 0.0)
+    return dict(tet_boxes=np.ascontiguousarray(np.concatenate([lo_t, hi_t], axis=1)),
+                grid_origin=origin.astype(np.float64), grid_cell_size=float(cell),
                 grid_dims=dims.astype(np.int64), cell_start=cell_start, cell_tets=cell_tets,
                 cell_clearance=np.ascontiguousarray(clearance))
 
@@ -269,6 +278,7 @@ class ShapeTable:
     local_box_min: np.ndarray      # (n_shapes, 3)
     local_box_max: np.ndarray
     wall_potential_depth: np.ndarray   # (n_shapes,)
+    tet_boxes: np.ndarray          # (n_tets_total, 6)
 
     @classmethod
     def build(cls, shapes) -> "ShapeTable":
@@ -295,6 +305,7 @@ class ShapeTable:
         cell_offset, clearance = cat(lambda s: s.cell_clearance, np.float64)
         cell_start_offset, cell_start = cat(lambda s: s.cell_start, np.int64)
         cell_tets_offset, cell_tets = cat(lambda s: s.cell_tets, np.int64)
+        _, tet_boxes = cat(lambda s: s.tet_boxes, np.float64)
         return cls(
             shapes=shapes,
             node_offset=node_offset, nodes=nodes, tet_offset=tet_offset, tets=tets,
@@ -310,6 +321,7 @@ class ShapeTable:
             local_box_min=np.array([s.mesh.nodes.min(axis=0) for s in shapes]).reshape(-1, 3),
             local_box_max=np.array([s.mesh.nodes.max(axis=0) for s in shapes]).reshape(-1, 3),
             wall_potential_depth=np.array([s.boundary_subtet_height for s in shapes], dtype=np.float64),
+            tet_boxes=tet_boxes,
         )
 
     def kernel_arrays(self) -> tuple:
@@ -320,4 +332,4 @@ class ShapeTable:
                 self.cluster_radii, self.grid_origin, self.grid_cell_size, self.grid_dims,
                 self.cell_offset, self.cell_start_offset, self.cell_start, self.cell_tets_offset,
                 self.cell_tets, self.cell_clearance, self.local_box_min, self.local_box_max,
-                self.wall_potential_depth)
+                self.wall_potential_depth, self.tet_boxes)

@@ -40,7 +40,22 @@ R_POINT = 7        # 3: p int x phi dS
 R_STIFFNESS = 10   # p int |grad phi . n| dS
 R_AREA = 11        # area of the surface inside P
 R_OVERFLOW = 12    # > 0 if the candidate buffer overflowed
-R_SIZE = 13
+R_TRIANGLES = 13   # diagnostics: triangles that reached the tet lookup
+R_CANDIDATES = 14  # diagnostics: candidate tets tested
+R_CLIPPED = 15     # diagnostics: (triangle, tet) pairs integrated
+R_SIZE = 16
+
+
+@kernel
+def make_scratch(max_tets):
+    """Work arrays of one thread, allocated once per batch of pairs (allocation inside the pair
+    loop costs more than the geometry)."""
+    return (np.empty((MAX_POLYGON, 7)), np.empty((MAX_POLYGON, 7)), np.empty((MAX_POLYGON, 7)),
+            np.empty(MAX_POLYGON), np.zeros(6), np.empty((3, 3)), np.empty((3, 4)), np.empty(3),
+            np.empty(3), np.empty(MAX_CANDIDATE_TETS, dtype=np.int64),
+            np.full(max(max_tets, 1), -1, dtype=np.int64), np.zeros(1, dtype=np.int64),
+            np.empty(3), np.empty(3), np.empty(3, dtype=np.int64), np.empty(3, dtype=np.int64),
+            np.zeros(R_SIZE), np.empty(4))
 
 
 @kernel
@@ -50,7 +65,8 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
                          triangle_radii, cluster_offset, cluster_begin, cluster_end,
                          cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
                          cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets,
-                         cell_clearance, local_box_min, local_box_max, result):
+                         cell_clearance, local_box_min, local_box_max, tet_boxes, scratch,
+                         result):
     """Boundary triangles of ``surface_shape`` inside the tets of ``potential_shape``.
 
     ``rotation``, ``translation`` map the surface body's frame into the potential body's frame.
@@ -76,18 +92,10 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
     toff_p = tet_offset[sp]
     troff = triangle_offset[ss]
 
-    polygon = np.empty((MAX_POLYGON, 7))
-    work_a = np.empty((MAX_POLYGON, 7))
-    work_b = np.empty((MAX_POLYGON, 7))
-    signed = np.empty(MAX_POLYGON)
-    moments = np.zeros(6)
-    vertices = np.empty((3, 3))
-    lam = np.empty((3, 4))
-    normal = np.empty(3)
-    centre = np.empty(3)
-    candidates = np.empty(MAX_CANDIDATE_TETS, dtype=np.int64)
-    i_lo = np.empty(3, dtype=np.int64)
-    i_hi = np.empty(3, dtype=np.int64)
+    (polygon, work_a, work_b, signed, moments, vertices, lam, normal, centre, candidates, stamp,
+     counter, tri_lo, tri_hi, i_lo, i_hi, _, _) = scratch
+    # stamp[t] == counter means tet t is already listed for the current triangle: O(1)
+    # de-duplication; the counter keeps growing across calls so stale stamps never match.
 
     for cl in range(cluster_offset[ss], cluster_offset[ss + 1]):
         for c in range(3):
@@ -114,9 +122,13 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
                              + rotation[c, 2] * triangle_normals[tri, 2])
             # Candidate tets: those listed in the grid cells the triangle's box touches.
             n_candidates = 0
+            counter[0] += 1
+            mark = counter[0]
             for c in range(3):
                 lo = min(vertices[0, c], min(vertices[1, c], vertices[2, c]))
                 hi = max(vertices[0, c], max(vertices[1, c], vertices[2, c]))
+                tri_lo[c] = lo
+                tri_hi[c] = hi
                 a = int(np.floor((lo - origin[c]) / cell))
                 b = int(np.floor((hi - origin[c]) / cell))
                 n_axis = grid_dims[sp, c]
@@ -124,23 +136,27 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
                 i_hi[c] = min(b, n_axis - 1)
             if i_lo[0] > i_hi[0] or i_lo[1] > i_hi[1] or i_lo[2] > i_hi[2]:
                 continue
+            result[R_TRIANGLES] += 1.0
             for ix in range(i_lo[0], i_hi[0] + 1):
                 for iy in range(i_lo[1], i_hi[1] + 1):
                     for iz in range(i_lo[2], i_hi[2] + 1):
                         cell_id = (ix * ny + iy) * nz + iz
                         for e in range(cell_start[csoff + cell_id], cell_start[csoff + cell_id + 1]):
                             t = cell_tets[ctoff + e]
-                            seen = False
-                            for q in range(n_candidates):
-                                if candidates[q] == t:
-                                    seen = True
-                                    break
-                            if not seen:
-                                if n_candidates < MAX_CANDIDATE_TETS:
-                                    candidates[n_candidates] = t
-                                    n_candidates += 1
-                                else:
-                                    result[R_OVERFLOW] += 1.0
+                            if stamp[t] == mark:
+                                continue
+                            stamp[t] = mark
+                            tb = toff_p + t
+                            if (tet_boxes[tb, 0] > tri_hi[0] or tet_boxes[tb, 3] < tri_lo[0]
+                                    or tet_boxes[tb, 1] > tri_hi[1] or tet_boxes[tb, 4] < tri_lo[1]
+                                    or tet_boxes[tb, 2] > tri_hi[2] or tet_boxes[tb, 5] < tri_lo[2]):
+                                continue
+                            if n_candidates < MAX_CANDIDATE_TETS:
+                                candidates[n_candidates] = t
+                                n_candidates += 1
+                            else:
+                                result[R_OVERFLOW] += 1.0
+            result[R_CANDIDATES] += n_candidates
             for q in range(n_candidates):
                 t = toff_p + candidates[q]
                 # Barycentrics of the three vertices; a face plane with all three outside rejects.
@@ -158,6 +174,20 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
                         break
                 if outside:
                     continue
+                # The triangle's own plane separates when all four tet nodes lie on one side.
+                above = 0
+                below = 0
+                for k in range(4):
+                    node = node_offset[sp] + tets[t, k]
+                    side = ((nodes[node, 0] - vertices[0, 0]) * normal[0]
+                            + (nodes[node, 1] - vertices[0, 1]) * normal[1]
+                            + (nodes[node, 2] - vertices[0, 2]) * normal[2])
+                    if side > 0.0:
+                        above += 1
+                    elif side < 0.0:
+                        below += 1
+                if above == 4 or below == 4:
+                    continue
                 for v in range(3):
                     for c in range(3):
                         polygon[v, c] = vertices[v, c]
@@ -165,6 +195,7 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
                         polygon[v, 3 + k] = lam[v, k]
                 for m in range(6):
                     moments[m] = 0.0
+                result[R_CLIPPED] += 1.0
                 integrate_tet_potential_on_polygon(polygon, 3, barycentric[t, :, 0:3], normal,
                                                    work_a, work_b, signed, moments)
                 if moments[0] <= 0.0:
@@ -220,11 +251,20 @@ def body_pair_potential_force(shape_a, shape_b, position_a, rotation_a, position
     ``out`` (14,): [0:3] force on A (world), [3:6] torque on A about its centroid, [6:9] torque on B
     about its centroid, [9:12] force-weighted contact point, [12] stiffness (N/m), [13] overflow.
     """
+    scratch = make_scratch(shape_arrays[3].shape[0])
+    pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b, penalty,
+                         shape_arrays, scratch, out)
+
+
+@kernel
+def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
+                         penalty, shape_arrays, scratch, out):
+    """:func:`body_pair_potential_force` with caller-provided work arrays."""
     (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
      triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
      cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
      cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets, cell_clearance,
-     local_box_min, local_box_max, wall_potential_depth) = shape_arrays
+     local_box_min, local_box_max, wall_potential_depth, tet_boxes) = shape_arrays
     for i in range(14):
         out[i] = 0.0
     weight = 0.0
@@ -234,14 +274,15 @@ def body_pair_potential_force(shape_a, shape_b, position_a, rotation_a, position
     # Direction 1: A's surface in B's potential, evaluated in B's frame.
     rel_rotation = mat3_mul_transposed(rotation_b, rotation_a)
     rel_translation = mat3_transposed_vec(rotation_b, d)
-    res = np.zeros(R_SIZE)
+    res = scratch[16]
+    res[:] = 0.0
     surface_in_potential(shape_a, shape_b, rel_rotation, rel_translation, penalty,
                          node_offset, nodes, tet_offset, tets, barycentric, triangle_offset,
                          triangles, triangle_normals, triangle_centres, triangle_radii,
                          cluster_offset, cluster_begin, cluster_end, cluster_centres,
                          cluster_radii, grid_origin, grid_cell_size, grid_dims, cell_offset,
                          cell_start_offset, cell_start, cell_tets_offset, cell_tets,
-                         cell_clearance, local_box_min, local_box_max, res)
+                         cell_clearance, local_box_min, local_box_max, tet_boxes, scratch, res)
     force1 = mat3_vec(rotation_b, res[R_FORCE:R_FORCE + 3])          # on A
     moment1 = mat3_vec(rotation_b, res[R_MOMENT:R_MOMENT + 3])       # about B's centroid
     # torque on A about its centroid: moment about B's centroid + (x_B - x_A) x F
@@ -263,7 +304,7 @@ def body_pair_potential_force(shape_a, shape_b, position_a, rotation_a, position
                          cluster_offset, cluster_begin, cluster_end, cluster_centres,
                          cluster_radii, grid_origin, grid_cell_size, grid_dims, cell_offset,
                          cell_start_offset, cell_start, cell_tets_offset, cell_tets,
-                         cell_clearance, local_box_min, local_box_max, res)
+                         cell_clearance, local_box_min, local_box_max, tet_boxes, scratch, res)
     force2 = mat3_vec(rotation_a, res[R_FORCE:R_FORCE + 3])          # on B
     moment2 = mat3_vec(rotation_a, res[R_MOMENT:R_MOMENT + 3])       # about A's centroid
     force_a -= force2
@@ -286,6 +327,16 @@ def body_pair_potential_force(shape_a, shape_b, position_a, rotation_a, position
 @kernel
 def body_wall_potential_force(shape, position, rotation, wall_point, wall_normal, penalty,
                               shape_arrays, out):
+    """Potential contact between a rigid body and a half-space wall (see
+    :func:`wall_potential_force`)."""
+    scratch = make_scratch(1)
+    wall_potential_force(shape, position, rotation, wall_point, wall_normal, penalty, shape_arrays,
+                         scratch, out)
+
+
+@kernel
+def wall_potential_force(shape, position, rotation, wall_point, wall_normal, penalty,
+                         shape_arrays, scratch, out):
     """Potential contact between a rigid body and a half-space wall.
 
     The wall is {x : n.(x - point) < 0}; its potential rises linearly with depth over the body's
@@ -297,7 +348,7 @@ def body_wall_potential_force(shape, position, rotation, wall_point, wall_normal
      triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
      cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
      cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets, cell_clearance,
-     local_box_min, local_box_max, wall_potential_depth) = shape_arrays
+     local_box_min, local_box_max, wall_potential_depth, tet_boxes) = shape_arrays
     for i in range(14):
         out[i] = 0.0
     # The plane in the body frame: n_b . y = offset; inside the wall where n_b . y < offset.
@@ -311,11 +362,11 @@ def body_wall_potential_force(shape, position, rotation, wall_point, wall_normal
     point = np.zeros(3)
     weight = 0.0
     stiffness = 0.0
-    polygon = np.empty((MAX_POLYGON, 7))
-    work_a = np.empty((MAX_POLYGON, 7))
-    work_b = np.empty((MAX_POLYGON, 7))
-    signed = np.empty(MAX_POLYGON)
-    moments = np.zeros(6)
+    polygon = scratch[0]
+    work_a = scratch[1]
+    work_b = scratch[2]
+    signed = scratch[3]
+    moments = scratch[4]
     noff = node_offset[shape]
     # (i) boundary triangles inside the wall, weighted by the wall potential depth / h_wall.
     for tri in range(triangle_offset[shape], triangle_offset[shape + 1]):
@@ -353,7 +404,7 @@ def body_wall_potential_force(shape, position, rotation, wall_point, wall_normal
         stiffness += penalty * moments[4] * cos / h_wall
     # (ii) the wall plane inside the body's tets, weighted by the body's potential.
     toff = tet_offset[shape]
-    depths = np.empty(4)
+    depths = scratch[17]
     for t_local in range(tet_offset[shape + 1] - toff):
         t = toff + t_local
         n_in = 0

@@ -96,35 +96,81 @@ def integrate_linear_on_polygon(polygon, n_vertices, value_column, scale, normal
 @kernel
 def integrate_tet_potential_on_polygon(polygon, n_vertices, gradients, normal, work_a, work_b,
                                        signed, moments):
-    """Integrate a tet's potential phi = 4 min_k lambda_k over a polygon that lies in the tet's
-    barycentric columns 3-6, splitting it into the four sub-tet regions.
+    """Integrate a tet's potential phi = 4 min_k lambda_k over the part of a planar polygon inside
+    the tet; the polygon carries the tet's barycentric coordinates in columns 3-6.
 
     ``gradients`` (4, 3): grad lambda_k. Adds to ``moments`` [0] int phi dA, [1:4] int x phi dA,
     [4] area, [5] int |grad phi . normal| dA (the rate at which the integral grows with a normal
-    push: the contact's stiffness per unit penalty).
+    push: the contact's stiffness per unit penalty). ``polygon`` is overwritten.
     """
+    # First the whole tet (lambda_k >= 0 for all k): most polygons that reach here only graze it.
+    # Results ping-pong between work_a and work_b; ``in_a`` says where the current polygon is.
+    m = n_vertices
+    for i in range(m):
+        for c in range(7):
+            work_b[i, c] = polygon[i, c]
+    in_a = False
     for k in range(4):
-        # Region of sub-tet k: lambda_k >= 0 and lambda_j - lambda_k >= 0 for j != k.
-        for i in range(n_vertices):
-            for c in range(7):
-                work_a[i, c] = polygon[i, c]
-        m = n_vertices
+        all_in = True
         for i in range(m):
-            signed[i] = work_a[i, 3 + k]
-        m = clip_polygon(work_a, m, signed, work_b)
-        source = work_b
-        target = work_a
+            value = work_a[i, 3 + k] if in_a else work_b[i, 3 + k]
+            signed[i] = value
+            if value < 0.0:
+                all_in = False
+        if all_in:
+            continue
+        if in_a:
+            m = clip_polygon(work_a, m, signed, work_b)
+        else:
+            m = clip_polygon(work_b, m, signed, work_a)
+        in_a = not in_a
+        if m < 3:
+            return
+    for i in range(m):
+        for c in range(7):
+            polygon[i, c] = work_a[i, c] if in_a else work_b[i, c]
+    inside = m
+    # Then the four sub-tets: region k is lambda_j - lambda_k >= 0 for j != k.
+    for k in range(4):
+        m = inside
+        for i in range(m):
+            for c in range(7):
+                work_b[i, c] = polygon[i, c]
+        in_a = False
         for j in range(4):
-            if j == k or m < 3:
+            if j == k:
                 continue
+            all_in = True
+            any_in = False
             for i in range(m):
-                signed[i] = source[i, 3 + j] - source[i, 3 + k]
-            m = clip_polygon(source, m, signed, target)
-            source, target = target, source
+                if in_a:
+                    value = work_a[i, 3 + j] - work_a[i, 3 + k]
+                else:
+                    value = work_b[i, 3 + j] - work_b[i, 3 + k]
+                signed[i] = value
+                if value < 0.0:
+                    all_in = False
+                else:
+                    any_in = True
+            if all_in:
+                continue
+            if not any_in:
+                m = 0
+                break
+            if in_a:
+                m = clip_polygon(work_a, m, signed, work_b)
+            else:
+                m = clip_polygon(work_b, m, signed, work_a)
+            in_a = not in_a
+            if m < 3:
+                break
         if m < 3:
             continue
         before = moments[4]
-        integrate_linear_on_polygon(source, m, 3 + k, 4.0, normal, moments)
+        if in_a:
+            integrate_linear_on_polygon(work_a, m, 3 + k, 4.0, normal, moments)
+        else:
+            integrate_linear_on_polygon(work_b, m, 3 + k, 4.0, normal, moments)
         sub_area = moments[4] - before
         g = 4.0 * (gradients[k, 0] * normal[0] + gradients[k, 1] * normal[1]
                    + gradients[k, 2] * normal[2])
@@ -155,3 +201,80 @@ def mat3_mul_transposed(a, b):
         for j in range(3):
             out[i, j] = a[0, i] * b[0, j] + a[1, i] * b[1, j] + a[2, i] * b[2, j]
     return out
+
+
+@kernel
+def surface_clearance(points, nodes, triangles, tets, barycentric, cell_of_point_tets_start,
+                      cell_of_point_tets):
+    """Distance from each point to a closed tetrahedral body: 0 inside, else the exact distance
+    to the nearest boundary triangle. Candidate tets for the inside test come in CSR form."""
+    n = points.shape[0]
+    out = np.empty(n)
+    for p in range(n):
+        x = points[p]
+        inside = False
+        for e in range(cell_of_point_tets_start[p], cell_of_point_tets_start[p + 1]):
+            t = cell_of_point_tets[e]
+            ok = True
+            for k in range(4):
+                lam = (barycentric[t, k, 0] * x[0] + barycentric[t, k, 1] * x[1]
+                       + barycentric[t, k, 2] * x[2] + barycentric[t, k, 3])
+                if lam < 0.0:
+                    ok = False
+                    break
+            if ok:
+                inside = True
+                break
+        if inside:
+            out[p] = 0.0
+            continue
+        best = np.inf
+        for f in range(triangles.shape[0]):
+            d = _point_triangle_distance(x, nodes[triangles[f, 0]], nodes[triangles[f, 1]],
+                                         nodes[triangles[f, 2]])
+            if d < best:
+                best = d
+        out[p] = best
+    return out
+
+
+@kernel
+def _point_triangle_distance(p, a, b, c):
+    """Exact distance from point p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5)."""
+    ab = b - a
+    ac = c - a
+    ap = p - a
+    d1 = ab @ ap
+    d2 = ac @ ap
+    if d1 <= 0.0 and d2 <= 0.0:
+        return np.sqrt(ap @ ap)
+    bp = p - b
+    d3 = ab @ bp
+    d4 = ac @ bp
+    if d3 >= 0.0 and d4 <= d3:
+        return np.sqrt(bp @ bp)
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        v = d1 / (d1 - d3)
+        q = a + v * ab - p
+        return np.sqrt(q @ q)
+    cp = p - c
+    d5 = ab @ cp
+    d6 = ac @ cp
+    if d6 >= 0.0 and d5 <= d6:
+        return np.sqrt(cp @ cp)
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        w = d2 / (d2 - d6)
+        q = a + w * ac - p
+        return np.sqrt(q @ q)
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        q = b + w * (c - b) - p
+        return np.sqrt(q @ q)
+    denom = 1.0 / (va + vb + vc)
+    v = vb * denom
+    w = vc * denom
+    q = a + ab * v + ac * w - p
+    return np.sqrt(q @ q)

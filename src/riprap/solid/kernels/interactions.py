@@ -16,7 +16,7 @@ The damping and friction forces act at the force-weighted contact point.
 import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
-from riprap.solid.kernels.contact import body_pair_potential_force, body_wall_potential_force
+from riprap.solid.kernels.contact import make_scratch, pair_potential_force, wall_potential_force
 from riprap.solid.kernels.geometry_ops import rotation_matrix
 
 # Columns of the per-candidate result array.
@@ -43,88 +43,109 @@ def evaluate_candidates(body_pairs, wall_pairs, positions, quaternions, velociti
     n_body_pairs = body_pairs.shape[0]
     n_total = n_body_pairs + wall_pairs.shape[0]
     results = np.zeros((n_total, C_SIZE))
-    for k in prange(n_total):
+    # Candidates are handled in contiguous batches, each with its own work arrays.
+    n_batches = min(n_total, 64)
+    max_tets = shape_arrays[3].shape[0]
+    for batch in prange(n_batches):
+        scratch = make_scratch(max_tets)
         out = np.zeros(14)
-        if k < n_body_pairs:
-            i = body_pairs[k, 0]
-            j = body_pairs[k, 1]
-            mi = material_index[i]
-            mj = material_index[j]
-            r_i = rotation_matrix(quaternions[i])
-            r_j = rotation_matrix(quaternions[j])
-            body_pair_potential_force(shape_index[i], shape_index[j], positions[i], r_i,
-                                      positions[j], r_j, pair_penalty[mi, mj], shape_arrays, out)
-            key = i * key_stride + j
-            inv_j = inverse_masses[j]
-        else:
-            w = k - n_body_pairs
-            i = wall_pairs[w, 0]
-            wall = wall_pairs[w, 1]
-            j = -1
-            mi = material_index[i]
-            mj = wall_materials[wall]
-            r_i = rotation_matrix(quaternions[i])
-            body_wall_potential_force(shape_index[i], positions[i], r_i, wall_points[wall],
-                                      wall_normals[wall], pair_penalty[mi, mj], shape_arrays, out)
-            key = i * key_stride + (key_stride - 1 - wall)
-            inv_j = 0.0
-        results[k, C_OVERFLOW] = out[13]
-        f_mag = np.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
-        if f_mag <= 0.0:
-            continue
-        normal = out[0:3] / f_mag
-        point = out[9:12]
-        # Relative velocity of body i with respect to body j (or the wall) at the contact point.
-        arm_i = point - positions[i]
-        v_rel = velocities[i] + np.cross(omegas[i], arm_i)
-        if j >= 0:
-            arm_j = point - positions[j]
-            v_rel = v_rel - (velocities[j] + np.cross(omegas[j], arm_j))
-        v_n = v_rel[0] * normal[0] + v_rel[1] * normal[1] + v_rel[2] * normal[2]
-        v_t = v_rel - v_n * normal
-        inv_sum = inverse_masses[i] + inv_j
-        m_eff = 1.0 / inv_sum if inv_sum > 0.0 else 0.0
-        stiffness = out[12]
-        zeta = pair_damping_ratio[mi, mj]
-        gamma_n = 2.0 * zeta * np.sqrt(m_eff * stiffness)
-        normal_magnitude = f_mag - gamma_n * v_n
-        if normal_magnitude < 0.0:
-            normal_magnitude = 0.0
-        # Tangential spring: previous value rotated onto the current tangent plane.
-        spring = np.zeros(3)
-        idx = np.searchsorted(history_keys, key)
-        if idx < history_keys.shape[0] and history_keys[idx] == key:
-            old = history_springs[idx]
-            old_norm = np.sqrt(old[0] * old[0] + old[1] * old[1] + old[2] * old[2])
-            spring = old - (old[0] * normal[0] + old[1] * normal[1] + old[2] * normal[2]) * normal
-            new_norm = np.sqrt(spring[0] * spring[0] + spring[1] * spring[1] + spring[2] * spring[2])
-            if new_norm > 0.0:
-                spring *= old_norm / new_norm
-        spring += v_t * step
-        k_t = pair_tangential_ratio[mi, mj] * stiffness
-        gamma_t = 2.0 * zeta * np.sqrt(m_eff * k_t)
-        tangential = -k_t * spring - gamma_t * v_t
-        t_mag = np.sqrt(tangential[0] ** 2 + tangential[1] ** 2 + tangential[2] ** 2)
-        limit = pair_friction[mi, mj] * normal_magnitude
-        if t_mag > limit:
-            if t_mag > 0.0:
-                tangential *= limit / t_mag
-            if k_t > 0.0:
-                spring = -tangential / k_t
-        extra = (normal_magnitude - f_mag) * normal + tangential
-        force_i = normal_magnitude * normal + tangential
-        torque_i = out[3:6] + np.cross(arm_i, extra)
-        results[k, C_FORCE_I:C_FORCE_I + 3] = force_i
-        results[k, C_TORQUE_I:C_TORQUE_I + 3] = torque_i
-        if j >= 0:
-            results[k, C_TORQUE_J:C_TORQUE_J + 3] = out[6:9] - np.cross(point - positions[j], extra)
-        results[k, C_POINT:C_POINT + 3] = point
-        results[k, C_NORMAL_FORCE:C_NORMAL_FORCE + 3] = normal_magnitude * normal
-        results[k, C_TANGENTIAL_FORCE:C_TANGENTIAL_FORCE + 3] = tangential
-        results[k, C_SPRING:C_SPRING + 3] = spring
-        results[k, C_STIFFNESS] = stiffness
-        results[k, C_ACTIVE] = 1.0
+        first = batch * n_total // n_batches
+        last = (batch + 1) * n_total // n_batches
+        for k in range(first, last):
+            _evaluate_one(k, n_body_pairs, body_pairs, wall_pairs, positions, quaternions,
+                          velocities, omegas, shape_index, material_index, inverse_masses,
+                          wall_points, wall_normals, wall_materials, pair_penalty, pair_friction,
+                          pair_damping_ratio, pair_tangential_ratio, history_keys,
+                          history_springs, key_stride, step, shape_arrays, scratch, out, results)
     return results
+
+
+@kernel
+def _evaluate_one(k, n_body_pairs, body_pairs, wall_pairs, positions, quaternions, velocities,
+                  omegas, shape_index, material_index, inverse_masses, wall_points, wall_normals,
+                  wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
+                  pair_tangential_ratio, history_keys, history_springs, key_stride, step,
+                  shape_arrays, scratch, out, results):
+    if k < n_body_pairs:
+        i = body_pairs[k, 0]
+        j = body_pairs[k, 1]
+        mi = material_index[i]
+        mj = material_index[j]
+        r_i = rotation_matrix(quaternions[i])
+        r_j = rotation_matrix(quaternions[j])
+        pair_potential_force(shape_index[i], shape_index[j], positions[i], r_i, positions[j],
+                             r_j, pair_penalty[mi, mj], shape_arrays, scratch, out)
+        key = i * key_stride + j
+        inv_j = inverse_masses[j]
+    else:
+        w = k - n_body_pairs
+        i = wall_pairs[w, 0]
+        wall = wall_pairs[w, 1]
+        j = -1
+        mi = material_index[i]
+        mj = wall_materials[wall]
+        r_i = rotation_matrix(quaternions[i])
+        wall_potential_force(shape_index[i], positions[i], r_i, wall_points[wall],
+                             wall_normals[wall], pair_penalty[mi, mj], shape_arrays, scratch,
+                             out)
+        key = i * key_stride + (key_stride - 1 - wall)
+        inv_j = 0.0
+    results[k, C_OVERFLOW] = out[13]
+    f_mag = np.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
+    if f_mag <= 0.0:
+        return
+    normal = out[0:3] / f_mag
+    point = out[9:12]
+    # Relative velocity of body i with respect to body j (or the wall) at the contact point.
+    arm_i = point - positions[i]
+    v_rel = velocities[i] + np.cross(omegas[i], arm_i)
+    if j >= 0:
+        arm_j = point - positions[j]
+        v_rel = v_rel - (velocities[j] + np.cross(omegas[j], arm_j))
+    v_n = v_rel[0] * normal[0] + v_rel[1] * normal[1] + v_rel[2] * normal[2]
+    v_t = v_rel - v_n * normal
+    inv_sum = inverse_masses[i] + inv_j
+    m_eff = 1.0 / inv_sum if inv_sum > 0.0 else 0.0
+    stiffness = out[12]
+    zeta = pair_damping_ratio[mi, mj]
+    gamma_n = 2.0 * zeta * np.sqrt(m_eff * stiffness)
+    normal_magnitude = f_mag - gamma_n * v_n
+    if normal_magnitude < 0.0:
+        normal_magnitude = 0.0
+    # Tangential spring: previous value rotated onto the current tangent plane.
+    spring = np.zeros(3)
+    idx = np.searchsorted(history_keys, key)
+    if idx < history_keys.shape[0] and history_keys[idx] == key:
+        old = history_springs[idx]
+        old_norm = np.sqrt(old[0] * old[0] + old[1] * old[1] + old[2] * old[2])
+        spring = old - (old[0] * normal[0] + old[1] * normal[1] + old[2] * normal[2]) * normal
+        new_norm = np.sqrt(spring[0] * spring[0] + spring[1] * spring[1] + spring[2] * spring[2])
+        if new_norm > 0.0:
+            spring *= old_norm / new_norm
+    spring += v_t * step
+    k_t = pair_tangential_ratio[mi, mj] * stiffness
+    gamma_t = 2.0 * zeta * np.sqrt(m_eff * k_t)
+    tangential = -k_t * spring - gamma_t * v_t
+    t_mag = np.sqrt(tangential[0] ** 2 + tangential[1] ** 2 + tangential[2] ** 2)
+    limit = pair_friction[mi, mj] * normal_magnitude
+    if t_mag > limit:
+        if t_mag > 0.0:
+            tangential *= limit / t_mag
+        if k_t > 0.0:
+            spring = -tangential / k_t
+    extra = (normal_magnitude - f_mag) * normal + tangential
+    force_i = normal_magnitude * normal + tangential
+    torque_i = out[3:6] + np.cross(arm_i, extra)
+    results[k, C_FORCE_I:C_FORCE_I + 3] = force_i
+    results[k, C_TORQUE_I:C_TORQUE_I + 3] = torque_i
+    if j >= 0:
+        results[k, C_TORQUE_J:C_TORQUE_J + 3] = out[6:9] - np.cross(point - positions[j], extra)
+    results[k, C_POINT:C_POINT + 3] = point
+    results[k, C_NORMAL_FORCE:C_NORMAL_FORCE + 3] = normal_magnitude * normal
+    results[k, C_TANGENTIAL_FORCE:C_TANGENTIAL_FORCE + 3] = tangential
+    results[k, C_SPRING:C_SPRING + 3] = spring
+    results[k, C_STIFFNESS] = stiffness
+    results[k, C_ACTIVE] = 1.0
 
 
 @kernel
