@@ -8,7 +8,6 @@ its second thread (measured here: 5000 steps of a cube on a plane took 0.06 s on
 the verification tests run numba on one thread and restore the previous setting afterwards.
 """
 import numba
-import numpy as np
 import pytest
 
 from riprap.solid import walls
@@ -81,27 +80,3 @@ def run_through_contact():
                     f"{max_steps} steps (time step {solver.time_step:.3e} s)")
 
     return run
-
-
-def hertz_contact_time(*, effective_modulus, effective_radius, effective_mass, approach_speed):
-    """Hertz contact duration t_c = 2.868 (m*^2 / (E*^2 R* v))^(1/5), s (Chung & Ooi 2011)."""
-    return 2.868 * (effective_mass ** 2 / (effective_modulus ** 2 * effective_radius
-                                           * approach_speed)) ** 0.2
-
-
-@pytest.fixture
-def hertz():
-    """The Hertz contact-time formula as a fixture (conftest helpers are not importable)."""
-    return hertz_contact_time
-
-
-@pytest.fixture
-def rotation_about():
-    """Function: quaternion (w, x, y, z) of a rotation by ``angle`` (rad) about ``axis``."""
-
-    def quaternion(axis, angle):
-        axis = np.asarray(axis, dtype=float)
-        axis = axis / np.linalg.norm(axis)
-        return np.concatenate([[np.cos(0.5 * angle)], np.sin(0.5 * angle) * axis])
-
-    return quaternion
