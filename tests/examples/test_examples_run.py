@@ -1,0 +1,54 @@
+"""Every example and the embedded demo run in smoke mode (RIPRAP_SMOKE=1: 0.01 s of simulated time)
+and write their outputs; a meta-test fails when an example folder is not covered."""
+import json
+from pathlib import Path
+
+import pytest
+
+from riprap.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+CASES = sorted(EXAMPLES.glob("*/case.toml"))
+
+
+@pytest.fixture(autouse=True)
+def smoke(monkeypatch):
+    monkeypatch.setenv("RIPRAP_SMOKE", "1")
+
+
+def _check_outputs(out: Path, bodies: int):
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["bodies"] == bodies
+    assert summary["steps"] > 0
+    assert summary["simulated_time"] == pytest.approx(0.01, rel=0.05)
+    assert (out / "bodies.pvd").read_text().count("<DataSet") >= 2
+    assert (out / "final_state.png").stat().st_size > 10_000
+    assert (out / "checkpoint.npz").exists()
+
+
+def test_demo_runs(tmp_path):
+    assert main(["demo", "--out", str(tmp_path / "demo"), "--quiet"]) == 0
+    _check_outputs(tmp_path / "demo", bodies=32)
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.parent.name for c in CASES])
+def test_example_runs(case, tmp_path):
+    assert main(["run", str(case), "--out", str(tmp_path / case.parent.name), "--quiet"]) == 0
+    text = case.read_text()
+    assert "riprap run examples/" in text, "each example says how to run it"
+
+
+def test_no_missing_examples():
+    folders = sorted(p for p in EXAMPLES.iterdir() if p.is_dir())
+    assert folders, "examples/ must not be empty"
+    for folder in folders:
+        assert (folder / "case.toml").exists(), f"{folder.name} has no case.toml, so no test runs it"
+        assert (folder / "README.md").exists(), f"{folder.name} has no README.md"
+
+
+def test_check_command_reports_errors(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("format_version = 1\n[simulation]\nend_tme = 1.0\n")
+    assert main(["check", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "bad.toml:3" in err and "end_tme" in err
