@@ -7,7 +7,15 @@ reference evaluation to 1e-9 and must not depend on reassociation.
 
 Set ``NUMBA_DISABLE_JIT=1`` to run every kernel as plain Python (slow) for tracebacks and debugging.
 """
-import numba
+import os
+
+# OpenMP worker threads that spin while waiting steal the only other core of a small machine from
+# whatever else runs (or from the main thread): measured 70x slowdowns on a loaded 2-core box.
+# Passive waiting costs a few microseconds per parallel region instead. Must be set before numba
+# starts its thread pool; a user's own setting wins.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+import numba  # noqa: E402
 
 kernel = numba.njit(cache=True, fastmath=False, error_model="numpy")
 parallel_kernel = numba.njit(cache=True, fastmath=False, parallel=True, error_model="numpy")

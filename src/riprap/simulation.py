@@ -15,6 +15,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, RiprapError
 from riprap.geometry.tetmesh import TetMesh
+from riprap.solid.kernels import interactions
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
 from riprap.solid.solver import SolidSolver
@@ -369,7 +370,7 @@ class Simulation:
         s.time_step = float(arrays["clock"][2])
         s._ready = True
         s.load_state_arrays(arrays)
-        s._last = (np.zeros((0, 24)), np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64))
+        s._last = (np.zeros((0, interactions.C_SIZE)), np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64))
         s._contacts = None
         self._frame_index = int(metadata["frame_index"])
         self._checkpoint_index = int(metadata["checkpoint_index"])

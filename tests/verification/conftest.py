@@ -3,9 +3,10 @@
 The verification cases hold one to a dozen bodies. For so few candidate pairs the thread launch of
 the parallel pair loop (``interactions.evaluate_candidates``) costs far more than the pair work, and
 on a 2-core machine shared with other jobs a parallel region can wait a whole scheduler slice for
-its second thread (measured here: 5000 steps of a cube on a plane took 0.06 s on one thread and
-1.6-4 s on two). The results do not depend on the thread count (every pair writes its own row), so
-the verification tests run numba on one thread and restore the previous setting afterwards.
+its second thread (measured here while other jobs ran: 3000 steps of a box resting on a plane took
+1.0 s on one thread and 72 s on two). The results do not depend on the thread count (every pair
+writes its own row), so the verification tests run numba on one thread and restore the previous
+setting afterwards.
 """
 import numba
 import pytest

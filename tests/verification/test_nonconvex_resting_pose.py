@@ -15,8 +15,8 @@ hull of its contacts, and with the small drops used here only one pose is reacha
 
 Bodies: 2400 kg/m^3, friction 0.6, restitution 0.3, ``local_damping`` = 0.3 (Cundall's numerical
 damping, used here to settle quickly); penalty 1e8 Pa (L) and 1e9 Pa (tetrapod: its rim contacts
-are small, the stiffer penalty keeps the overlap near 2 mm). Settling times 0.4 s and 1.5 s: the
-last bounce ends before 0.3 s and 1.2 s in all cases.
+are small, the stiffer penalty keeps the overlap near 2 mm). Settling times 0.4 s (L) and 1.5 s
+(tetrapod, which may tumble over a leg before it lands on three).
 
 Quantities and tolerances (absolute):
 

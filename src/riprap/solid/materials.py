@@ -1,10 +1,13 @@
 """Materials of solid bodies and walls, and the rule that combines two of them at a contact."""
 from __future__ import annotations
 
-import math
+import cmath
+from functools import lru_cache
 from dataclasses import dataclass
 
 import numpy as np
+
+from scipy import optimize
 
 from riprap.errors import CaseFileError
 
@@ -52,9 +55,66 @@ class Material:
 
     @property
     def damping_ratio(self) -> float:
-        """Critical damping ratio of a linear spring-dashpot with this restitution."""
-        log_e = math.log(self.restitution)
-        return -log_e / math.sqrt(math.pi ** 2 + log_e ** 2)
+        """Damping ratio zeta of the normal contact dashpot that gives this restitution.
+
+        The contact force never pulls (it is clipped at zero), so the classical linear
+        spring-dashpot relation e = exp(-pi zeta / sqrt(1 - zeta^2)) does not hold: the contact
+        ends when the force, not the overlap, reaches zero. The exact relation for this
+        "no-tension" spring-dashpot (Schwager & Poeschel 2007, Phys. Rev. E 75, 051304) is
+        inverted numerically.
+        """
+        return damping_ratio_for_restitution(self.restitution)
+
+
+def restitution_of_damping_ratio(zeta: float) -> float:
+    """Restitution of a linear spring-dashpot whose force is clipped at zero (zeta >= 0).
+
+    Dimensionless motion x'' + 2 zeta x' + x = 0, x(0) = 0, x'(0) = 1, with roots r1, r2 of
+    r^2 + 2 zeta r + 1: x = (exp(r1 t) - exp(r2 t)) / (r1 - r2). The contact ends at the first
+    t > 0 where the force x + 2 zeta x' reaches zero; e = -x'(t).
+    """
+    if zeta <= 0.0:
+        return 1.0
+    if abs(zeta - 1.0) < 1e-9:
+        zeta = 1.0 + 1e-9
+    root = cmath.sqrt(zeta * zeta - 1.0)
+    r1, r2 = -zeta + root, -zeta - root
+
+    def position(t):
+        return ((cmath.exp(r1 * t) - cmath.exp(r2 * t)) / (r1 - r2)).real
+
+    def velocity(t):
+        return ((r1 * cmath.exp(r1 * t) - r2 * cmath.exp(r2 * t)) / (r1 - r2)).real
+
+    def force(t):
+        return position(t) + 2.0 * zeta * velocity(t)
+
+    # The force starts at 2 zeta > 0; scan forward for its first sign change, then refine.
+    step = 0.01 / max(1.0, zeta)
+    t = step
+    while force(t) > 0.0:
+        t += step
+        if t > 1e4:
+            return 0.0
+    end = optimize.brentq(force, t - step, t, xtol=1e-14)
+    return max(-velocity(end), 0.0)
+
+
+@lru_cache(maxsize=256)
+def damping_ratio_for_restitution(restitution: float) -> float:
+    """Inverse of :func:`restitution_of_damping_ratio` (bisection; the relation is monotonic)."""
+    if restitution >= 1.0:
+        return 0.0
+    low, high = 0.0, 50.0
+    for _ in range(100):
+        middle = 0.5 * (low + high)
+        if restitution_of_damping_ratio(middle) > restitution:
+            low = middle
+        else:
+            high = middle
+        if high - low < 1e-12:
+            break
+    return 0.5 * (low + high)
 
 
 def pair_tables(materials) -> dict[str, np.ndarray]:

@@ -163,7 +163,7 @@ class SolidSolver:
         self.wall_normals = np.array([w.normal for w in self.walls], dtype=np.float64).reshape(-1, 3)
         self.wall_materials = np.array([self.material_index(w.material) for w in self.walls], dtype=np.int64)
         self.history_keys = np.zeros(0, dtype=np.int64)
-        self.history_springs = np.zeros((0, 3))
+        self.history_springs = np.zeros((0, interactions.HISTORY_WIDTH))
         self._margin = _BROAD_PHASE_MARGIN * float(self.bounding_radius.max())
 
     # ------------------------------------------------------------------ physics

@@ -32,6 +32,9 @@ from riprap.solid.kernels.geometry_ops import (MAX_POLYGON, clip_polygon, integr
                                                mat3_vec, mat3_transposed_vec)
 
 MAX_CANDIDATE_TETS = 1024
+# Output of a pair evaluation: [0:3] force on A, [3:6] torque on A, [6:9] torque on B, [9:12]
+# contact point, [12] stiffness, [13] overflow, [14] contact area (m^2, mean of the two surfaces).
+OUT_SIZE = 15
 # Result layout of one directional evaluation (surface of S in the potential of P), in P's frame.
 R_FORCE = 0        # 3: force on the surface body
 R_MOMENT = 3       # 3: moment of that force about P's centroid
@@ -252,24 +255,28 @@ def body_pair_potential_force(shape_a, shape_b, position_a, rotation_a, position
     about its centroid, [9:12] force-weighted contact point, [12] stiffness (N/m), [13] overflow.
     """
     scratch = make_scratch(shape_arrays[3].shape[0])
+    full = np.zeros(OUT_SIZE)
     pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b, penalty,
-                         shape_arrays, scratch, out)
+                         shape_arrays, scratch, full)
+    for i in range(min(out.shape[0], OUT_SIZE)):
+        out[i] = full[i]
 
 
 @kernel
 def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
                          penalty, shape_arrays, scratch, out):
-    """:func:`body_pair_potential_force` with caller-provided work arrays."""
+    """:func:`body_pair_potential_force` with caller-provided work arrays; ``out`` (OUT_SIZE,)."""
     (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
      triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
      cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
      cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets, cell_clearance,
      local_box_min, local_box_max, wall_potential_depth, tet_boxes) = shape_arrays
-    for i in range(14):
+    for i in range(OUT_SIZE):
         out[i] = 0.0
     weight = 0.0
     point = np.zeros(3)
     stiffness = 0.0
+    area = 0.0
     d = position_a - position_b
     # Direction 1: A's surface in B's potential, evaluated in B's frame.
     rel_rotation = mat3_mul_transposed(rotation_b, rotation_a)
@@ -293,6 +300,7 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
         weight += res[R_WEIGHT]
         point += mat3_vec(rotation_b, res[R_POINT:R_POINT + 3]) + position_b * res[R_WEIGHT]
     stiffness += res[R_STIFFNESS]
+    area += res[R_AREA]
     overflow = res[R_OVERFLOW]
     # Direction 2: B's surface in A's potential, evaluated in A's frame.
     rel_rotation = mat3_mul_transposed(rotation_a, rotation_b)
@@ -314,6 +322,7 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
         weight += res[R_WEIGHT]
         point += mat3_vec(rotation_a, res[R_POINT:R_POINT + 3]) + position_a * res[R_WEIGHT]
     stiffness += res[R_STIFFNESS]
+    area += res[R_AREA]
     overflow += res[R_OVERFLOW]
     out[0:3] = force_a
     out[3:6] = torque_a
@@ -322,6 +331,7 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
         out[9:12] = point / weight
     out[12] = stiffness
     out[13] = overflow
+    out[14] = 0.5 * area
 
 
 @kernel
@@ -330,8 +340,11 @@ def body_wall_potential_force(shape, position, rotation, wall_point, wall_normal
     """Potential contact between a rigid body and a half-space wall (see
     :func:`wall_potential_force`)."""
     scratch = make_scratch(1)
+    full = np.zeros(OUT_SIZE)
     wall_potential_force(shape, position, rotation, wall_point, wall_normal, penalty, shape_arrays,
-                         scratch, out)
+                         scratch, full)
+    for i in range(min(out.shape[0], OUT_SIZE)):
+        out[i] = full[i]
 
 
 @kernel
@@ -344,12 +357,13 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
     F = -p int_{dA in wall} phi_W n_A dS + p int_{wall plane in A} phi_A n dS.
     ``out`` as for :func:`body_pair_potential_force` with [6:9] unused.
     """
+    area = 0.0
     (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
      triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
      cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
      cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets, cell_clearance,
      local_box_min, local_box_max, wall_potential_depth, tet_boxes) = shape_arrays
-    for i in range(14):
+    for i in range(OUT_SIZE):
         out[i] = 0.0
     # The plane in the body frame: n_b . y = offset; inside the wall where n_b . y < offset.
     n_b = mat3_transposed_vec(rotation, wall_normal)
@@ -402,6 +416,7 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
             point[c] += penalty * moments[1 + c]
         cos = abs(n_b[0] * normal[0] + n_b[1] * normal[1] + n_b[2] * normal[2])
         stiffness += penalty * moments[4] * cos / h_wall
+        area += moments[4]
     # (ii) the wall plane inside the body's tets, weighted by the body's potential.
     toff = tet_offset[shape]
     depths = scratch[17]
@@ -433,11 +448,13 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
         for c in range(3):
             point[c] += penalty * moments[1 + c]
         stiffness += penalty * moments[5]
+        area += moments[4]
     out[0:3] = mat3_vec(rotation, force)
     out[3:6] = mat3_vec(rotation, moment)
     if weight > 0.0:
         out[9:12] = mat3_vec(rotation, point / weight) + position
     out[12] = stiffness
+    out[14] = 0.5 * area
 
 
 @kernel

@@ -7,18 +7,27 @@ Contact law per pair (all vectors world frame, n = unit direction of the potenti
   gamma_n = 2 zeta sqrt(m_eff k_n), zeta = -ln e / sqrt(pi^2 + ln^2 e) (restitution e of a linear
   spring-dashpot), k_n = p int |grad phi . n| dS is the potential's stiffness measured on the
   contact itself;
-- tangential: spring xi (history, rotated onto the new tangent plane each step), xi += v_t dt,
-  F_t = -k_t xi - gamma_t v_t with k_t = tangential_stiffness_ratio k_n, capped at
-  friction_coefficient |F_n| (slip; the spring is then reset to -F_t / k_t).
+- tangential: incremental elastic force F_s (history, rotated onto the new tangent plane each
+  step), F_s -= k_t v_t dt, F_t = F_s - gamma_t v_t with k_t = tangential_stiffness_ratio k_n,
+  capped at friction_coefficient |F_n| (slip; F_s is then reset to F_t). Storing the force, not
+  the displacement, means a stiffness that grows as the contact grows cannot create energy; when
+  the stiffness falls (the contact shrinks) F_s is scaled by k_new / k_old, so the stored energy
+  F_s^2 / (2 k) never grows without work either.
+- twist: the same law for the torque about the normal, with the relative spin w_n, stiffness
+  k_t a^2 and cap (2/3) friction_coefficient |F_n| a, a = sqrt(area / pi) the radius of a disc
+  with the contact's area (the exact torsional friction of a uniformly loaded disc). Without it a
+  body could spin freely about a single contact normal.
 
 The damping and friction forces act at the force-weighted contact point.
 """
 import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
-from riprap.solid.kernels.contact import make_scratch, pair_potential_force, wall_potential_force
+from riprap.solid.kernels.contact import OUT_SIZE, make_scratch, pair_potential_force, wall_potential_force
 from riprap.solid.kernels.geometry_ops import rotation_matrix
 
+# Below this many candidate pairs the evaluation stays on one thread.
+PARALLEL_MIN_CANDIDATES = 32
 # Columns of the per-candidate result array.
 C_FORCE_I = 0
 C_TORQUE_I = 3
@@ -26,38 +35,78 @@ C_TORQUE_J = 6
 C_POINT = 9
 C_NORMAL_FORCE = 12
 C_TANGENTIAL_FORCE = 15
-C_SPRING = 18
-C_STIFFNESS = 21
-C_ACTIVE = 22
-C_OVERFLOW = 23
-C_SIZE = 24
+C_SPRING = 18          # 6: tangential elastic force (3), twisting elastic torque, and the
+                       # tangential and twisting stiffness they were built with
+C_STIFFNESS = 24
+C_ACTIVE = 25
+C_OVERFLOW = 26
+C_AREA = 27
+C_SIZE = 28
+HISTORY_WIDTH = 6
 
 
-@parallel_kernel
+@kernel
 def evaluate_candidates(body_pairs, wall_pairs, positions, quaternions, velocities, omegas,
                         shape_index, material_index, inverse_masses, wall_points, wall_normals,
                         wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
                         pair_tangential_ratio, history_keys, history_springs, key_stride, step,
                         shape_arrays):
-    """Evaluate every candidate body-body and body-wall pair; returns (n_candidates, C_SIZE)."""
-    n_body_pairs = body_pairs.shape[0]
-    n_total = n_body_pairs + wall_pairs.shape[0]
+    """Evaluate every candidate body-body and body-wall pair; returns (n_candidates, C_SIZE).
+
+    Few candidates are done on the calling thread (waking the thread pool costs more than they
+    do); the serial loop lives outside the parallel function because numba leaked the work arrays
+    of a serial branch inside a ``parallel=True`` function (measured 18 kB per call).
+    """
+    n_total = body_pairs.shape[0] + wall_pairs.shape[0]
     results = np.zeros((n_total, C_SIZE))
-    # Candidates are handled in contiguous batches, each with its own work arrays.
-    n_batches = min(n_total, 64)
-    max_tets = shape_arrays[3].shape[0]
-    for batch in prange(n_batches):
-        scratch = make_scratch(max_tets)
-        out = np.zeros(14)
-        first = batch * n_total // n_batches
-        last = (batch + 1) * n_total // n_batches
-        for k in range(first, last):
-            _evaluate_one(k, n_body_pairs, body_pairs, wall_pairs, positions, quaternions,
-                          velocities, omegas, shape_index, material_index, inverse_masses,
-                          wall_points, wall_normals, wall_materials, pair_penalty, pair_friction,
-                          pair_damping_ratio, pair_tangential_ratio, history_keys,
-                          history_springs, key_stride, step, shape_arrays, scratch, out, results)
+    if n_total < PARALLEL_MIN_CANDIDATES:
+        _evaluate_range(0, n_total, body_pairs, wall_pairs, positions, quaternions, velocities,
+                        omegas, shape_index, material_index, inverse_masses, wall_points,
+                        wall_normals, wall_materials, pair_penalty, pair_friction,
+                        pair_damping_ratio, pair_tangential_ratio, history_keys, history_springs,
+                        key_stride, step, shape_arrays, results)
+    else:
+        _evaluate_parallel(body_pairs, wall_pairs, positions, quaternions, velocities, omegas,
+                           shape_index, material_index, inverse_masses, wall_points, wall_normals,
+                           wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
+                           pair_tangential_ratio, history_keys, history_springs, key_stride, step,
+                           shape_arrays, results)
     return results
+
+
+@parallel_kernel
+def _evaluate_parallel(body_pairs, wall_pairs, positions, quaternions, velocities, omegas,
+                       shape_index, material_index, inverse_masses, wall_points, wall_normals,
+                       wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
+                       pair_tangential_ratio, history_keys, history_springs, key_stride, step,
+                       shape_arrays, results):
+    """Contiguous batches of candidates in parallel, each batch with its own work arrays."""
+    n_total = results.shape[0]
+    n_batches = min(n_total, 64)
+    for batch in prange(n_batches):
+        _evaluate_range(batch * n_total // n_batches, (batch + 1) * n_total // n_batches,
+                        body_pairs, wall_pairs, positions, quaternions, velocities, omegas,
+                        shape_index, material_index, inverse_masses, wall_points, wall_normals,
+                        wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
+                        pair_tangential_ratio, history_keys, history_springs, key_stride, step,
+                        shape_arrays, results)
+
+
+@kernel
+def _evaluate_range(first, last, body_pairs, wall_pairs, positions, quaternions, velocities,
+                    omegas, shape_index, material_index, inverse_masses, wall_points, wall_normals,
+                    wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
+                    pair_tangential_ratio, history_keys, history_springs, key_stride, step,
+                    shape_arrays, results):
+    scratch = make_scratch(shape_arrays[3].shape[0])
+    out = np.zeros(OUT_SIZE)
+    n_body_pairs = body_pairs.shape[0]
+    for k in range(first, last):
+        _evaluate_one(k, n_body_pairs, body_pairs, wall_pairs, positions, quaternions, velocities,
+                      omegas, shape_index, material_index, inverse_masses, wall_points,
+                      wall_normals, wall_materials, pair_penalty, pair_friction,
+                      pair_damping_ratio, pair_tangential_ratio, history_keys, history_springs,
+                      key_stride, step, shape_arrays, scratch, out, results)
 
 
 @kernel
@@ -112,39 +161,69 @@ def _evaluate_one(k, n_body_pairs, body_pairs, wall_pairs, positions, quaternion
     normal_magnitude = f_mag - gamma_n * v_n
     if normal_magnitude < 0.0:
         normal_magnitude = 0.0
-    # Tangential spring: previous value rotated onto the current tangent plane.
+    # Tangential elastic force and twisting torque from the history, the force rotated onto the
+    # current tangent plane with its magnitude kept.
     spring = np.zeros(3)
+    twist = 0.0
+    k_t_old = 0.0
+    k_twist_old = 0.0
     idx = np.searchsorted(history_keys, key)
     if idx < history_keys.shape[0] and history_keys[idx] == key:
         old = history_springs[idx]
         old_norm = np.sqrt(old[0] * old[0] + old[1] * old[1] + old[2] * old[2])
-        spring = old - (old[0] * normal[0] + old[1] * normal[1] + old[2] * normal[2]) * normal
+        spring = old[0:3] - (old[0] * normal[0] + old[1] * normal[1] + old[2] * normal[2]) * normal
         new_norm = np.sqrt(spring[0] * spring[0] + spring[1] * spring[1] + spring[2] * spring[2])
         if new_norm > 0.0:
             spring *= old_norm / new_norm
-    spring += v_t * step
+        twist = old[3]
+        k_t_old = old[4]
+        k_twist_old = old[5]
     k_t = pair_tangential_ratio[mi, mj] * stiffness
+    radius = np.sqrt(out[14] / np.pi)
+    k_twist = k_t * radius * radius
+    if idx < history_keys.shape[0] and history_keys[idx] == key:
+        if k_t < k_t_old:
+            spring *= k_t / k_t_old
+        if k_twist < k_twist_old:
+            twist *= k_twist / k_twist_old
     gamma_t = 2.0 * zeta * np.sqrt(m_eff * k_t)
-    tangential = -k_t * spring - gamma_t * v_t
+    friction = pair_friction[mi, mj]
+    spring -= k_t * step * v_t
+    tangential = spring - gamma_t * v_t
     t_mag = np.sqrt(tangential[0] ** 2 + tangential[1] ** 2 + tangential[2] ** 2)
-    limit = pair_friction[mi, mj] * normal_magnitude
+    limit = friction * normal_magnitude
     if t_mag > limit:
         if t_mag > 0.0:
             tangential *= limit / t_mag
-        if k_t > 0.0:
-            spring = -tangential / k_t
+        spring = tangential.copy()
+    # Twist about the normal.
+    w_rel = omegas[i]
+    if j >= 0:
+        w_rel = w_rel - omegas[j]
+    w_n = w_rel[0] * normal[0] + w_rel[1] * normal[1] + w_rel[2] * normal[2]
+    twist -= k_twist * step * w_n
+    twist_torque = twist - gamma_t * radius * radius * w_n
+    twist_limit = 2.0 / 3.0 * friction * normal_magnitude * radius
+    if abs(twist_torque) > twist_limit:
+        twist_torque = np.sign(twist_torque) * twist_limit
+        twist = twist_torque
     extra = (normal_magnitude - f_mag) * normal + tangential
     force_i = normal_magnitude * normal + tangential
-    torque_i = out[3:6] + np.cross(arm_i, extra)
+    torque_i = out[3:6] + np.cross(arm_i, extra) + twist_torque * normal
     results[k, C_FORCE_I:C_FORCE_I + 3] = force_i
     results[k, C_TORQUE_I:C_TORQUE_I + 3] = torque_i
     if j >= 0:
-        results[k, C_TORQUE_J:C_TORQUE_J + 3] = out[6:9] - np.cross(point - positions[j], extra)
+        results[k, C_TORQUE_J:C_TORQUE_J + 3] = (out[6:9] - np.cross(point - positions[j], extra)
+                                                 - twist_torque * normal)
     results[k, C_POINT:C_POINT + 3] = point
     results[k, C_NORMAL_FORCE:C_NORMAL_FORCE + 3] = normal_magnitude * normal
     results[k, C_TANGENTIAL_FORCE:C_TANGENTIAL_FORCE + 3] = tangential
     results[k, C_SPRING:C_SPRING + 3] = spring
+    results[k, C_SPRING + 3] = twist
+    results[k, C_SPRING + 4] = k_t
+    results[k, C_SPRING + 5] = k_twist
     results[k, C_STIFFNESS] = stiffness
+    results[k, C_AREA] = out[14]
     results[k, C_ACTIVE] = 1.0
 
 

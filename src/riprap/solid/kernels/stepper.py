@@ -50,7 +50,7 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
         if results[k, interactions.C_ACTIVE] > 0.0:
             n_active += 1
     keys = np.empty(n_active, dtype=np.int64)
-    springs = np.empty((n_active, 3))
+    springs = np.empty((n_active, interactions.HISTORY_WIDTH))
     m = 0
     for k in range(results.shape[0]):
         if results[k, interactions.C_ACTIVE] == 0.0:
@@ -60,7 +60,7 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
         else:
             w = k - n_body_pairs
             keys[m] = wall_pairs[w, 0] * key_stride + (key_stride - 1 - wall_pairs[w, 1])
-        for c in range(3):
+        for c in range(interactions.HISTORY_WIDTH):
             springs[m, c] = results[k, interactions.C_SPRING + c]
         m += 1
     order = np.argsort(keys)
