@@ -17,9 +17,12 @@ per step grows exactly linearly with N), the numba compile time (measured in a s
 empty numba cache), the wall time of the whole bench, and last the line
 ``METRIC body_steps_per_s <value> 1/s`` for the largest N (1000 by default) on all cores.
 
-Pouring a heap takes thousands of steps (minutes for N = 1000), so the heap is built once, with
-stronger gravity and damping to compact it quickly, then relaxed under normal gravity and saved to
-``bench/.cache/heap_n<N>_<version>.npz``; later runs load it. Run::
+Pouring a heap takes thousands of steps (about ten minutes for N = 200 on this machine), so each
+heap is built once, with stronger gravity, damping and a larger time step to compact it quickly,
+then relaxed under normal gravity and saved to ``bench/.cache/heap_n<N>_<version>.npz``; later runs
+load it. Heaps of more than LARGEST_DIRECT_POUR bodies (N = 1000) are assembled from 2 x 2 copies of
+a poured heap of N / 4 bodies in a box half as wide, then relaxed (``--direct-pour`` pours them
+instead). The timed window always uses the default time step and ``local_damping`` 0.3. Run::
 
     python bench/rigid_deposition.py                      # N = 200 and 1000
     python bench/rigid_deposition.py --bodies 200 --steps 200 --repeats 1
@@ -443,7 +446,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--bodies", type=int, nargs="+", default=[200, 1000],
                         help="numbers of rocks (default 200 1000); METRIC uses the largest")
-    parser.add_argument("--steps", type=int, default=300, help="steps in each timed window")
+    parser.add_argument("--steps", type=int, default=200, help="steps in each timed window")
     parser.add_argument("--repeats", type=int, default=2, help="timed windows per thread count")
     parser.add_argument("--rebuild-heap", action="store_true", help="pour again, ignoring the cache")
     parser.add_argument("--pour-wall-limit", type=float, default=900.0,

@@ -34,7 +34,9 @@ from riprap.solid.kernels.geometry_ops import (MAX_POLYGON, clip_polygon, integr
 MAX_CANDIDATE_TETS = 1024
 # Output of a pair evaluation: [0:3] force on A, [3:6] torque on A, [6:9] torque on B, [9:12]
 # contact point, [12] stiffness, [13] overflow, [14] contact area (m^2, mean of the two surfaces).
-OUT_SIZE = 15
+OUT_SIZE = 22
+# [15:21] second moment of the contact pressure about the contact point (world; xx, yy, zz, xy,
+# xz, yz; N m^2 per unit... weighted by p phi dS), [21] total weight p int phi dS.
 # Result layout of one directional evaluation (surface of S in the potential of P), in P's frame.
 R_FORCE = 0        # 3: force on the surface body
 R_MOMENT = 3       # 3: moment of that force about P's centroid
@@ -46,7 +48,9 @@ R_OVERFLOW = 12    # > 0 if the candidate buffer overflowed
 R_TRIANGLES = 13   # diagnostics: triangles that reached the tet lookup
 R_CANDIDATES = 14  # diagnostics: candidate tets tested
 R_CLIPPED = 15     # diagnostics: (triangle, tet) pairs integrated
-R_SIZE = 16
+R_SECOND = 16      # 6: p sum M1 M1^T / M0 over pieces (xx, yy, zz, xy, xz, yz): second moment of
+                   # the contact pressure with each piece lumped at its centroid
+R_SIZE = 22
 
 
 @kernel
@@ -222,6 +226,57 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
                 result[R_POINT + 2] += penalty * mz
                 result[R_STIFFNESS] += penalty * moments[5]
                 result[R_AREA] += moments[4]
+                _add_second_moment(result, R_SECOND, penalty, moments)
+
+
+@kernel
+def _add_second_moment(target, at, penalty, moments):
+    """Add p M1 M1^T / M0 of one integrated piece (lumped at its centroid)."""
+    if moments[0] <= 0.0:
+        return
+    scale = penalty / moments[0]
+    target[at + 0] += scale * moments[1] * moments[1]
+    target[at + 1] += scale * moments[2] * moments[2]
+    target[at + 2] += scale * moments[3] * moments[3]
+    target[at + 3] += scale * moments[1] * moments[2]
+    target[at + 4] += scale * moments[1] * moments[3]
+    target[at + 5] += scale * moments[2] * moments[3]
+
+
+@kernel
+def _second_moment_to_world(local, weight, first, rotation, translation, total):
+    """Rotate and translate a second moment S = sum w x x^T (6 comps) with first moment ``first``
+    (sum w x, local) and weight sum w into the world, adding to ``total`` (3x3)."""
+    s = np.empty((3, 3))
+    s[0, 0] = local[0]
+    s[1, 1] = local[1]
+    s[2, 2] = local[2]
+    s[0, 1] = s[1, 0] = local[3]
+    s[0, 2] = s[2, 0] = local[4]
+    s[1, 2] = s[2, 1] = local[5]
+    rf = mat3_vec(rotation, first)
+    for i in range(3):
+        for j in range(3):
+            value = 0.0
+            for a in range(3):
+                for b in range(3):
+                    value += rotation[i, a] * s[a, b] * rotation[j, b]
+            total[i, j] += (value + rf[i] * translation[j] + translation[i] * rf[j]
+                            + weight * translation[i] * translation[j])
+
+
+@kernel
+def _store_spread(total, weight, point, out):
+    """out[15:21] = second moment about the contact point, out[21] = weight."""
+    if weight <= 0.0:
+        return
+    out[15] = total[0, 0] - weight * point[0] * point[0]
+    out[16] = total[1, 1] - weight * point[1] * point[1]
+    out[17] = total[2, 2] - weight * point[2] * point[2]
+    out[18] = total[0, 1] - weight * point[0] * point[1]
+    out[19] = total[0, 2] - weight * point[0] * point[2]
+    out[20] = total[1, 2] - weight * point[1] * point[2]
+    out[21] = weight
 
 
 @kernel
@@ -277,6 +332,7 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
     point = np.zeros(3)
     stiffness = 0.0
     area = 0.0
+    second = np.zeros((3, 3))
     d = position_a - position_b
     # Direction 1: A's surface in B's potential, evaluated in B's frame.
     rel_rotation = mat3_mul_transposed(rotation_b, rotation_a)
@@ -299,6 +355,8 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
     if res[R_WEIGHT] > 0.0:
         weight += res[R_WEIGHT]
         point += mat3_vec(rotation_b, res[R_POINT:R_POINT + 3]) + position_b * res[R_WEIGHT]
+        _second_moment_to_world(res[R_SECOND:R_SECOND + 6], res[R_WEIGHT],
+                                res[R_POINT:R_POINT + 3], rotation_b, position_b, second)
     stiffness += res[R_STIFFNESS]
     area += res[R_AREA]
     overflow = res[R_OVERFLOW]
@@ -321,6 +379,8 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
     if res[R_WEIGHT] > 0.0:
         weight += res[R_WEIGHT]
         point += mat3_vec(rotation_a, res[R_POINT:R_POINT + 3]) + position_a * res[R_WEIGHT]
+        _second_moment_to_world(res[R_SECOND:R_SECOND + 6], res[R_WEIGHT],
+                                res[R_POINT:R_POINT + 3], rotation_a, position_a, second)
     stiffness += res[R_STIFFNESS]
     area += res[R_AREA]
     overflow += res[R_OVERFLOW]
@@ -329,6 +389,7 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
     out[6:9] = torque_b
     if weight > 0.0:
         out[9:12] = point / weight
+        _store_spread(second, weight, out[9:12], out)
     out[12] = stiffness
     out[13] = overflow
     out[14] = 0.5 * area
@@ -358,6 +419,7 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
     ``out`` as for :func:`body_pair_potential_force` with [6:9] unused.
     """
     area = 0.0
+    local_second = np.zeros(6)
     (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
      triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
      cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
@@ -414,6 +476,7 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
         weight += penalty * moments[0]
         for c in range(3):
             point[c] += penalty * moments[1 + c]
+        _add_second_moment(local_second, 0, penalty, moments)
         cos = abs(n_b[0] * normal[0] + n_b[1] * normal[1] + n_b[2] * normal[2])
         stiffness += penalty * moments[4] * cos / h_wall
         area += moments[4]
@@ -447,12 +510,16 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
         weight += penalty * moments[0]
         for c in range(3):
             point[c] += penalty * moments[1 + c]
+        _add_second_moment(local_second, 0, penalty, moments)
         stiffness += penalty * moments[5]
         area += moments[4]
     out[0:3] = mat3_vec(rotation, force)
     out[3:6] = mat3_vec(rotation, moment)
     if weight > 0.0:
         out[9:12] = mat3_vec(rotation, point / weight) + position
+        second = np.zeros((3, 3))
+        _second_moment_to_world(local_second, weight, point, rotation, position, second)
+        _store_spread(second, weight, out[9:12], out)
     out[12] = stiffness
     out[14] = 0.5 * area
 

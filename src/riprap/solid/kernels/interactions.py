@@ -14,9 +14,11 @@ Contact law per pair (all vectors world frame, n = unit direction of the potenti
   the stiffness falls (the contact shrinks) F_s is scaled by k_new / k_old, so the stored energy
   F_s^2 / (2 k) never grows without work either.
 - twist: the same law for the torque about the normal, with the relative spin w_n, stiffness
-  k_t a^2 and cap (2/3) friction_coefficient |F_n| a, a = sqrt(area / pi) the radius of a disc
-  with the contact's area (the exact torsional friction of a uniformly loaded disc). Without it a
-  body could spin freely about a single contact normal.
+  k_t r^2 and cap (2 sqrt(2) / 3) friction_coefficient |F_n| r, where r is the polar radius of
+  gyration of the contact pressure about the contact point (pieces lumped at their centroids;
+  at least that of a disc with the contact's area, a / sqrt(2)). For a uniformly loaded disc of
+  radius a the cap is the exact (2/3) mu F a; for a unit standing on three legs r is the legs'
+  spread, as it should be. Without it a body could spin freely about a single contact normal.
 
 The damping and friction forces act at the force-weighted contact point.
 """
@@ -179,8 +181,16 @@ def _evaluate_one(k, n_body_pairs, body_pairs, wall_pairs, positions, quaternion
         k_t_old = old[4]
         k_twist_old = old[5]
     k_t = pair_tangential_ratio[mi, mj] * stiffness
-    radius = np.sqrt(out[14] / np.pi)
-    k_twist = k_t * radius * radius
+    # Polar radius of gyration of the contact pressure about the normal through the contact point.
+    polar = out[15] + out[16] + out[17] - (
+        normal[0] * normal[0] * out[15] + normal[1] * normal[1] * out[16]
+        + normal[2] * normal[2] * out[17] + 2.0 * (normal[0] * normal[1] * out[18]
+                                                   + normal[0] * normal[2] * out[19]
+                                                   + normal[1] * normal[2] * out[20]))
+    radius_squared = polar / out[21] if out[21] > 0.0 else 0.0
+    radius_squared = max(radius_squared, 0.5 * out[14] / np.pi)
+    radius = np.sqrt(radius_squared)
+    k_twist = k_t * radius_squared
     if idx < history_keys.shape[0] and history_keys[idx] == key:
         if k_t < k_t_old:
             spring *= k_t / k_t_old
@@ -202,8 +212,8 @@ def _evaluate_one(k, n_body_pairs, body_pairs, wall_pairs, positions, quaternion
         w_rel = w_rel - omegas[j]
     w_n = w_rel[0] * normal[0] + w_rel[1] * normal[1] + w_rel[2] * normal[2]
     twist -= k_twist * step * w_n
-    twist_torque = twist - gamma_t * radius * radius * w_n
-    twist_limit = 2.0 / 3.0 * friction * normal_magnitude * radius
+    twist_torque = twist - gamma_t * radius_squared * w_n
+    twist_limit = 2.0 * np.sqrt(2.0) / 3.0 * friction * normal_magnitude * radius
     if abs(twist_torque) > twist_limit:
         twist_torque = np.sign(twist_torque) * twist_limit
         twist = twist_torque
