@@ -26,6 +26,9 @@ from riprap.solid.walls import Wall
 _INITIAL_OVERLAP_FRACTION = 0.01
 # A speed above this (m/s) means the explicit scheme has blown up even if numbers are still finite.
 _RUNAWAY_SPEED = 1.0e3
+# Largest allowed dt / (2 sqrt(m_eff / k)) over the contacts actually present (1 is the stability
+# limit of an undamped spring; rotation about the contact lowers the effective mass, hence margin).
+_MAX_STABILITY_RATIO = 0.5
 # A body rests when its net force is below this fraction of its weight (and it is slow).
 _REST_FORCE_RATIO = 0.1
 # Wall-clock seconds between progress updates (and rest checks).
@@ -47,6 +50,7 @@ class RunSummary:
     kinetic_energy: float
     max_speed: float
     frames: int
+    stability_ratio_max: float = 0.0
     outputs: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
@@ -196,6 +200,7 @@ class Simulation:
                 try:
                     solver.advance(n)
                     self._check_runaway()
+                    self._check_contact_stability()
                 except InstabilityError as error:
                     path = self._write_checkpoint(checkpoint_io, good, "failure_checkpoint.npz")
                     raise InstabilityError(f"{error}\nThe last good state (t = {good['clock'][0]:.6g} s) "
@@ -232,7 +237,9 @@ class Simulation:
                              body_steps_per_second=steps * solver.n_bodies / max(wall, 1e-9),
                              bodies=solver.n_bodies, contacts=len(solver.contacts),
                              kinetic_energy=solver.kinetic_energy(), max_speed=self.max_speed(),
-                             frames=self._frame_index, outputs=outputs)
+                             frames=self._frame_index,
+                             stability_ratio_max=getattr(self, "_max_stability_ratio", 0.0),
+                             outputs=outputs)
         from riprap.io.summary import write_json
         write_json(out / "summary.json", summary.as_dict())
         return summary
@@ -260,6 +267,33 @@ class Simulation:
             return True
         ratio = np.linalg.norm(s.forces[free], axis=1) / (s.masses[free] * g)
         return bool(ratio.max() < _REST_FORCE_RATIO)
+
+    def stability_ratio(self) -> float:
+        """max over current contacts of dt / (2 sqrt(m_eff / k)), k the contact's measured stiffness
+        and m_eff the smaller of the translational and rotational effective masses of the pair."""
+        s = self.solver
+        c = s.contacts
+        if len(c) == 0:
+            return 0.0
+        shapes = s.shape_index
+        rotational = s.principal_inertia.min(axis=1) / s.bounding_radius[shapes] ** 2
+        inverse = np.where(s.fixed, 0.0, 1.0 / np.minimum(s.masses, rotational))
+        inverse_j = np.where(c.body_j >= 0, inverse[np.maximum(c.body_j, 0)], 0.0)
+        ratio = s.time_step * np.sqrt(c.stiffness * (inverse[c.body_i] + inverse_j)) / 2.0
+        worst = int(np.argmax(ratio))
+        j = int(c.body_j[worst])
+        self._stiffest_pair = f"body {int(c.body_i[worst])} and " + (f"wall {-1 - j}" if j < 0 else f"body {j}")
+        return float(ratio[worst])
+
+    def _check_contact_stability(self) -> None:
+        ratio = self.stability_ratio()
+        self._max_stability_ratio = max(getattr(self, "_max_stability_ratio", 0.0), ratio)
+        if ratio > _MAX_STABILITY_RATIO:
+            raise InstabilityError(
+                f"time step {self.solver.time_step:.3e} s is too large for the contacts at t = "
+                f"{self.solver.time:.6g} s: dt / (2 sqrt(m/k)) = {ratio:.2f} > {_MAX_STABILITY_RATIO} "
+                f"at the contact of {self._stiffest_pair}; lower time_step or time_step_safety, or "
+                "contact_penalty")
 
     def max_speed(self) -> float:
         """Largest speed of a free body including rotation at its bounding radius (m/s)."""
