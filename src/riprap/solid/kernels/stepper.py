@@ -26,7 +26,10 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
     n = positions.shape[0]
     lo, hi = broad_phase.world_boxes(positions, quaternions, shape_index, local_box_min,
                                      local_box_max, margin)
-    body_pairs = broad_phase.overlapping_pairs(lo, hi, fixed)
+    radii = np.empty(n)
+    for b in range(n):
+        radii[b] = bounding_radius[shape_index[b]] + margin
+    body_pairs = broad_phase.overlapping_pairs(lo, hi, fixed, positions, radii)
     wall_pairs = broad_phase.near_wall_pairs(positions, shape_index, bounding_radius, fixed,
                                              wall_points, wall_normals, margin)
     omegas = integrate.angular_velocities(quaternions, angular_momenta, inverse_principal_inertia)
