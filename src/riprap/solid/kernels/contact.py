@@ -28,10 +28,13 @@ import numpy as np
 
 from riprap._jit import kernel
 from riprap.solid.kernels.geometry_ops import (MAX_POLYGON, clip_polygon, integrate_linear_on_polygon,
-                                               integrate_tet_potential_on_polygon, mat3_mul_transposed,
+                                               integrate_tet_potential_on_polygon,
+                                               integrate_tet_potential_on_triangle, mat3_mul_transposed,
                                                mat3_vec, mat3_transposed_vec)
 
 MAX_CANDIDATE_TETS = 1024
+# (triangle, tet) pieces one pair may list: a buffer per thread, overflow is reported.
+MAX_PAIR_PIECES = 65536
 # Output of a pair evaluation: [0:3] force on A, [3:6] torque on A, [6:9] torque on B, [9:12]
 # contact point, [12] stiffness, [13] overflow, [14] contact area (m^2, mean of the two surfaces).
 OUT_SIZE = 22
@@ -62,23 +65,28 @@ def make_scratch(max_tets):
             np.empty(3), np.empty(MAX_CANDIDATE_TETS, dtype=np.int64),
             np.full(max(max_tets, 1), -1, dtype=np.int64), np.zeros(1, dtype=np.int64),
             np.empty(3), np.empty(3), np.empty(3, dtype=np.int64), np.empty(3, dtype=np.int64),
-            np.zeros(R_SIZE), np.empty(4))
+            np.zeros(R_SIZE), np.empty(4), np.empty((MAX_PAIR_PIECES, 2), dtype=np.int64),
+            np.empty((3, MAX_POLYGON, 2)))
 
 
 @kernel
-def surface_in_potential(surface_shape, potential_shape, rotation, translation, penalty,
-                         node_offset, nodes, tet_offset, tets, barycentric,
-                         triangle_offset, triangles, triangle_normals, triangle_centres,
-                         triangle_radii, cluster_offset, cluster_begin, cluster_end,
-                         cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
-                         cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets,
-                         cell_clearance, local_box_min, local_box_max, tet_boxes, scratch,
-                         result):
-    """Boundary triangles of ``surface_shape`` inside the tets of ``potential_shape``.
+def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
+                   node_offset, nodes, tet_offset, tets, barycentric,
+                   triangle_offset, triangles, triangle_normals, triangle_centres,
+                   triangle_radii, cluster_offset, cluster_begin, cluster_end,
+                   cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
+                   cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets,
+                   cell_clearance, local_box_min, local_box_max, tet_boxes, scratch,
+                   pieces, n_pieces, result):
+    """List the (boundary triangle of the surface body, tet of the potential body) pairs that
+    can overlap, appending rows (local triangle, local tet) to ``pieces`` from row ``n_pieces``;
+    returns the new row count.
 
-    ``rotation``, ``translation`` map the surface body's frame into the potential body's frame.
-    Adds to ``result`` (layout R_*), all in the potential body's frame:
-    force -p int phi n dS on the surface body, its moment about the potential body's centroid, etc.
+    With ``skin`` > 0 every test is widened by ``skin`` (m): the list then holds every pair that can
+    overlap after the surface body has moved, relative to the potential body, by up to ``skin`` at
+    every point, so that it can be reused for as long as the relative motion stays below that.
+    Widening only adds pairs, whose integral is exactly zero, so the force does not depend on it.
+    Rows come out ordered by triangle, then tet, whatever the skin.
     """
     sp = potential_shape
     ss = surface_shape
@@ -96,11 +104,13 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
     csoff = cell_start_offset[sp]
     ctoff = cell_tets_offset[sp]
     noff_s = node_offset[ss]
+    noff_p = node_offset[sp]
     toff_p = tet_offset[sp]
     troff = triangle_offset[ss]
+    capacity = pieces.shape[0]
 
-    (polygon, work_a, work_b, signed, moments, vertices, lam, normal, centre, candidates, stamp,
-     counter, tri_lo, tri_hi, i_lo, i_hi, _, _) = scratch
+    (_, _, _, _, _, vertices, lam, normal, centre, candidates, stamp,
+     counter, tri_lo, tri_hi, i_lo, i_hi, _, _, _, _) = scratch
     # stamp[t] == counter means tet t is already listed for the current triangle: O(1)
     # de-duplication; the counter keeps growing across calls so stale stamps never match.
 
@@ -108,7 +118,7 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
         for c in range(3):
             centre[c] = (rotation[c, 0] * cluster_centres[cl, 0] + rotation[c, 1] * cluster_centres[cl, 1]
                          + rotation[c, 2] * cluster_centres[cl, 2] + translation[c])
-        if _sphere_far(centre, cluster_radii[cl], box_lo, box_hi, origin, cell, nx, ny, nz,
+        if _sphere_far(centre, cluster_radii[cl] + skin, box_lo, box_hi, origin, cell, nx, ny, nz,
                        cell_clearance, coff, local_box_min[sp], local_box_max[sp]):
             continue
         for tri_local in range(cluster_begin[cl], cluster_end[cl]):
@@ -116,24 +126,18 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
             for c in range(3):
                 centre[c] = (rotation[c, 0] * triangle_centres[tri, 0] + rotation[c, 1] * triangle_centres[tri, 1]
                              + rotation[c, 2] * triangle_centres[tri, 2] + translation[c])
-            if _sphere_far(centre, triangle_radii[tri], box_lo, box_hi, origin, cell, nx, ny, nz,
-                           cell_clearance, coff, local_box_min[sp], local_box_max[sp]):
+            if _sphere_far(centre, triangle_radii[tri] + skin, box_lo, box_hi, origin, cell, nx, ny,
+                           nz, cell_clearance, coff, local_box_min[sp], local_box_max[sp]):
                 continue
-            for v in range(3):
-                node = noff_s + triangles[tri, v]
-                for c in range(3):
-                    vertices[v, c] = (rotation[c, 0] * nodes[node, 0] + rotation[c, 1] * nodes[node, 1]
-                                      + rotation[c, 2] * nodes[node, 2] + translation[c])
-            for c in range(3):
-                normal[c] = (rotation[c, 0] * triangle_normals[tri, 0] + rotation[c, 1] * triangle_normals[tri, 1]
-                             + rotation[c, 2] * triangle_normals[tri, 2])
-            # Candidate tets: those listed in the grid cells the triangle's box touches.
+            _place_triangle(rotation, translation, nodes, noff_s, triangles, triangle_normals, tri,
+                            vertices, normal)
+            # Candidate tets: those listed in the grid cells the triangle's (widened) box touches.
             n_candidates = 0
             counter[0] += 1
             mark = counter[0]
             for c in range(3):
-                lo = min(vertices[0, c], min(vertices[1, c], vertices[2, c]))
-                hi = max(vertices[0, c], max(vertices[1, c], vertices[2, c]))
+                lo = min(vertices[0, c], min(vertices[1, c], vertices[2, c])) - skin
+                hi = max(vertices[0, c], max(vertices[1, c], vertices[2, c])) + skin
                 tri_lo[c] = lo
                 tri_hi[c] = hi
                 a = int(np.floor((lo - origin[c]) / cell))
@@ -158,75 +162,132 @@ def surface_in_potential(surface_shape, potential_shape, rotation, translation, 
                                     or tet_boxes[tb, 1] > tri_hi[1] or tet_boxes[tb, 4] < tri_lo[1]
                                     or tet_boxes[tb, 2] > tri_hi[2] or tet_boxes[tb, 5] < tri_lo[2]):
                                 continue
+                            if _separated(barycentric, toff_p + t, vertices, normal, nodes, noff_p,
+                                          tets, skin, lam):
+                                continue
                             if n_candidates < MAX_CANDIDATE_TETS:
                                 candidates[n_candidates] = t
                                 n_candidates += 1
                             else:
                                 result[R_OVERFLOW] += 1.0
             result[R_CANDIDATES] += n_candidates
+            # Ascending tet order: the integration order (and so the round-off) is then the same
+            # whatever cells, skin or earlier poses produced the list.
+            for q in range(1, n_candidates):
+                value = candidates[q]
+                r = q - 1
+                while r >= 0 and candidates[r] > value:
+                    candidates[r + 1] = candidates[r]
+                    r -= 1
+                candidates[r + 1] = value
             for q in range(n_candidates):
-                t = toff_p + candidates[q]
-                # Barycentrics of the three vertices; a face plane with all three outside rejects.
-                outside = False
-                for k in range(4):
-                    all_out = True
-                    for v in range(3):
-                        value = (barycentric[t, k, 0] * vertices[v, 0] + barycentric[t, k, 1] * vertices[v, 1]
-                                 + barycentric[t, k, 2] * vertices[v, 2] + barycentric[t, k, 3])
-                        lam[v, k] = value
-                        if value > 0.0:
-                            all_out = False
-                    if all_out:
-                        outside = True
-                        break
-                if outside:
-                    continue
-                # The triangle's own plane separates when all four tet nodes lie on one side.
-                above = 0
-                below = 0
-                for k in range(4):
-                    node = node_offset[sp] + tets[t, k]
-                    side = ((nodes[node, 0] - vertices[0, 0]) * normal[0]
-                            + (nodes[node, 1] - vertices[0, 1]) * normal[1]
-                            + (nodes[node, 2] - vertices[0, 2]) * normal[2])
-                    if side > 0.0:
-                        above += 1
-                    elif side < 0.0:
-                        below += 1
-                if above == 4 or below == 4:
-                    continue
-                for v in range(3):
-                    for c in range(3):
-                        polygon[v, c] = vertices[v, c]
-                    for k in range(4):
-                        polygon[v, 3 + k] = lam[v, k]
-                for m in range(6):
-                    moments[m] = 0.0
-                result[R_CLIPPED] += 1.0
-                integrate_tet_potential_on_polygon(polygon, 3, barycentric[t, :, 0:3], normal,
-                                                   work_a, work_b, signed, moments)
-                if moments[0] <= 0.0:
-                    continue
-                # Force on the surface body: -p phi n dS; moment about the potential body's centroid.
-                fx = -penalty * moments[0] * normal[0]
-                fy = -penalty * moments[0] * normal[1]
-                fz = -penalty * moments[0] * normal[2]
-                result[R_FORCE + 0] += fx
-                result[R_FORCE + 1] += fy
-                result[R_FORCE + 2] += fz
-                mx = moments[1]
-                my = moments[2]
-                mz = moments[3]
-                result[R_MOMENT + 0] += -penalty * (my * normal[2] - mz * normal[1])
-                result[R_MOMENT + 1] += -penalty * (mz * normal[0] - mx * normal[2])
-                result[R_MOMENT + 2] += -penalty * (mx * normal[1] - my * normal[0])
-                result[R_WEIGHT] += penalty * moments[0]
-                result[R_POINT + 0] += penalty * mx
-                result[R_POINT + 1] += penalty * my
-                result[R_POINT + 2] += penalty * mz
-                result[R_STIFFNESS] += penalty * moments[5]
-                result[R_AREA] += moments[4]
-                _add_second_moment(result, R_SECOND, penalty, moments)
+                if n_pieces < capacity:
+                    pieces[n_pieces, 0] = tri_local
+                    pieces[n_pieces, 1] = candidates[q]
+                    n_pieces += 1
+                else:
+                    result[R_OVERFLOW] += 1.0
+    return n_pieces
+
+
+@kernel
+def _place_triangle(rotation, translation, nodes, node_offset, triangles, triangle_normals, tri,
+                    vertices, normal):
+    """Vertices and unit normal of boundary triangle ``tri`` moved by (rotation, translation)."""
+    for v in range(3):
+        node = node_offset + triangles[tri, v]
+        for c in range(3):
+            vertices[v, c] = (rotation[c, 0] * nodes[node, 0] + rotation[c, 1] * nodes[node, 1]
+                              + rotation[c, 2] * nodes[node, 2] + translation[c])
+    for c in range(3):
+        normal[c] = (rotation[c, 0] * triangle_normals[tri, 0] + rotation[c, 1] * triangle_normals[tri, 1]
+                     + rotation[c, 2] * triangle_normals[tri, 2])
+
+
+@kernel
+def _separated(barycentric, t, vertices, normal, nodes, noff_p, tets, skin, lam):
+    """True when triangle ``vertices`` stays more than ``skin`` away from tet ``t``: all three
+    vertices beyond one face plane, or all four tet nodes on one side of the triangle's plane.
+    When False, ``lam`` (3, 4) holds the barycentrics of the three vertices."""
+    for k in range(4):
+        # lambda_k < -skin |grad lambda_k| means more than ``skin`` beyond the face plane.
+        limit = 0.0
+        if skin > 0.0:
+            limit = -skin * np.sqrt(barycentric[t, k, 0] ** 2 + barycentric[t, k, 1] ** 2
+                                    + barycentric[t, k, 2] ** 2)
+        all_out = True
+        for v in range(3):
+            value = (barycentric[t, k, 0] * vertices[v, 0] + barycentric[t, k, 1] * vertices[v, 1]
+                     + barycentric[t, k, 2] * vertices[v, 2] + barycentric[t, k, 3])
+            lam[v, k] = value
+            if value > limit:
+                all_out = False
+        if all_out:
+            return True
+    # The triangle's own plane separates when all four tet nodes lie on one side.
+    above = 0
+    below = 0
+    for k in range(4):
+        node = noff_p + tets[t, k]
+        side = ((nodes[node, 0] - vertices[0, 0]) * normal[0]
+                + (nodes[node, 1] - vertices[0, 1]) * normal[1]
+                + (nodes[node, 2] - vertices[0, 2]) * normal[2])
+        if side > skin:
+            above += 1
+        elif side < -skin:
+            below += 1
+    return above == 4 or below == 4
+
+
+@kernel
+def integrate_pieces(surface_shape, potential_shape, rotation, translation, penalty, pieces, first,
+                     last, node_offset, nodes, tet_offset, tets, barycentric, triangle_offset,
+                     triangles, triangle_normals, scratch, result):
+    """Integrate the potential of ``potential_shape`` over the listed (triangle, tet) pieces of
+    ``surface_shape``'s boundary (rows ``first:last`` of ``pieces``), at the relative pose
+    ``rotation``, ``translation``. Adds to ``result`` (layout R_*) in the potential body's frame."""
+    sp = potential_shape
+    ss = surface_shape
+    noff_s = node_offset[ss]
+    noff_p = node_offset[sp]
+    toff_p = tet_offset[sp]
+    troff = triangle_offset[ss]
+    (_, _, _, signed, moments, vertices, lam, normal, _, _, _,
+     _, _, _, _, _, _, _, _, polygons) = scratch
+    current = -1
+    for q in range(first, last):
+        tri_local = pieces[q, 0]
+        if tri_local != current:
+            current = tri_local
+            _place_triangle(rotation, translation, nodes, noff_s, triangles, triangle_normals,
+                            troff + tri_local, vertices, normal)
+        t = toff_p + pieces[q, 1]
+        if _separated(barycentric, t, vertices, normal, nodes, noff_p, tets, 0.0, lam):
+            continue
+        for m in range(6):
+            moments[m] = 0.0
+        result[R_CLIPPED] += 1.0
+        integrate_tet_potential_on_triangle(lam, vertices, barycentric[t, :, 0:3], normal,
+                                            polygons, signed, moments)
+        if moments[0] <= 0.0:
+            continue
+        # Force on the surface body: -p phi n dS; moment about the potential body's centroid.
+        result[R_FORCE + 0] += -penalty * moments[0] * normal[0]
+        result[R_FORCE + 1] += -penalty * moments[0] * normal[1]
+        result[R_FORCE + 2] += -penalty * moments[0] * normal[2]
+        mx = moments[1]
+        my = moments[2]
+        mz = moments[3]
+        result[R_MOMENT + 0] += -penalty * (my * normal[2] - mz * normal[1])
+        result[R_MOMENT + 1] += -penalty * (mz * normal[0] - mx * normal[2])
+        result[R_MOMENT + 2] += -penalty * (mx * normal[1] - my * normal[0])
+        result[R_WEIGHT] += penalty * moments[0]
+        result[R_POINT + 0] += penalty * mx
+        result[R_POINT + 1] += penalty * my
+        result[R_POINT + 2] += penalty * mz
+        result[R_STIFFNESS] += penalty * moments[5]
+        result[R_AREA] += moments[4]
+        _add_second_moment(result, R_SECOND, penalty, moments)
 
 
 @kernel
@@ -321,11 +382,63 @@ def body_pair_potential_force(shape_a, shape_b, position_a, rotation_a, position
 def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
                          penalty, shape_arrays, scratch, out):
     """:func:`body_pair_potential_force` with caller-provided work arrays; ``out`` (OUT_SIZE,)."""
+    pieces = scratch[18]
+    split, last, overflow = collect_pair_pieces(shape_a, shape_b, position_a, rotation_a,
+                                                position_b, rotation_b, 0.0, shape_arrays,
+                                                scratch, pieces, 0)
+    pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
+                           penalty, shape_arrays, scratch, pieces, 0, split, last, out)
+    out[13] += overflow
+
+
+@kernel
+def relative_pose(position_a, rotation_a, position_b, rotation_b):
+    """(rotation, translation) mapping A's frame into B's, and B's into A's."""
+    d = position_a - position_b
+    return (mat3_mul_transposed(rotation_b, rotation_a), mat3_transposed_vec(rotation_b, d),
+            mat3_mul_transposed(rotation_a, rotation_b), mat3_transposed_vec(rotation_a, -d))
+
+
+@kernel
+def collect_pair_pieces(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b, skin,
+                        shape_arrays, scratch, pieces, first):
+    """The (triangle, tet) pieces of both directions of a pair (:func:`collect_pieces`), written
+    to ``pieces`` from row ``first``: A's triangles in B's tets, then B's in A's.
+    Returns (row where the second direction starts, row after the last, overflow count)."""
     (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
      triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
      cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
      cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets, cell_clearance,
      local_box_min, local_box_max, wall_potential_depth, tet_boxes) = shape_arrays
+    rotation_1, translation_1, rotation_2, translation_2 = relative_pose(position_a, rotation_a,
+                                                                          position_b, rotation_b)
+    counters = scratch[16]
+    counters[:] = 0.0
+    split = collect_pieces(shape_a, shape_b, rotation_1, translation_1, skin, node_offset, nodes,
+                           tet_offset, tets, barycentric, triangle_offset, triangles,
+                           triangle_normals, triangle_centres, triangle_radii, cluster_offset,
+                           cluster_begin, cluster_end, cluster_centres, cluster_radii,
+                           grid_origin, grid_cell_size, grid_dims, cell_offset, cell_start_offset,
+                           cell_start, cell_tets_offset, cell_tets, cell_clearance, local_box_min,
+                           local_box_max, tet_boxes, scratch, pieces, first, counters)
+    last = collect_pieces(shape_b, shape_a, rotation_2, translation_2, skin, node_offset, nodes,
+                          tet_offset, tets, barycentric, triangle_offset, triangles,
+                          triangle_normals, triangle_centres, triangle_radii, cluster_offset,
+                          cluster_begin, cluster_end, cluster_centres, cluster_radii,
+                          grid_origin, grid_cell_size, grid_dims, cell_offset, cell_start_offset,
+                          cell_start, cell_tets_offset, cell_tets, cell_clearance, local_box_min,
+                          local_box_max, tet_boxes, scratch, pieces, split, counters)
+    return split, last, counters[R_OVERFLOW]
+
+
+@kernel
+def pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
+                           penalty, shape_arrays, scratch, pieces, first, split, last, out):
+    """Potential contact of a pair from its listed pieces (rows ``first:split`` A's triangles in
+    B's tets, ``split:last`` B's in A's); ``out`` (OUT_SIZE,) as for
+    :func:`body_pair_potential_force`."""
+    (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
+     triangle_normals) = shape_arrays[:8]
     for i in range(OUT_SIZE):
         out[i] = 0.0
     weight = 0.0
@@ -334,18 +447,14 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
     area = 0.0
     second = np.zeros((3, 3))
     d = position_a - position_b
+    rotation_1, translation_1, rotation_2, translation_2 = relative_pose(position_a, rotation_a,
+                                                                          position_b, rotation_b)
     # Direction 1: A's surface in B's potential, evaluated in B's frame.
-    rel_rotation = mat3_mul_transposed(rotation_b, rotation_a)
-    rel_translation = mat3_transposed_vec(rotation_b, d)
     res = scratch[16]
     res[:] = 0.0
-    surface_in_potential(shape_a, shape_b, rel_rotation, rel_translation, penalty,
-                         node_offset, nodes, tet_offset, tets, barycentric, triangle_offset,
-                         triangles, triangle_normals, triangle_centres, triangle_radii,
-                         cluster_offset, cluster_begin, cluster_end, cluster_centres,
-                         cluster_radii, grid_origin, grid_cell_size, grid_dims, cell_offset,
-                         cell_start_offset, cell_start, cell_tets_offset, cell_tets,
-                         cell_clearance, local_box_min, local_box_max, tet_boxes, scratch, res)
+    integrate_pieces(shape_a, shape_b, rotation_1, translation_1, penalty, pieces, first, split,
+                     node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
+                     triangle_normals, scratch, res)
     force1 = mat3_vec(rotation_b, res[R_FORCE:R_FORCE + 3])          # on A
     moment1 = mat3_vec(rotation_b, res[R_MOMENT:R_MOMENT + 3])       # about B's centroid
     # torque on A about its centroid: moment about B's centroid + (x_B - x_A) x F
@@ -359,18 +468,11 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
                                 res[R_POINT:R_POINT + 3], rotation_b, position_b, second)
     stiffness += res[R_STIFFNESS]
     area += res[R_AREA]
-    overflow = res[R_OVERFLOW]
     # Direction 2: B's surface in A's potential, evaluated in A's frame.
-    rel_rotation = mat3_mul_transposed(rotation_a, rotation_b)
-    rel_translation = mat3_transposed_vec(rotation_a, -d)
     res[:] = 0.0
-    surface_in_potential(shape_b, shape_a, rel_rotation, rel_translation, penalty,
-                         node_offset, nodes, tet_offset, tets, barycentric, triangle_offset,
-                         triangles, triangle_normals, triangle_centres, triangle_radii,
-                         cluster_offset, cluster_begin, cluster_end, cluster_centres,
-                         cluster_radii, grid_origin, grid_cell_size, grid_dims, cell_offset,
-                         cell_start_offset, cell_start, cell_tets_offset, cell_tets,
-                         cell_clearance, local_box_min, local_box_max, tet_boxes, scratch, res)
+    integrate_pieces(shape_b, shape_a, rotation_2, translation_2, penalty, pieces, split, last,
+                     node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
+                     triangle_normals, scratch, res)
     force2 = mat3_vec(rotation_a, res[R_FORCE:R_FORCE + 3])          # on B
     moment2 = mat3_vec(rotation_a, res[R_MOMENT:R_MOMENT + 3])       # about A's centroid
     force_a -= force2
@@ -383,7 +485,6 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
                                 res[R_POINT:R_POINT + 3], rotation_a, position_a, second)
     stiffness += res[R_STIFFNESS]
     area += res[R_AREA]
-    overflow += res[R_OVERFLOW]
     out[0:3] = force_a
     out[3:6] = torque_a
     out[6:9] = torque_b
@@ -391,7 +492,7 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
         out[9:12] = point / weight
         _store_spread(second, weight, out[9:12], out)
     out[12] = stiffness
-    out[13] = overflow
+    out[13] = 0.0
     out[14] = 0.5 * area
 
 

@@ -178,6 +178,183 @@ def integrate_tet_potential_on_polygon(polygon, n_vertices, gradients, normal, w
 
 
 @kernel
+def integrate_tet_potential_on_triangle(lam, vertices, gradients, normal, polygons, signed,
+                                        moments):
+    """Integrate a tet's potential phi = 4 min_k lambda_k over the part of a triangle inside the
+    tet, adding to ``moments`` the same quantities as :func:`integrate_tet_potential_on_polygon`
+    (which it replaces for boundary triangles: same integrals, a fraction of the work).
+
+    The clipping is done in the triangle's own affine coordinates (mu1, mu2), x = V0 + mu1 (V1 -
+    V0) + mu2 (V2 - V0): every lambda_k is affine in them, so a polygon is two columns, a clipping
+    line three numbers, and dA = 2 A dmu with A the triangle's area. ``lam`` (3, 4): barycentrics
+    of the three vertices; ``gradients`` (4, 3): grad lambda_k; ``polygons`` (3, MAX_POLYGON, 2)
+    and ``signed`` (MAX_POLYGON,): work arrays. The triangle is counter-clockwise about ``normal``.
+    """
+    ex = vertices[1, 0] - vertices[0, 0]
+    ey = vertices[1, 1] - vertices[0, 1]
+    ez = vertices[1, 2] - vertices[0, 2]
+    fx = vertices[2, 0] - vertices[0, 0]
+    fy = vertices[2, 1] - vertices[0, 1]
+    fz = vertices[2, 2] - vertices[0, 2]
+    jacobian = ((ey * fz - ez * fy) * normal[0] + (ez * fx - ex * fz) * normal[1]
+                + (ex * fy - ey * fx) * normal[2])          # 2 A
+    if jacobian <= 0.0:
+        return
+    # The unit triangle, counter-clockwise in (mu1, mu2); then the part inside the tet.
+    polygons[0, 0, 0] = 0.0
+    polygons[0, 0, 1] = 0.0
+    polygons[0, 1, 0] = 1.0
+    polygons[0, 1, 1] = 0.0
+    polygons[0, 2, 0] = 0.0
+    polygons[0, 2, 1] = 1.0
+    m = 3
+    current = 0
+    for k in range(4):
+        # lambda_k(mu) = c0 + c1 mu1 + c2 mu2
+        c0 = lam[0, k]
+        c1 = lam[1, k] - c0
+        c2 = lam[2, k] - c0
+        target = 1 if current == 0 else 0
+        m, moved = _clip_by_line(polygons, current, target, m, c0, c1, c2, signed)
+        if m < 3:
+            return
+        if moved:
+            current = target
+    inside = current
+    area_mu = 0.0
+    integral = 0.0
+    first_1 = 0.0
+    first_2 = 0.0
+    stiffness = 0.0
+    # The sub-tet regions {lambda_k <= lambda_j for all j} are convex: when every vertex of the
+    # (convex) polygon has the same smallest lambda, the whole polygon lies in that one sub-tet.
+    # This is the usual case of a shallow contact, and it needs no further clipping.
+    common = -1
+    for i in range(m):
+        u = polygons[inside, i, 0]
+        v = polygons[inside, i, 1]
+        smallest = np.inf
+        which = 0
+        for k in range(4):
+            value = lam[0, k] + (lam[1, k] - lam[0, k]) * u + (lam[2, k] - lam[0, k]) * v
+            if value < smallest:
+                smallest = value
+                which = k
+        if i == 0:
+            common = which
+        elif which != common:
+            common = -1
+            break
+    first_spare = 1 if inside == 0 else 0
+    second_spare = 3 - inside - first_spare
+    for k in range(4):
+        if common >= 0 and k != common:
+            continue
+        # Sub-tet k: lambda_j - lambda_k >= 0 for every j != k; there phi = 4 lambda_k.
+        current = inside
+        count = m
+        if common < 0:
+            for j in range(4):
+                if j == k:
+                    continue
+                d0 = lam[0, j] - lam[0, k]
+                d1 = (lam[1, j] - lam[1, k]) - d0
+                d2 = (lam[2, j] - lam[2, k]) - d0
+                target = first_spare if current != first_spare else second_spare
+                count, moved = _clip_by_line(polygons, current, target, count, d0, d1, d2, signed)
+                if count < 3:
+                    break
+                if moved:
+                    current = target
+            if count < 3:
+                continue
+        piece_integral, piece_1, piece_2, piece_area = _integrate_fan(
+            polygons, current, count, 4.0 * lam[0, k], 4.0 * (lam[1, k] - lam[0, k]),
+            4.0 * (lam[2, k] - lam[0, k]))
+        integral += piece_integral
+        first_1 += piece_1
+        first_2 += piece_2
+        area_mu += piece_area
+        g = 4.0 * (gradients[k, 0] * normal[0] + gradients[k, 1] * normal[1]
+                   + gradients[k, 2] * normal[2])
+        stiffness += piece_area * abs(g)
+    # Back to x: dA = jacobian dmu, x = V0 + mu1 e + mu2 f.
+    moments[0] += jacobian * integral
+    moments[1] += jacobian * (vertices[0, 0] * integral + ex * first_1 + fx * first_2)
+    moments[2] += jacobian * (vertices[0, 1] * integral + ey * first_1 + fy * first_2)
+    moments[3] += jacobian * (vertices[0, 2] * integral + ez * first_1 + fz * first_2)
+    moments[4] += jacobian * area_mu
+    moments[5] += jacobian * stiffness
+
+
+@kernel
+def _integrate_fan(polygons, current, count, c0, c1, c2):
+    """Integrals of f = c0 + c1 mu1 + c2 mu2 over the convex polygon ``polygons[current]`` (mu
+    coordinates): (int f, int mu1 f, int mu2 f, area), exactly, over its fan triangles."""
+    u0 = polygons[current, 0, 0]
+    v0 = polygons[current, 0, 1]
+    f0 = c0 + c1 * u0 + c2 * v0
+    integral = 0.0
+    first_1 = 0.0
+    first_2 = 0.0
+    total_area = 0.0
+    for i in range(1, count - 1):
+        u1 = polygons[current, i, 0]
+        v1 = polygons[current, i, 1]
+        u2 = polygons[current, i + 1, 0]
+        v2 = polygons[current, i + 1, 1]
+        area = 0.5 * ((u1 - u0) * (v2 - v0) - (u2 - u0) * (v1 - v0))
+        if area <= 0.0:
+            continue
+        f1 = c0 + c1 * u1 + c2 * v1
+        f2 = c0 + c1 * u2 + c2 * v2
+        fsum = f0 + f1 + f2
+        integral += area * fsum / 3.0
+        # integral of mu f over a triangle = A/12 (sum f sum mu + sum f_i mu_i)
+        first_1 += area / 12.0 * (fsum * (u0 + u1 + u2) + f0 * u0 + f1 * u1 + f2 * u2)
+        first_2 += area / 12.0 * (fsum * (v0 + v1 + v2) + f0 * v0 + f1 * v1 + f2 * v2)
+        total_area += area
+    return integral, first_1, first_2, total_area
+
+
+@kernel
+def _clip_by_line(polygons, source, target, n_vertices, c0, c1, c2, signed):
+    """Keep the part of convex polygon ``polygons[source]`` (mu coordinates) where c0 + c1 mu1 +
+    c2 mu2 >= 0. Returns (vertex count, whether it was written to ``polygons[target]``); a polygon
+    wholly inside is left where it is."""
+    all_in = True
+    any_in = False
+    for i in range(n_vertices):
+        value = c0 + c1 * polygons[source, i, 0] + c2 * polygons[source, i, 1]
+        signed[i] = value
+        if value < 0.0:
+            all_in = False
+        else:
+            any_in = True
+    if all_in:
+        return n_vertices, False
+    if not any_in:
+        return 0, False
+    m = 0
+    for i in range(n_vertices):
+        j = i + 1
+        if j == n_vertices:
+            j = 0
+        si = signed[i]
+        sj = signed[j]
+        if si >= 0.0:
+            polygons[target, m, 0] = polygons[source, i, 0]
+            polygons[target, m, 1] = polygons[source, i, 1]
+            m += 1
+        if (si >= 0.0) != (sj >= 0.0):
+            t = si / (si - sj)
+            polygons[target, m, 0] = polygons[source, i, 0] + t * (polygons[source, j, 0] - polygons[source, i, 0])
+            polygons[target, m, 1] = polygons[source, i, 1] + t * (polygons[source, j, 1] - polygons[source, i, 1])
+            m += 1
+    return m, True
+
+
+@kernel
 def mat3_vec(a, v):
     out = np.empty(3)
     for i in range(3):

@@ -25,7 +25,9 @@ The damping and friction forces act at the force-weighted contact point.
 import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
-from riprap.solid.kernels.contact import OUT_SIZE, make_scratch, pair_potential_force, wall_potential_force
+from riprap.solid.kernels.contact import (OUT_SIZE, collect_pair_pieces, make_scratch,
+                                          pair_force_from_pieces, relative_pose,
+                                          wall_potential_force)
 from riprap.solid.kernels.geometry_ops import rotation_matrix
 
 # Below this many candidate pairs the evaluation stays on one thread.
@@ -45,6 +47,10 @@ C_OVERFLOW = 26
 C_AREA = 27
 C_SIZE = 28
 HISTORY_WIDTH = 6
+# Where a body pair's piece list for the next step lives.
+SOURCE_NONE = 0     # not kept (skin 0 or the batch's buffer was full)
+SOURCE_OLD = 1      # rows of the previous cache's pieces
+SOURCE_FRESH = 2    # rows of this step's fresh buffer
 
 
 @kernel
@@ -52,96 +58,246 @@ def evaluate_candidates(body_pairs, wall_pairs, positions, quaternions, velociti
                         shape_index, material_index, inverse_masses, wall_points, wall_normals,
                         wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
                         pair_tangential_ratio, history_keys, history_springs, key_stride, step,
-                        shape_arrays):
-    """Evaluate every candidate body-body and body-wall pair; returns (n_candidates, C_SIZE).
+                        piece_cache, skin, bounding_radius, shape_arrays):
+    """Evaluate every candidate body-body and body-wall pair.
+
+    Returns (results (n_candidates, C_SIZE), the piece cache for the next step).
+
+    ``piece_cache`` = (keys, poses, bounds, pieces): for each body pair evaluated last step (sorted
+    pair keys), the relative pose at which its (triangle, tet) pieces were listed with the widening
+    ``skin`` (m), and its rows [start, split, end) of ``pieces``. A pair whose surfaces have moved
+    less than ``skin`` relative to each other since then reuses its list; otherwise the list is
+    made again (:func:`riprap.solid.kernels.contact.collect_pieces`). Reuse does not change the
+    force, not even its round-off: lists are ordered canonically and extra pieces add exactly zero.
 
     Few candidates are done on the calling thread (waking the thread pool costs more than they
     do); the serial loop lives outside the parallel function because numba leaked the work arrays
     of a serial branch inside a ``parallel=True`` function (measured 18 kB per call).
     """
-    n_total = body_pairs.shape[0] + wall_pairs.shape[0]
+    n_body_pairs = body_pairs.shape[0]
+    n_total = n_body_pairs + wall_pairs.shape[0]
     results = np.zeros((n_total, C_SIZE))
-    if n_total < PARALLEL_MIN_CANDIDATES:
-        _evaluate_range(0, n_total, body_pairs, wall_pairs, positions, quaternions, velocities,
-                        omegas, shape_index, material_index, inverse_masses, wall_points,
-                        wall_normals, wall_materials, pair_penalty, pair_friction,
+    n_batches = 1 if n_total < PARALLEL_MIN_CANDIDATES else min(n_total, 64)
+    # Per body pair: where its piece list for the next step is (SOURCE_*), its rows, its pose.
+    source = np.full(n_body_pairs, SOURCE_NONE, dtype=np.int64)
+    bounds = np.zeros((n_body_pairs, 3), dtype=np.int64)
+    poses = np.empty((n_body_pairs, 12))
+    per_batch = (n_body_pairs + n_batches - 1) // n_batches
+    capacity = 8192 + 2 * (piece_cache[3].shape[0] // n_batches) + 128 * per_batch
+    fresh = np.empty((n_batches * capacity, 2), dtype=np.int64)
+    if n_batches == 1:
+        _evaluate_range(0, 0, n_total, body_pairs, wall_pairs, positions, quaternions,
+                        velocities, omegas, shape_index, material_index, inverse_masses,
+                        wall_points, wall_normals, wall_materials, pair_penalty, pair_friction,
                         pair_damping_ratio, pair_tangential_ratio, history_keys, history_springs,
-                        key_stride, step, shape_arrays, results)
+                        key_stride, step, piece_cache, skin, bounding_radius, shape_arrays,
+                        fresh, capacity, source, bounds, poses, results)
     else:
-        _evaluate_parallel(body_pairs, wall_pairs, positions, quaternions, velocities, omegas,
-                           shape_index, material_index, inverse_masses, wall_points, wall_normals,
-                           wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
-                           pair_tangential_ratio, history_keys, history_springs, key_stride, step,
-                           shape_arrays, results)
-    return results
+        _evaluate_parallel(n_batches, body_pairs, wall_pairs, positions, quaternions, velocities,
+                           omegas, shape_index, material_index, inverse_masses, wall_points,
+                           wall_normals, wall_materials, pair_penalty, pair_friction,
+                           pair_damping_ratio, pair_tangential_ratio, history_keys,
+                           history_springs, key_stride, step, piece_cache, skin, bounding_radius,
+                           shape_arrays, fresh, capacity, source, bounds, poses, results)
+    return results, _next_piece_cache(body_pairs, key_stride, piece_cache, fresh, source, bounds,
+                                      poses)
+
+
+@kernel
+def empty_piece_cache():
+    return (np.zeros(0, dtype=np.int64), np.zeros((0, 12)), np.zeros((0, 3), dtype=np.int64),
+            np.zeros((0, 2), dtype=np.int64))
+
+
+@kernel
+def _next_piece_cache(body_pairs, key_stride, piece_cache, fresh, source, bounds, poses):
+    """Gather the kept piece lists into a new cache ordered by pair key."""
+    old_keys, old_poses, old_bounds, old_pieces = piece_cache
+    n = body_pairs.shape[0]
+    n_kept = 0
+    all_old = True
+    for k in range(n):
+        if source[k] != SOURCE_NONE:
+            n_kept += 1
+        if source[k] != SOURCE_OLD:
+            all_old = False
+    if all_old and n_kept == old_keys.shape[0]:
+        return piece_cache      # the same pairs, all lists reused: nothing to move
+    keys = np.empty(n_kept, dtype=np.int64)
+    members = np.empty(n_kept, dtype=np.int64)
+    m = 0
+    for k in range(n):
+        if source[k] != SOURCE_NONE:
+            keys[m] = body_pairs[k, 0] * key_stride + body_pairs[k, 1]
+            members[m] = k
+            m += 1
+    order = np.argsort(keys)
+    total = 0
+    for m in range(n_kept):
+        k = members[m]
+        total += bounds[k, 2] - bounds[k, 0]
+    new_keys = np.empty(n_kept, dtype=np.int64)
+    new_poses = np.empty((n_kept, 12))
+    new_bounds = np.empty((n_kept, 3), dtype=np.int64)
+    new_pieces = np.empty((total, 2), dtype=np.int64)
+    row = 0
+    for m in range(n_kept):
+        k = members[order[m]]
+        new_keys[m] = keys[order[m]]
+        new_poses[m] = poses[k]
+        first = bounds[k, 0]
+        count = bounds[k, 2] - first
+        new_bounds[m, 0] = row
+        new_bounds[m, 1] = row + bounds[k, 1] - first
+        new_bounds[m, 2] = row + count
+        if source[k] == SOURCE_OLD:
+            for r in range(count):
+                new_pieces[row + r, 0] = old_pieces[first + r, 0]
+                new_pieces[row + r, 1] = old_pieces[first + r, 1]
+        else:
+            for r in range(count):
+                new_pieces[row + r, 0] = fresh[first + r, 0]
+                new_pieces[row + r, 1] = fresh[first + r, 1]
+        row += count
+    return new_keys, new_poses, new_bounds, new_pieces
 
 
 @parallel_kernel
-def _evaluate_parallel(body_pairs, wall_pairs, positions, quaternions, velocities, omegas,
-                       shape_index, material_index, inverse_masses, wall_points, wall_normals,
-                       wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
-                       pair_tangential_ratio, history_keys, history_springs, key_stride, step,
-                       shape_arrays, results):
-    """Contiguous batches of candidates in parallel, each batch with its own work arrays."""
+def _evaluate_parallel(n_batches, body_pairs, wall_pairs, positions, quaternions, velocities,
+                       omegas, shape_index, material_index, inverse_masses, wall_points,
+                       wall_normals, wall_materials, pair_penalty, pair_friction,
+                       pair_damping_ratio, pair_tangential_ratio, history_keys, history_springs,
+                       key_stride, step, piece_cache, skin, bounding_radius, shape_arrays, fresh,
+                       capacity, source, bounds, poses, results):
+    """Contiguous batches of candidates in parallel, each batch with its own work arrays and its
+    own part of the fresh piece buffer."""
     n_total = results.shape[0]
-    n_batches = min(n_total, 64)
     for batch in prange(n_batches):
-        _evaluate_range(batch * n_total // n_batches, (batch + 1) * n_total // n_batches,
+        _evaluate_range(batch, batch * n_total // n_batches, (batch + 1) * n_total // n_batches,
                         body_pairs, wall_pairs, positions, quaternions, velocities, omegas,
                         shape_index, material_index, inverse_masses, wall_points, wall_normals,
                         wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
                         pair_tangential_ratio, history_keys, history_springs, key_stride, step,
-                        shape_arrays, results)
+                        piece_cache, skin, bounding_radius, shape_arrays, fresh, capacity, source,
+                        bounds, poses, results)
 
 
 @kernel
-def _evaluate_range(first, last, body_pairs, wall_pairs, positions, quaternions, velocities,
-                    omegas, shape_index, material_index, inverse_masses, wall_points, wall_normals,
-                    wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
+def _evaluate_range(batch, first, last, body_pairs, wall_pairs, positions, quaternions,
+                    velocities, omegas, shape_index, material_index, inverse_masses, wall_points,
+                    wall_normals, wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
                     pair_tangential_ratio, history_keys, history_springs, key_stride, step,
-                    shape_arrays, results):
+                    piece_cache, skin, bounding_radius, shape_arrays, fresh, capacity, source,
+                    bounds, poses, results):
     scratch = make_scratch(shape_arrays[3].shape[0])
     out = np.zeros(OUT_SIZE)
     n_body_pairs = body_pairs.shape[0]
+    cache_keys, cache_poses, cache_bounds, cache_pieces = piece_cache
+    buffer_start = batch * capacity
+    used = 0
     for k in range(first, last):
-        _evaluate_one(k, n_body_pairs, body_pairs, wall_pairs, positions, quaternions, velocities,
-                      omegas, shape_index, material_index, inverse_masses, wall_points,
-                      wall_normals, wall_materials, pair_penalty, pair_friction,
-                      pair_damping_ratio, pair_tangential_ratio, history_keys, history_springs,
-                      key_stride, step, shape_arrays, scratch, out, results)
+        if k < n_body_pairs:
+            i = body_pairs[k, 0]
+            j = body_pairs[k, 1]
+            mi = material_index[i]
+            mj = material_index[j]
+            key = i * key_stride + j
+            r_i = rotation_matrix(quaternions[i])
+            r_j = rotation_matrix(quaternions[j])
+            shape_i = shape_index[i]
+            shape_j = shape_index[j]
+            penalty = pair_penalty[mi, mj]
+            rotation_1, translation_1, _, _ = relative_pose(positions[i], r_i, positions[j], r_j)
+            idx = np.searchsorted(cache_keys, key)
+            if (skin > 0.0 and idx < cache_keys.shape[0] and cache_keys[idx] == key
+                    and _within_skin(rotation_1, translation_1, cache_poses[idx],
+                                     bounding_radius[shape_i], bounding_radius[shape_j], skin)):
+                pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, positions[j], r_j,
+                                       penalty, shape_arrays, scratch, cache_pieces,
+                                       cache_bounds[idx, 0], cache_bounds[idx, 1],
+                                       cache_bounds[idx, 2], out)
+                source[k] = SOURCE_OLD
+                for c in range(3):
+                    bounds[k, c] = cache_bounds[idx, c]
+                poses[k] = cache_poses[idx]
+                overflow = 0.0
+            else:
+                pieces = scratch[18]
+                split, end, overflow = collect_pair_pieces(shape_i, shape_j, positions[i], r_i,
+                                                           positions[j], r_j, skin, shape_arrays,
+                                                           scratch, pieces, 0)
+                pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, positions[j], r_j,
+                                       penalty, shape_arrays, scratch, pieces, 0, split, end, out)
+                if skin > 0.0 and overflow == 0.0 and used + end <= capacity:
+                    row = buffer_start + used
+                    for r in range(end):
+                        fresh[row + r, 0] = pieces[r, 0]
+                        fresh[row + r, 1] = pieces[r, 1]
+                    source[k] = SOURCE_FRESH
+                    bounds[k, 0] = row
+                    bounds[k, 1] = row + split
+                    bounds[k, 2] = row + end
+                    for a in range(3):
+                        for b in range(3):
+                            poses[k, 3 * a + b] = rotation_1[a, b]
+                        poses[k, 9 + a] = translation_1[a]
+                    used += end
+            inv_j = inverse_masses[j]
+        else:
+            w = k - n_body_pairs
+            i = wall_pairs[w, 0]
+            wall = wall_pairs[w, 1]
+            j = -1
+            mi = material_index[i]
+            mj = wall_materials[wall]
+            r_i = rotation_matrix(quaternions[i])
+            wall_potential_force(shape_index[i], positions[i], r_i, wall_points[wall],
+                                 wall_normals[wall], pair_penalty[mi, mj], shape_arrays, scratch,
+                                 out)
+            key = i * key_stride + (key_stride - 1 - wall)
+            inv_j = 0.0
+            overflow = out[13]
+        results[k, C_OVERFLOW] = overflow
+        _contact_law(k, i, j, key, inv_j, mi, mj, positions, velocities, omegas, inverse_masses,
+                     pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys,
+                     history_springs, step, out, results)
 
 
 @kernel
-def _evaluate_one(k, n_body_pairs, body_pairs, wall_pairs, positions, quaternions, velocities,
-                  omegas, shape_index, material_index, inverse_masses, wall_points, wall_normals,
-                  wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
-                  pair_tangential_ratio, history_keys, history_springs, key_stride, step,
-                  shape_arrays, scratch, out, results):
-    if k < n_body_pairs:
-        i = body_pairs[k, 0]
-        j = body_pairs[k, 1]
-        mi = material_index[i]
-        mj = material_index[j]
-        r_i = rotation_matrix(quaternions[i])
-        r_j = rotation_matrix(quaternions[j])
-        pair_potential_force(shape_index[i], shape_index[j], positions[i], r_i, positions[j],
-                             r_j, pair_penalty[mi, mj], shape_arrays, scratch, out)
-        key = i * key_stride + j
-        inv_j = inverse_masses[j]
-    else:
-        w = k - n_body_pairs
-        i = wall_pairs[w, 0]
-        wall = wall_pairs[w, 1]
-        j = -1
-        mi = material_index[i]
-        mj = wall_materials[wall]
-        r_i = rotation_matrix(quaternions[i])
-        wall_potential_force(shape_index[i], positions[i], r_i, wall_points[wall],
-                             wall_normals[wall], pair_penalty[mi, mj], shape_arrays, scratch,
-                             out)
-        key = i * key_stride + (key_stride - 1 - wall)
-        inv_j = 0.0
-    results[k, C_OVERFLOW] = out[13]
+def _within_skin(rotation, translation, pose, radius_a, radius_b, skin):
+    """True when no surface point of either body has moved more than ``skin`` relative to the
+    other since ``pose`` (rotation row-major, translation; A's frame into B's).
+
+    A point y of A maps to R y + t in B's frame, so it has moved by at most |dt| + ||dR|| |y|
+    (Frobenius norm bounds the spectral one); B's points in A's frame move by the same rotation
+    change and by R^T t - R0^T t0.
+    """
+    rotation_change = 0.0
+    for a in range(3):
+        for b in range(3):
+            d = rotation[a, b] - pose[3 * a + b]
+            rotation_change += d * d
+    rotation_change = np.sqrt(rotation_change)
+    move_a = 0.0
+    move_b = 0.0
+    for a in range(3):
+        d = translation[a] - pose[9 + a]
+        move_a += d * d
+        # (R^T t)_a - (R0^T t0)_a
+        e = 0.0
+        for b in range(3):
+            e += rotation[b, a] * translation[b] - pose[3 * b + a] * pose[9 + b]
+        move_b += e * e
+    return (np.sqrt(move_a) + rotation_change * radius_a <= skin
+            and np.sqrt(move_b) + rotation_change * radius_b <= skin)
+
+
+@kernel
+def _contact_law(k, i, j, key, inv_j, mi, mj, positions, velocities, omegas, inverse_masses,
+                 pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys,
+                 history_springs, step, out, results):
+    """Normal damping, tangential and twisting friction of candidate ``k`` from its potential
+    force ``out``; writes row ``k`` of ``results``."""
     f_mag = np.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
     if f_mag <= 0.0:
         return

@@ -15,10 +15,11 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
                    inverse_masses, inverse_principal_inertia, fixed, shape_index, material_index,
                    gravity, wall_points, wall_normals, wall_materials, bounding_radius,
                    pair_penalty, pair_friction, pair_damping_ratio, pair_tangential_ratio,
-                   history_keys, history_springs, margin, step, shape_arrays):
+                   history_keys, history_springs, margin, step, piece_cache, skin, shape_arrays):
     """Forces and torques of every body at the current positions (gravity + contacts).
 
-    Returns (history_keys, history_springs, results, body_pairs, wall_pairs, omegas, overflow).
+    Returns (history_keys, history_springs, results, body_pairs, wall_pairs, omegas, overflow,
+    piece_cache).
     """
     # positions of the shape boxes in ShapeTable.kernel_arrays()
     local_box_min = shape_arrays[24]
@@ -34,11 +35,11 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
                                              wall_points, wall_normals, margin)
     omegas = integrate.angular_velocities(quaternions, angular_momenta, inverse_principal_inertia)
     key_stride = n + wall_points.shape[0]
-    results = interactions.evaluate_candidates(
+    results, piece_cache = interactions.evaluate_candidates(
         body_pairs, wall_pairs, positions, quaternions, velocities, omegas, shape_index,
         material_index, inverse_masses, wall_points, wall_normals, wall_materials, pair_penalty,
         pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys, history_springs,
-        key_stride, step, shape_arrays)
+        key_stride, step, piece_cache, skin, bounding_radius, shape_arrays)
     overflow = False
     for b in range(n):
         for c in range(3):
@@ -67,7 +68,7 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
             springs[m, c] = results[k, interactions.C_SPRING + c]
         m += 1
     order = np.argsort(keys)
-    return keys[order], springs[order], results, body_pairs, wall_pairs, omegas, overflow
+    return keys[order], springs[order], results, body_pairs, wall_pairs, omegas, overflow, piece_cache
 
 
 @kernel
@@ -75,9 +76,10 @@ def advance(n_steps, positions, quaternions, velocities, angular_momenta, forces
             masses, inverse_masses, inverse_principal_inertia, fixed, shape_index, material_index,
             gravity, wall_points, wall_normals, wall_materials, bounding_radius, pair_penalty,
             pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys,
-            history_springs, margin, step, local_damping, shape_arrays):
+            history_springs, margin, step, local_damping, piece_cache, skin, shape_arrays):
     """Advance ``n_steps`` velocity-Verlet steps. Returns (steps done, status, history_keys,
-    history_springs, results, body_pairs, wall_pairs, omegas) of the last force evaluation."""
+    history_springs, results, body_pairs, wall_pairs, omegas, piece_cache) of the last force
+    evaluation."""
     results = np.zeros((0, interactions.C_SIZE))
     body_pairs = np.zeros((0, 2), dtype=np.int64)
     wall_pairs = np.zeros((0, 2), dtype=np.int64)
@@ -87,16 +89,16 @@ def advance(n_steps, positions, quaternions, velocities, angular_momenta, forces
         integrate.drift(positions, quaternions, velocities, angular_momenta, inverse_masses,
                         inverse_principal_inertia, step)
         (history_keys, history_springs, results, body_pairs, wall_pairs, omegas,
-         overflow) = compute_forces(
+         overflow, piece_cache) = compute_forces(
             positions, quaternions, velocities, angular_momenta, forces, torques, masses,
             inverse_masses, inverse_principal_inertia, fixed, shape_index, material_index,
             gravity, wall_points, wall_normals, wall_materials, bounding_radius, pair_penalty,
             pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys,
-            history_springs, margin, step, shape_arrays)
+            history_springs, margin, step, piece_cache, skin, shape_arrays)
         integrate.kick(velocities, angular_momenta, omegas, forces, torques, inverse_masses,
                        0.5 * step, local_damping)
         if overflow:
-            return s + 1, STATUS_OVERFLOW, history_keys, history_springs, results, body_pairs, wall_pairs, omegas
+            return s + 1, STATUS_OVERFLOW, history_keys, history_springs, results, body_pairs, wall_pairs, omegas, piece_cache
         for b in range(positions.shape[0]):
             finite = True
             for c in range(3):
@@ -104,5 +106,5 @@ def advance(n_steps, positions, quaternions, velocities, angular_momenta, forces
                         and np.isfinite(angular_momenta[b, c])):
                     finite = False
             if not finite:
-                return s + 1, STATUS_NOT_FINITE, history_keys, history_springs, results, body_pairs, wall_pairs, omegas
-    return n_steps, STATUS_OK, history_keys, history_springs, results, body_pairs, wall_pairs, omegas
+                return s + 1, STATUS_NOT_FINITE, history_keys, history_springs, results, body_pairs, wall_pairs, omegas, piece_cache
+    return n_steps, STATUS_OK, history_keys, history_springs, results, body_pairs, wall_pairs, omegas, piece_cache
