@@ -79,6 +79,8 @@ class Simulation:
     rest_speed : float
         If > 0, the run stops once every free body moves slower than this (m/s, including the
         rotational speed at its bounding radius).
+    rest_kinetic_energy : float
+        If > 0, resting also needs the total kinetic energy of the free bodies below this (J).
     output_directory : str or Path
     paraview, picture : bool
         Write a ``.pvd`` series / a PNG of the final state.
@@ -90,13 +92,15 @@ class Simulation:
                  gravity=(0.0, 0.0, -9.81), output_interval: float = 0.05,
                  checkpoint_interval: float = 0.0, local_damping: float = 0.0,
                  rest_speed: float = 0.0, output_directory="riprap-out", paraview: bool = True,
-                 picture: bool = True, progress: bool = True):
+                 picture: bool = True, progress: bool = True, rest_kinetic_energy: float = 0.0):
         _require(end_time > 0, "end_time", end_time, "> 0 s")
         _require(time_step >= 0, "time_step", time_step, ">= 0 s (0 = automatic)")
         _require(0 < time_step_safety <= 1, "time_step_safety", time_step_safety, "in (0, 1]")
         _require(output_interval > 0, "output_interval", output_interval, "> 0 s")
         _require(checkpoint_interval >= 0, "checkpoint_interval", checkpoint_interval, ">= 0 s")
         _require(rest_speed >= 0, "rest_speed", rest_speed, ">= 0 m/s")
+        _require(rest_kinetic_energy >= 0, "rest_kinetic_energy", rest_kinetic_energy, ">= 0 J")
+        self.rest_kinetic_energy = float(rest_kinetic_energy)
         self.end_time = float(end_time)
         self.requested_time_step = float(time_step)
         self.time_step_safety = float(time_step_safety)
@@ -119,11 +123,14 @@ class Simulation:
     def add_material(self, material: Material) -> None:
         self.solver.add_material(material)
 
-    def add_shape(self, name: str, mesh: TetMesh) -> None:
+    def add_shape(self, name: str, mesh: TetMesh | RigidShape) -> None:
+        """Add a shape by name: a tetrahedral mesh, or a prepared :class:`RigidShape` (whose frame
+        as built is then its principal frame)."""
         if name in self._shape_names:
             raise CaseFileError(f"shape '{name}' defined twice")
-        self._shape_names[name] = self.solver.add_shape(RigidShape.from_mesh(mesh, name=name))
-        self._meshes.append(mesh)
+        shape = mesh if isinstance(mesh, RigidShape) else RigidShape.from_mesh(mesh, name=name)
+        self._shape_names[name] = self.solver.add_shape(shape)
+        self._meshes.append(shape.mesh if isinstance(mesh, RigidShape) else mesh)
 
     def shape(self, name: str) -> RigidShape:
         return self.solver.shapes[self._shape_index(name)]
@@ -135,13 +142,14 @@ class Simulation:
 
     def add_body(self, *, shape: str, material: str, position, orientation=(1.0, 0.0, 0.0, 0.0),
                  velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
-                 fixed: bool = False) -> int:
+                 fixed: bool = False, frame: str = "shape") -> int:
         """Add a body; ``position`` is its centroid (m), ``orientation`` a quaternion (w, x, y, z)
-        applied to the shape as built. Returns the body index."""
+        applied to the shape as built (``frame="shape"``) or to its principal frame
+        (``frame="principal"``, as the solver stores it). Returns the body index."""
         return self.solver.add_body(shape=self._shape_index(shape),
                                     material=self.solver.material_index(material),
                                     position=position, orientation=orientation, velocity=velocity,
-                                    angular_velocity=angular_velocity, fixed=fixed)
+                                    angular_velocity=angular_velocity, fixed=fixed, frame=frame)
 
     def add_walls(self, walls: list[Wall], *, container_box=None) -> None:
         self.solver.add_walls(walls)
@@ -261,6 +269,8 @@ class Simulation:
         if self.max_speed() >= self.rest_speed:
             return False
         s = self.solver
+        if self.rest_kinetic_energy > 0 and s.kinetic_energy() >= self.rest_kinetic_energy:
+            return False
         g = float(np.linalg.norm(s.gravity))
         free = ~s.fixed
         if g == 0.0 or not free.any():

@@ -1,0 +1,65 @@
+"""Placement grids generated from a design: rows along the face, units per row, spacing from a target
+packing density coefficient.
+
+Units per area is phi / D_n^2 (CEM VI-5, see ``layer_metrics``). With ``units_per_row`` = (n1, n2)
+the rows alternate between n1 and n2 units, the longer rows spanning the flume width with a
+horizontal spacing dx = width / max(n1, n2) and the shorter ones centred between them (a staggered
+pattern, as cranes place single-layer units); the spacing up the face is then
+dy = D_n^2 / (phi dx), so that the grid itself has the target packing density. The seed paper's
+Core-Loc layer is 21 rows alternating 12 and 11 units.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from riprap.errors import CaseFileError
+
+
+@dataclass(frozen=True)
+class DesignGrid:
+    """Centroids of a generated grid: world positions (n, 3), row index and slope coordinates."""
+
+    positions: np.ndarray
+    rows: np.ndarray
+    slope_coordinates: np.ndarray
+    horizontal_spacing: float
+    upslope_spacing: float
+
+
+def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12, 11),
+                packing_density_coefficient: float, first_row_s: float,
+                start_height: float) -> DesignGrid:
+    """Staggered rows of unit centroids on ``slope`` at ``start_height`` above the face (m)."""
+    counts = tuple(int(n) for n in np.atleast_1d(units_per_row))
+    if rows < 1:
+        raise CaseFileError(f"design grid: rows = {rows} must be >= 1")
+    if not counts or min(counts) < 1 or len(counts) > 2:
+        raise CaseFileError(f"design grid: units_per_row = {units_per_row!r} must be one or two "
+                            "positive integers (alternating rows)")
+    if not packing_density_coefficient > 0:
+        raise CaseFileError(f"design grid: packing_density_coefficient = "
+                            f"{packing_density_coefficient!r} must be > 0")
+    widest = max(counts)
+    dx = slope.width / widest
+    dy = nominal_diameter ** 2 / (packing_density_coefficient * dx)
+    s_list, y_list, row_list = [], [], []
+    for r in range(rows):
+        n = counts[r % len(counts)]
+        y0 = 0.5 * (slope.width - (n - 1) * dx)
+        for i in range(n):
+            s_list.append(first_row_s + r * dy)
+            y_list.append(y0 + i * dx)
+            row_list.append(r)
+    s = np.array(s_list)
+    if s.max() > slope.length:
+        raise CaseFileError(
+            f"design grid: {rows} rows {dy:.3f} m apart from s = {first_row_s:g} m reach "
+            f"s = {s.max():.3f} m along the face, beyond its length {slope.length:g} m; "
+            "use fewer rows, a longer slope or a lower first row")
+    y = np.array(y_list)
+    h = np.full(len(s), float(start_height))
+    return DesignGrid(positions=slope.to_world(s, y, h), rows=np.array(row_list, dtype=np.int64),
+                      slope_coordinates=np.stack([s, y, h], axis=1), horizontal_spacing=dx,
+                      upslope_spacing=dy)

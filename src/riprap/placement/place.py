@@ -1,0 +1,339 @@
+"""Deposit an underlayer of rocks and an armour layer of units on a slope until they rest (POSITIT).
+
+Two stages, each one rigid FEMDEM run (:class:`riprap.simulation.Simulation`):
+
+1. :func:`build_underlayer`: graded rocks start on a loose lattice above the face (no two bounding
+   spheres touch), fall onto it and settle with a settling damping; they are then held fixed.
+2. :func:`place_units`: units start at the grid's centroids (a user file or a design grid) with
+   user, random (uniform on rotations) or limited random orientations and an optional initial
+   velocity, fall onto the fixed underlayer and run until every unit rests (``rest_speed`` and
+   ``rest_kinetic_energy``) or ``max_time`` passes.
+
+A unit that starts overlapping another unit, a rock or a wall is an error naming the unit and the
+grid line it came from; with a generated grid, units are lifted until they are clear instead.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from riprap.errors import CaseFileError, OverlapError
+from riprap.placement import layer_metrics
+from riprap.simulation import Simulation
+from riprap.solid.materials import Material
+from riprap.solid.shape import RigidShape
+
+# Gap between the bounding spheres of neighbouring rocks in the start lattice, over their diameter.
+_ROCK_LATTICE_GAP = 0.05
+# A unit is lifted by this fraction of its height at a time while it overlaps something.
+_LIFT_STEP = 0.25
+_MAX_LIFTS = 40
+# Overlap tolerance at the start, as a fraction of the smallest boundary sub-tet height.
+_START_OVERLAP_FRACTION = 0.01
+
+
+@dataclass(frozen=True)
+class PlacementMaterials:
+    """Contact materials of the four kinds of surfaces (names must differ)."""
+
+    unit: Material
+    rock: Material
+    face: Material          # the slope face and the bed (the core's surface)
+    side_wall: Material
+
+    def all(self) -> list[Material]:
+        return [self.unit, self.rock, self.face, self.side_wall]
+
+
+@dataclass
+class Underlayer:
+    """Rocks resting on the face, held fixed for the armour placement."""
+
+    shapes: list[RigidShape]
+    shape_of_rock: np.ndarray        # (n,) index into shapes
+    positions: np.ndarray            # (n, 3) centroids, m
+    quaternions: np.ndarray          # (n, 4) principal frames (w, x, y, z)
+    nominal_diameters: np.ndarray    # (n,) m
+    top_level: float                 # top of the underlayer above the face, m
+    summary: dict = field(default_factory=dict)
+
+    def node_sets(self) -> list[np.ndarray]:
+        out = []
+        for k in range(len(self.positions)):
+            rotation = Rotation.from_quat(np.roll(self.quaternions[k], -1)).as_matrix()
+            out.append(self.shapes[self.shape_of_rock[k]].mesh.nodes @ rotation.T + self.positions[k])
+        return out
+
+
+@dataclass
+class PlacementResult:
+    """The armour layer at the end of the placement run."""
+
+    simulation: Simulation
+    unit_bodies: np.ndarray          # body index of each unit
+    grid_lines: np.ndarray | None    # grid-file line of each unit (None for a generated grid)
+    summary: dict
+
+
+def _run_settings(kwargs: dict) -> dict:
+    keys = ("end_time", "time_step", "time_step_safety", "output_interval", "checkpoint_interval",
+            "local_damping", "rest_speed", "rest_kinetic_energy", "output_directory", "paraview",
+            "picture", "progress", "gravity")
+    return {k: v for k, v in kwargs.items() if k in keys}
+
+
+def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range, layers: int = 2,
+                     seed: int = 0, **run) -> Underlayer:
+    """Drop graded rocks on the face between ``s_range`` = (s_low, s_high) (m along the face).
+
+    ``rocks``: sequence of objects with ``mesh`` (TetMesh), ``nominal_diameter`` and
+    ``probability`` (a rock library, :func:`riprap.geometry.rock_grading.rock_library`).
+    ``run``: :class:`Simulation` settings (``end_time`` is the longest settling time).
+    """
+    rng = np.random.default_rng(seed)
+    shapes = [RigidShape.from_mesh(r.mesh, name=f"rock_{k}") for k, r in enumerate(rocks)]
+    probability = np.array([r.probability for r in rocks], dtype=float)
+    probability /= probability.sum()
+    radius = max(s.bounding_radius for s in shapes)
+    spacing = 2.0 * radius * (1.0 + _ROCK_LATTICE_GAP)
+    s_low, s_high = (float(v) for v in s_range)
+    n_s = int((s_high - s_low) // spacing)
+    n_y = int((slope.width - 2.0 * radius) // spacing) + 1
+    if n_s < 1 or n_y < 1:
+        raise CaseFileError(f"underlayer: the band s = {s_low:g}..{s_high:g} m of a {slope.width:g} m "
+                            f"wide face holds no rock of bounding diameter {2 * radius:.3g} m")
+    y0 = 0.5 * (slope.width - (n_y - 1) * spacing)
+    points = []
+    for layer in range(layers):
+        shift = 0.5 * spacing * (layer % 2)
+        for i in range(n_s):
+            for j in range(n_y - (layer % 2)):
+                points.append((s_low + (i + 0.5) * spacing + shift, y0 + j * spacing + shift,
+                               radius * (1.0 + _ROCK_LATTICE_GAP) + layer * spacing))
+    points = np.array(points)
+    sim = Simulation(**_run_settings(run))
+    for m in materials.all():
+        sim.add_material(m)
+    for s in shapes:
+        sim.add_shape(s.name, s)
+    sim.add_walls(slope.walls(face_material=materials.face.name,
+                              side_material=materials.side_wall.name))
+    choice = rng.choice(len(shapes), size=len(points), p=probability)
+    orientations = Rotation.random(len(points), random_state=rng.integers(2**31)).as_quat()
+    world = slope.to_world(points[:, 0], points[:, 1], points[:, 2])
+    for k in range(len(points)):
+        x, y, z, w = orientations[k]
+        sim.add_body(shape=shapes[choice[k]].name, material=materials.rock.name, position=world[k],
+                     orientation=(w, x, y, z))
+    summary = sim.run()
+    solver = sim.solver
+    underlayer = Underlayer(shapes=shapes, shape_of_rock=choice.astype(np.int64),
+                            positions=solver.positions.copy(), quaternions=solver.quaternions.copy(),
+                            nominal_diameters=np.array([rocks[c].nominal_diameter for c in choice]),
+                            top_level=0.0, summary=summary.as_dict())
+    underlayer.top_level = layer_metrics.underlayer_top(slope, underlayer.node_sets())
+    return underlayer
+
+
+def unit_orientations(count: int, *, mode: str, slope, seed: int = 0, max_tilt_deg: float = 180.0,
+                      user=None) -> np.ndarray:
+    """Quaternions (w, x, y, z) rotating the unit as built into the world.
+
+    ``mode``: ``"user"`` (``user`` quaternions), ``"random"`` (uniform on rotations) or
+    ``"random_within"`` (the unit's z axis turned to the face normal, then a random spin about it
+    and a tilt up to ``max_tilt_deg`` about a random horizontal axis).
+    """
+    rng = np.random.default_rng(seed)
+    if mode == "user":
+        if user is None:
+            raise CaseFileError("orientation = 'user' needs orientations in the grid file "
+                                "(columns qw, qx, qy, qz or roll, pitch, yaw)")
+        return np.asarray(user, dtype=float)
+    if mode == "random":
+        q = Rotation.random(count, random_state=rng.integers(2**31)).as_quat()
+    elif mode == "random_within":
+        if not 0.0 <= max_tilt_deg <= 180.0:
+            raise CaseFileError(f"max_tilt_deg = {max_tilt_deg!r} must lie in 0..180 degrees")
+        to_face = Rotation.from_rotvec(np.array([0.0, -slope.angle, 0.0]))
+        spin = Rotation.from_euler("z", rng.uniform(0.0, 2.0 * np.pi, count))
+        azimuth = rng.uniform(0.0, 2.0 * np.pi, count)
+        tilt = np.radians(max_tilt_deg) * np.sqrt(rng.uniform(0.0, 1.0, count))
+        axes = np.stack([np.cos(azimuth), np.sin(azimuth), np.zeros(count)], axis=1)
+        q = (to_face * Rotation.from_rotvec(axes * tilt[:, None]) * spin).as_quat()
+    else:
+        raise CaseFileError(f"orientation = {mode!r}: expected 'user', 'random' or 'random_within'")
+    return np.concatenate([q[:, 3:], q[:, :3]], axis=1)
+
+
+def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations, materials,
+                velocities=None, grid_lines=None, lift_overlapping: bool = False,
+                initial_velocity=(0.0, 0.0, 0.0), **run) -> PlacementResult:
+    """Deposit the units on the fixed underlayer and run until they rest.
+
+    ``unit``: an :class:`riprap.geometry.armour_units.ArmourUnit` (mesh, height, nominal_diameter,
+    volume, design). ``positions`` (n, 3) start centroids, ``orientations`` (n, 4) quaternions of the
+    unit as built; ``velocities`` (n, 3) or ``initial_velocity`` for all. ``grid_lines``: the grid
+    file line of each unit, named in errors. ``lift_overlapping``: lift units that start overlapping
+    (generated grids) instead of refusing them.
+    """
+    positions = np.array(positions, dtype=float)
+    orientations = np.asarray(orientations, dtype=float)
+    n_units = len(positions)
+    if velocities is None:
+        velocities = np.tile(np.asarray(initial_velocity, dtype=float), (n_units, 1))
+    unit_shape = RigidShape.from_mesh(unit.mesh, name="armour_unit")
+    if lift_overlapping:
+        _shift_between_side_walls(slope, unit_shape, positions, orientations)
+    _check_inside(slope, unit_shape, positions, orientations, grid_lines)
+    for _ in range(_MAX_LIFTS + 1):
+        sim = _placement_simulation(slope, unit_shape, underlayer, positions, orientations,
+                                    velocities, materials, run)
+        overlapping = _overlapping_units(sim, len(underlayer.positions), n_units)
+        if not overlapping:
+            break
+        if not lift_overlapping:
+            lines = [f"  unit {k}" + (f" (grid line {grid_lines[k]})" if grid_lines is not None else "")
+                     + f" overlaps {what}" for k, what in overlapping[:20]]
+            raise OverlapError(f"{len(overlapping)} unit(s) start overlapping:\n" + "\n".join(lines)
+                               + "\nMove them apart or higher in the grid.")
+        for k in sorted({k for k, _ in overlapping}):
+            positions[k, 2] += _LIFT_STEP * unit.height
+    else:
+        raise OverlapError(f"units still overlap after lifting them {_MAX_LIFTS} times by "
+                           f"{_LIFT_STEP:g} unit heights: the grid is too dense for this unit")
+    result = sim.run()
+    first_unit = len(underlayer.positions)
+    unit_bodies = np.arange(first_unit, first_unit + n_units)
+    summary = placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies)
+    summary["run"] = result.as_dict()
+    return PlacementResult(simulation=sim, unit_bodies=unit_bodies,
+                           grid_lines=None if grid_lines is None else np.asarray(grid_lines),
+                           summary=summary)
+
+
+def _placement_simulation(slope, unit_shape, underlayer, positions, orientations, velocities,
+                          materials, run) -> Simulation:
+    sim = Simulation(**_run_settings(run))
+    for m in materials.all():
+        sim.add_material(m)
+    for s in underlayer.shapes:
+        sim.add_shape(s.name, s)
+    sim.add_shape(unit_shape.name, unit_shape)
+    sim.add_walls(slope.walls(face_material=materials.face.name,
+                              side_material=materials.side_wall.name))
+    for k in range(len(underlayer.positions)):
+        sim.add_body(shape=underlayer.shapes[underlayer.shape_of_rock[k]].name,
+                     material=materials.rock.name, position=underlayer.positions[k],
+                     orientation=underlayer.quaternions[k], fixed=True, frame="principal")
+    for k in range(len(positions)):
+        # The unit's mesh as built is given to RigidShape.from_mesh, which moved it to its
+        # principal frame: orientations apply to the mesh as built, hence frame="shape".
+        sim.add_body(shape=unit_shape.name, material=materials.unit.name, position=positions[k],
+                     orientation=orientations[k], velocity=velocities[k], frame="shape")
+    return sim
+
+
+def _overlapping_units(sim: Simulation, first_unit: int, n_units: int) -> list[tuple[int, str]]:
+    """(unit number, what it overlaps) for every unit that starts overlapping something."""
+    solver = sim.solver
+    solver._build_arrays()
+    if sim.requested_time_step > 0:
+        solver.time_step = sim.requested_time_step
+    else:
+        solver.time_step = solver.stable_time_step(sim.time_step_safety)
+    solver.finalize()
+    tolerance = _START_OVERLAP_FRACTION * min(s.min_subtet_height for s in solver.shapes)
+    found = []
+    for i, j, depth in solver.overlaps(tolerance):
+        for a, b in ((i, j), (j, i)):
+            if a >= first_unit and (b < 0 or b < first_unit or a > b):
+                if b < 0:
+                    what = f"wall {-1 - b}"
+                elif b < first_unit:
+                    what = f"underlayer rock {b}"
+                else:
+                    what = f"unit {b - first_unit}"
+                found.append((a - first_unit, f"{what} (depth {depth:.2e} m)"))
+                break
+    return found
+
+
+def _world_nodes(unit_shape, position, quaternion) -> np.ndarray:
+    """Nodes of a unit placed with ``quaternion`` applied to its mesh as built."""
+    frame = Rotation.from_matrix(unit_shape.frame_rotation)
+    rotation = Rotation.from_quat([quaternion[1], quaternion[2], quaternion[3], quaternion[0]]) * frame
+    return rotation.apply(np.array(unit_shape.mesh.nodes)) + position
+
+
+def _shift_between_side_walls(slope, unit_shape, positions, orientations) -> None:
+    """Move generated units that reach through a side wall back inside (in place)."""
+    for k in range(len(positions)):
+        y = slope.to_slope(_world_nodes(unit_shape, positions[k], orientations[k]))[:, 1]
+        if y.max() - y.min() > slope.width:
+            raise CaseFileError(f"unit {k} is {y.max() - y.min():.3f} m wide across the flume, more "
+                                f"than its width {slope.width:g} m")
+        if y.min() < 0.0:
+            positions[k, 1] -= y.min()
+        elif y.max() > slope.width:
+            positions[k, 1] -= y.max() - slope.width
+
+
+def _check_inside(slope, unit_shape, positions, orientations, grid_lines) -> None:
+    """Every unit must start inside the flume (between the side walls, above the face)."""
+    problems = []
+    for k in range(len(positions)):
+        coords = slope.to_slope(_world_nodes(unit_shape, positions[k], orientations[k]))
+        where = f"unit {k}" + (f" (grid line {grid_lines[k]})" if grid_lines is not None else "")
+        if coords[:, 1].min() < 0.0 or coords[:, 1].max() > slope.width:
+            problems.append(f"  {where} reaches y = {coords[:, 1].min():.3f}..{coords[:, 1].max():.3f} m, "
+                            f"outside the side walls at 0 and {slope.width:g} m")
+        elif coords[:, 2].min() < 0.0:
+            problems.append(f"  {where} starts {-coords[:, 2].min():.3f} m inside the slope face")
+    if problems:
+        more = f"\n  ... and {len(problems) - 20} more" if len(problems) > 20 else ""
+        raise CaseFileError(f"{len(problems)} unit(s) start outside the container:\n"
+                            + "\n".join(problems[:20]) + more)
+
+
+def placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies) -> dict:
+    """The layer as designers read it (``layer_metrics``) plus what came to rest."""
+    solver = sim.solver
+    rotations = solver.rotation_matrices()
+    node_sets = [unit_shape.mesh.nodes @ rotations[b].T + solver.positions[b] for b in unit_bodies]
+    coords = slope.to_slope(solver.positions[unit_bodies])
+    speeds = (np.linalg.norm(solver.velocities[unit_bodies], axis=1)
+              + np.linalg.norm(solver.angular_velocities[unit_bodies], axis=1)
+              * unit_shape.bounding_radius)
+    dn = unit.nominal_diameter
+    # Slid past the toe by more than a unit (a unit resting in the toe corner is not), or thrown
+    # above the crest.
+    rolled_off = (coords[:, 0] < -dn) | (coords[:, 0] > slope.length)
+    threshold = sim.rest_speed if sim.rest_speed > 0 else np.inf
+    at_rest = (speeds < threshold) & ~rolled_off
+    on_face = ~rolled_off
+    figures = layer_metrics.layer_figures(
+        slope, solver.positions[unit_bodies][on_face], [n for n, ok in zip(node_sets, on_face) if ok],
+        nominal_diameter=dn, unit_volume=unit.volume, underlayer_level=underlayer.top_level)
+    overlaps = [depth for i, j, depth in solver.overlaps(0.0)
+                if i in set(unit_bodies.tolist()) or j in set(unit_bodies.tolist())]
+    design = unit.design
+    return {
+        "unit": unit.kind,
+        "unit_height_m": float(unit.height),
+        "nominal_diameter_m": float(dn),
+        "units_placed": int(len(unit_bodies)),
+        "units_at_rest": int(at_rest.sum()),
+        "units_rolled_off": [int(k) for k in np.flatnonzero(rolled_off)],
+        "units_not_at_rest": [int(k) for k in np.flatnonzero(~at_rest & ~rolled_off)],
+        **figures,
+        "design_packing_density_coefficient": float(design.packing_density_coefficient),
+        "design_layer_thickness_m": float(design.layers * design.layer_thickness_coefficient * dn),
+        "design_porosity": float(design.porosity),
+        "max_overlap_over_dn": float(max(overlaps, default=0.0) / dn),
+        "underlayer_rocks": int(len(underlayer.positions)),
+        "underlayer_top_m": float(underlayer.top_level),
+        "slope_angle_deg": slope.angle_deg,
+    }

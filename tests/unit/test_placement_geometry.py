@@ -1,0 +1,79 @@
+"""Slope frame, design grids and layer figures on arrangements whose answers are known by hand."""
+import numpy as np
+import pytest
+
+from riprap.errors import CaseFileError
+from riprap.placement import Slope, design_grid
+from riprap.placement import layer_metrics
+
+
+def test_slope_coordinates_round_trip_and_frame():
+    slope = Slope(cotangent=1.5, width=3.0, length=10.0, toe_x=2.0, toe_level=-1.0)
+    assert slope.angle_deg == pytest.approx(np.degrees(np.arctan(1 / 1.5)), abs=1e-12)
+    assert slope.tangent @ slope.normal == pytest.approx(0.0, abs=1e-15)
+    assert slope.crest_level == pytest.approx(-1.0 + 10.0 / np.sqrt(1 + 1.5 ** 2), rel=1e-12)
+    rng = np.random.default_rng(0)
+    points = rng.uniform(-5, 5, size=(20, 3))
+    back = slope.to_world(*slope.to_slope(points).T)
+    assert np.allclose(back, points, atol=1e-12)
+    # A point on the face has h = 0; the toe is s = 0.
+    on_face = slope.to_world(4.0, 1.0, 0.0)
+    assert on_face[2] == pytest.approx(-1.0 + 4.0 * np.sin(slope.angle), abs=1e-12)
+
+
+def test_slope_walls_point_into_the_free_space():
+    slope = Slope(cotangent=2.0, width=1.0, length=5.0)
+    walls = slope.walls(face_material="core", side_material="glass")
+    assert len(walls) == 4
+    free_point = slope.to_world(2.0, 0.5, 0.3)
+    for wall in walls:
+        assert (free_point - np.asarray(wall.point)) @ np.asarray(wall.normal) > 0
+
+
+def test_bad_slope_is_refused():
+    with pytest.raises(CaseFileError, match="cotangent"):
+        Slope(cotangent=0.3, width=1.0, length=1.0)
+    with pytest.raises(CaseFileError, match="width"):
+        Slope(cotangent=1.5, width=-1.0, length=1.0)
+
+
+def test_design_grid_has_the_target_packing_density():
+    slope = Slope(cotangent=1.33, width=12.0, length=60.0)
+    dn = 1.2
+    grid = design_grid(slope, nominal_diameter=dn, rows=21, units_per_row=(12, 11),
+                       packing_density_coefficient=0.62, first_row_s=1.0, start_height=2.0)
+    assert len(grid.positions) == 11 * 12 + 10 * 11 == 242          # the seed paper's layer
+    assert grid.horizontal_spacing == pytest.approx(1.0)
+    # Units per area of the grid = 1 / (dx dy) = phi / Dn^2.
+    assert dn ** 2 / (grid.horizontal_spacing * grid.upslope_spacing) == pytest.approx(0.62)
+    assert np.allclose(grid.slope_coordinates[:, 2], 2.0)
+    assert grid.slope_coordinates[:, 1].min() == pytest.approx(0.5)
+    assert grid.slope_coordinates[:, 1].max() == pytest.approx(11.5)
+
+
+def test_design_grid_longer_than_the_face_is_refused():
+    slope = Slope(cotangent=1.5, width=2.0, length=3.0)
+    with pytest.raises(CaseFileError, match="beyond its length"):
+        design_grid(slope, nominal_diameter=1.0, rows=10, units_per_row=2,
+                    packing_density_coefficient=0.6, first_row_s=0.5, start_height=1.0)
+
+
+def test_layer_figures_of_a_perfect_tiling_of_cubes():
+    """Cubes of side a tiling the face in rows: phi = 1, porosity 0, thickness a (by hand)."""
+    slope = Slope(cotangent=1.5, width=4.0, length=20.0)
+    a = 0.5
+    corners = np.array([[x, y, z] for x in (-a / 2, a / 2) for y in (-a / 2, a / 2) for z in (-a / 2, a / 2)])
+    s_values = np.arange(0.25, 6.0, a)
+    y_values = np.arange(0.25, 4.0, a)
+    centres, node_sets = [], []
+    for s in s_values:
+        for y in y_values:
+            local = np.column_stack([s + corners[:, 0], y + corners[:, 1], a / 2 + corners[:, 2]])
+            node_sets.append(slope.to_world(*local.T))
+            centres.append(slope.to_world(s, y, a / 2))
+    figures = layer_metrics.layer_figures(slope, np.array(centres), node_sets, nominal_diameter=a,
+                                          unit_volume=a ** 3, underlayer_level=0.0)
+    assert figures["units_in_measuring_band"] == (len(s_values) - 3) * len(y_values)
+    assert figures["packing_density_coefficient"] == pytest.approx(1.0, rel=1e-9)
+    assert figures["layer_thickness_m"] == pytest.approx(a, rel=1e-12)
+    assert figures["porosity"] == pytest.approx(0.0, abs=1e-9)
