@@ -162,15 +162,21 @@ class Simulation:
         solver = self.solver
         if solver._ready:
             return
+        self.build_without_checks()
+        if not self._restarted:
+            smallest = min(s.min_subtet_height for s in solver.shapes)
+            solver.check_no_initial_overlap(_INITIAL_OVERLAP_FRACTION * smallest)
+
+    def build_without_checks(self) -> None:
+        """Build the solver's arrays, choose the time step and evaluate the initial forces, without
+        refusing overlaps (callers that resolve overlaps themselves use ``solver.overlaps``)."""
+        solver = self.solver
         solver._build_arrays()
         if self.requested_time_step > 0:
             solver.time_step = self.requested_time_step
         else:
             solver.time_step = solver.stable_time_step(self.time_step_safety)
         solver.finalize()
-        if not self._restarted:
-            smallest = min(s.min_subtet_height for s in solver.shapes)
-            solver.check_no_initial_overlap(_INITIAL_OVERLAP_FRACTION * smallest)
 
     def run(self, *, restart_from=None) -> RunSummary:
         """Run to ``end_time`` (or rest); write frames, checkpoints, picture and summary."""

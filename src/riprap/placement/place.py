@@ -238,13 +238,8 @@ def _placement_simulation(slope, unit_shape, underlayer, positions, orientations
 
 def _overlapping_units(sim: Simulation, first_unit: int, n_units: int) -> list[tuple[int, str]]:
     """(unit number, what it overlaps) for every unit that starts overlapping something."""
+    sim.build_without_checks()
     solver = sim.solver
-    solver._build_arrays()
-    if sim.requested_time_step > 0:
-        solver.time_step = sim.requested_time_step
-    else:
-        solver.time_step = solver.stable_time_step(sim.time_step_safety)
-    solver.finalize()
     tolerance = _START_OVERLAP_FRACTION * min(s.min_subtet_height for s in solver.shapes)
     found = []
     for i, j, depth in solver.overlaps(tolerance):
