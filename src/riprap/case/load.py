@@ -521,14 +521,8 @@ class _Problems:
     def raise_if_any(self) -> None:
         if not self._items:
             return
-        messages = [text for _, _, text in sorted(self._items)]
-        shown = messages[:schema.MAXIMUM_REPORTED_PROBLEMS]
-        hidden = len(messages) - len(shown)
-        if hidden:
-            shown.append(f"... and {hidden} more problem(s) not shown; fix the ones above first")
-        error = CaseFileError("\n".join(shown))
-        error.problems = tuple(messages)
-        raise error
+        raise CaseFileError.from_problems([text for _, _, text in sorted(self._items)],
+                                          schema.MAXIMUM_REPORTED_PROBLEMS)
 
 
 class _Validator:

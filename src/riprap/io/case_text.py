@@ -11,7 +11,7 @@ from pathlib import Path
 
 from riprap.errors import CaseFileError
 
-__all__ = ["read_case_text"]
+__all__ = ["read_case_text", "read_text_file"]
 
 
 def read_case_text(path: str | os.PathLike) -> str:
@@ -33,23 +33,29 @@ def read_case_text(path: str | os.PathLike) -> str:
         If the file does not exist, cannot be read, or is not UTF-8 text (the message then gives
         the line of the first bad byte).
     """
+    return read_text_file(path, what="case file", extension=".toml")
+
+
+def read_text_file(path: str | os.PathLike, *, what: str, extension: str) -> str:
+    """Read a UTF-8 text input file (``what``: "case file", "grid file", ...), raising
+    CaseFileError messages that name the file and, for a bad byte, its line."""
     path = Path(path)
     try:
         with open(path, "rb") as stream:
             raw = stream.read()
     except FileNotFoundError:
         raise CaseFileError(
-            f"{path}: case file not found (looked for {path.absolute()}); check the path"
+            f"{path}: {what} not found (looked for {path.absolute()}); check the path"
         ) from None
     except IsADirectoryError:
-        raise CaseFileError(f"{path}: is a folder, not a case file; give the .toml file") from None
+        raise CaseFileError(f"{path}: is a folder, not a {what}; give the {extension} file") from None
     except OSError as error:
-        raise CaseFileError(f"{path}: cannot read the case file: {error.strerror}") from None
+        raise CaseFileError(f"{path}: cannot read the {what}: {error.strerror}") from None
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         line = raw.count(b"\n", 0, error.start) + 1
         raise CaseFileError(
-            f"{path}:{line}: the case file is not UTF-8 text (bad byte at offset {error.start}); "
+            f"{path}:{line}: the {what} is not UTF-8 text (bad byte at offset {error.start}); "
             "save it with UTF-8 encoding"
         ) from None
