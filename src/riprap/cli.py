@@ -2,6 +2,7 @@
 
     riprap demo [--out DIR]            drop rocks and tetrapods into a box (embedded case)
     riprap run CASE.toml [--out DIR] [--restart CHECKPOINT]
+    riprap place CASE.toml [--out DIR]   build an armour layer on a slope (pack, pictures, summary)
     riprap check CASE.toml             validate a case file and report every problem
     riprap info                        versions and threads
 """
@@ -11,7 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from riprap.errors import RiprapError
+from riprap.errors import CaseFileError, RiprapError
 
 
 def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> int:
@@ -19,6 +20,9 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
     from riprap.case.load import load_case
 
     case = load_case(path)
+    if case.is_placement and case.body_count == 0:
+        raise CaseFileError(f"{path} describes an armour placement and has no bodies of its own: "
+                            f"run it with 'riprap place {path}'")
     print(f"riprap: case {path}: {case.body_count} bodies, {len(case.shapes)} shapes, "
           f"{len(case.walls)} wall entries")
     print("riprap: contact pairs combine materials by the smaller friction coefficient, the smaller "
@@ -34,6 +38,25 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
     return 0
 
 
+def _place_case(path: Path, out: str | None, quiet: bool) -> int:
+    from riprap.case.build_placement import run_placement
+    from riprap.case.load import load_case
+
+    case = load_case(path)
+    print(f"riprap: placement case {path}: {case.armour.unit if case.armour else '?'} units on a "
+          f"1:{case.slope.cotangent if case.slope else '?'} slope")
+    summary = run_placement(case, output_directory=out, progress=not quiet)
+    print(f"riprap: {summary['units_placed']} units placed, {summary['units_at_rest']} at rest, "
+          f"{len(summary['units_rolled_off'])} rolled off; packing density coefficient "
+          f"{summary['packing_density_coefficient']:.3f} (design "
+          f"{summary['design_packing_density_coefficient']:.3f}), porosity "
+          f"{summary['porosity']:.3f}, layer thickness {summary['layer_thickness_m']:.3f} m, "
+          f"largest overlap {100 * summary['max_overlap_over_dn']:.2f} % of Dn")
+    for key, value in summary["outputs"].items():
+        print(f"riprap: {key}: {value}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="riprap", description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -45,6 +68,10 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--out", default=None, help="output directory (default: [output] directory)")
     run.add_argument("--restart", default=None, help="continue from this checkpoint (.npz)")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
+    place = sub.add_parser("place", help="build an armour layer on a slope (POSITIT)")
+    place.add_argument("case", type=Path)
+    place.add_argument("--out", default=None, help="output directory (default: [output] directory)")
+    place.add_argument("--quiet", action="store_true", help="no progress bar")
     check = sub.add_parser("check", help="validate a case file")
     check.add_argument("case", type=Path)
     sub.add_parser("info", help="versions and threads")
@@ -57,11 +84,14 @@ def main(argv: list[str] | None = None) -> int:
                 return _run_case(Path(path), args.out, None, args.quiet)
         if args.command == "run":
             return _run_case(args.case, args.out, args.restart, args.quiet)
+        if args.command == "place":
+            return _place_case(args.case, args.out, args.quiet)
         if args.command == "check":
             from riprap.case.load import load_case
 
             case = load_case(args.case)
-            print(f"{args.case}: valid ({case.body_count} bodies)")
+            what = "an armour placement" if case.is_placement else f"{case.body_count} bodies"
+            print(f"{args.case}: valid ({what})")
             return 0
         if args.command == "info":
             import numba

@@ -17,6 +17,14 @@ from riprap.solid import walls as wall_builders
 from riprap.solid.materials import Material
 
 
+def build_material(spec) -> Material:
+    """The :class:`Material` of a ``[[materials]]`` entry."""
+    return Material(name=spec.name, density=spec.density,
+                    friction_coefficient=spec.friction_coefficient, restitution=spec.restitution,
+                    contact_penalty=spec.contact_penalty,
+                    tangential_stiffness_ratio=spec.tangential_stiffness_ratio)
+
+
 def build_shape(spec) -> TetMesh:
     """The tetrahedral mesh of a ``[[shapes]]`` entry."""
     p = dict(spec.parameters)
@@ -65,10 +73,7 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
         output_directory=output_directory or case.output.directory,
         paraview=case.output.paraview, picture=case.output.picture, progress=progress)
     for m in case.materials:
-        sim.add_material(Material(name=m.name, density=m.density,
-                                  friction_coefficient=m.friction_coefficient,
-                                  restitution=m.restitution, contact_penalty=m.contact_penalty,
-                                  tangential_stiffness_ratio=m.tangential_stiffness_ratio))
+        sim.add_material(build_material(m))
     for spec in case.shapes:
         sim.add_shape(spec.name, build_shape(spec))
     for body in case.bodies:

@@ -132,6 +132,68 @@ class WallSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class SlopeSpec:
+    """``[slope]`` (``riprap place``)."""
+
+    cotangent: float
+    width: float
+    length: float
+    toe_x: float = _default("slope", "toe_x")
+    toe_level: float = _default("slope", "toe_level")
+    face_material: str
+    side_wall_material: str
+
+
+@dataclass(frozen=True, kw_only=True)
+class UnderlayerSpec:
+    """``[underlayer]`` (``riprap place``)."""
+
+    material: str
+    dn50: float
+    dn85_over_dn15: float = _default("underlayer", "dn85_over_dn15")
+    rock_shapes: int = _default("underlayer", "rock_shapes")
+    size_classes: int = _default("underlayer", "size_classes")
+    layers: int = _default("underlayer", "layers")
+    from_s: float = _default("underlayer", "from_s")
+    to_s: float = _default("underlayer", "to_s")
+    settle_time: float = _default("underlayer", "settle_time")
+    seed: int = _default("underlayer", "seed")
+
+
+@dataclass(frozen=True, kw_only=True)
+class ArmourSpec:
+    """``[armour]`` (``riprap place``)."""
+
+    unit: str
+    material: str
+    height: float = _default("armour", "height")
+    nominal_diameter: float = _default("armour", "nominal_diameter")
+    mass: float = _default("armour", "mass")
+    mesh_size: float = _default("armour", "mesh_size")
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlacementSpec:
+    """``[placement]`` (``riprap place``)."""
+
+    grid_file: str = _default("placement", "grid_file")
+    rows: int = _default("placement", "rows")
+    units_per_row: int = _default("placement", "units_per_row")
+    units_per_alternate_row: int = _default("placement", "units_per_alternate_row")
+    packing_density_coefficient: float = _default("placement", "packing_density_coefficient")
+    first_row_s: float = _default("placement", "first_row_s")
+    start_height: float = _default("placement", "start_height")
+    orientation: str = _default("placement", "orientation")
+    max_tilt_deg: float = _default("placement", "max_tilt_deg")
+    initial_velocity: Vector = _default("placement", "initial_velocity")
+    settle_time: float = _default("placement", "settle_time")
+    rest_speed: float = _default("placement", "rest_speed")
+    rest_kinetic_energy: float = _default("placement", "rest_kinetic_energy")
+    local_damping: float = _default("placement", "local_damping")
+    seed: int = _default("placement", "seed")
+
+
+@dataclass(frozen=True, kw_only=True)
 class OutputSettings:
     """``[output]``."""
 
@@ -164,6 +226,15 @@ class Case:
     body_grids: tuple[BodyGridSpec, ...] = ()
     walls: tuple[WallSpec, ...] = ()
     output: OutputSettings = OutputSettings()
+    slope: SlopeSpec | None = None
+    underlayer: UnderlayerSpec | None = None
+    armour: ArmourSpec | None = None
+    placement: PlacementSpec | None = None
+
+    @property
+    def is_placement(self) -> bool:
+        """Whether the case describes an armour placement (``riprap place``)."""
+        return self.placement is not None
 
     @property
     def body_count(self) -> int:
@@ -731,6 +802,8 @@ class _Validator:
         return self._entry(top, {name: data[name] for name in top_keys if name in data}, ())
 
     def _array(self, part: Table, data: dict) -> list:
+        # riprap place makes its own shapes and bodies: a placement case needs none.
+        minimum = 0 if part.name == "shapes" and "placement" in data else part.minimum_count
         raw = data.get(part.name, _NOT_GIVEN)
         entries: list = []
         if raw is _NOT_GIVEN:
@@ -748,15 +821,17 @@ class _Validator:
             return []
         else:
             entries = raw
-        if len(entries) < part.minimum_count:
+        if len(entries) < minimum:
             self._problems.add(
                 (part.name,),
-                f"at least {part.minimum_count} {part.header} entry needed, found {len(entries)}",
+                f"at least {minimum} {part.header} entry needed, found {len(entries)}",
             )
         return [self._entry(part, entry, (part.name, number))
                 for number, entry in enumerate(entries)]
 
     def _single(self, part: Table, data: dict) -> dict | None:
+        if part.minimum_count == 0 and part.name not in data:
+            return None          # an optional table that is absent
         raw = data.get(part.name, {})
         if isinstance(raw, list):
             self._problems.add(
@@ -795,11 +870,16 @@ class _Validator:
                        if values is not None and values.get("name", _INVALID) is not _INVALID]
             listing = ", ".join(format_toml_value(name) for name in dict.fromkeys(defined))
             listing = listing or "none"
-            for number, values in enumerate(tables[entry.table]):
+            table_values = tables[entry.table]
+            if schema.table(entry.table).is_array:
+                located = [((entry.table, number, entry.name), values)
+                           for number, values in enumerate(table_values)]
+            else:
+                located = [((entry.table, entry.name), table_values)]
+            for path, values in located:
                 if values is None or values.get(entry.name, _INVALID) is _INVALID:
                     continue
                 value = values[entry.name]
-                path = (entry.table, number, entry.name)
                 names = value if isinstance(value, tuple) else (value,)
                 for item_number, name in enumerate(names):
                     if name in defined:
@@ -813,6 +893,8 @@ class _Validator:
                     )
 
     def _check_body_count(self, tables: dict) -> None:
+        if tables.get("placement") is not None:
+            return               # riprap place makes the bodies
         total = len(tables["bodies"])
         for values in tables["body_grids"]:
             counts = None if values is None else values.get("counts", _INVALID)
@@ -849,7 +931,15 @@ class _Validator:
             walls=tuple(_with_parameters(WallSpec, "walls", values)
                         for values in tables["walls"]),
             output=OutputSettings(**tables["output"]),
+            slope=_optional(SlopeSpec, tables["slope"]),
+            underlayer=_optional(UnderlayerSpec, tables["underlayer"]),
+            armour=_optional(ArmourSpec, tables["armour"]),
+            placement=_optional(PlacementSpec, tables["placement"]),
         )
+
+
+def _optional(spec_class, values: dict | None):
+    return None if values is None else spec_class(**values)
 
 
 def _as_number(value: object) -> tuple[object, str]:

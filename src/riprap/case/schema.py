@@ -213,6 +213,8 @@ _FRACTION = Range(minimum=0.0, maximum=1.0, minimum_inclusive=False)
 _ZERO = (0.0, 0.0, 0.0)
 _SHAPE_TYPES = ("sphere", "box", "cube", "random_rock", "tetrapod", "l_shape", "mesh_file")
 _WALL_TYPES = ("plane", "box")
+#: Armour unit kinds of :mod:`riprap.geometry.armour_units` (a test keeps the two lists equal).
+UNIT_KINDS = ("core_loc_like", "accropode_like", "xbloc_like", "tetrapod", "cube", "antifer_cube")
 _MESH_EXTENSIONS = (".stl", ".obj", ".ply", ".msh", ".vtu")
 
 #: Every table of the case file, in the order the docs list them.
@@ -228,6 +230,14 @@ TABLES: tuple[Table, ...] = (
           "Rectangular grids of bodies (counts[0] x counts[1] x counts[2] bodies each)."),
     Table("walls", True, 0, "type",
           "Fixed analytic boundaries; the side the normal points to is free space."),
+    Table("slope", False, 0, None,
+          "`riprap place` only: the breakwater face, its toe and the flume's side walls. x points "
+          "up the slope, y along the breakwater axis, z up."),
+    Table("underlayer", False, 0, None,
+          "`riprap place` only: graded rocks dropped on the face, then held fixed."),
+    Table("armour", False, 0, None, "`riprap place` only: the armour unit placed on the underlayer."),
+    Table("placement", False, 0, None,
+          "`riprap place` only: where the units start, how they are oriented, when they rest."),
     Table("output", False, 1, None, "Where and what riprap writes."),
 )
 
@@ -363,6 +373,98 @@ KEYS: tuple[Key, ...] = (
         greater_than="min"),
     Key("walls", "open_top", "boolean", "-",
         "Leave out the top plane (5 planes instead of 6).", default=True, variant="box"),
+    # [slope]
+    Key("slope", "cotangent", "number", "-",
+        "cot(alpha) of the face: 1.5 for a 1:1.5 slope.", valid_range=Range(minimum=0.5)),
+    Key("slope", "width", "number", "m", "Distance between the flume's side walls.",
+        valid_range=_POSITIVE),
+    Key("slope", "length", "number", "m", "Length of the face from toe to crest, along the face.",
+        valid_range=_POSITIVE),
+    Key("slope", "toe_x", "number", "m", "Horizontal position of the toe line.", default=0.0),
+    Key("slope", "toe_level", "number", "m", "Level of the toe line and of the bed in front of it.",
+        default=0.0),
+    Key("slope", "face_material", "string", "-",
+        "Material of the face and the bed (the core's surface).", references="materials"),
+    Key("slope", "side_wall_material", "string", "-", "Material of the flume's side walls.",
+        references="materials"),
+    # [underlayer]
+    Key("underlayer", "material", "string", "-", "Material of the rocks.", references="materials"),
+    Key("underlayer", "dn50", "number", "m", "Median nominal diameter of the rocks.",
+        valid_range=_POSITIVE),
+    Key("underlayer", "dn85_over_dn15", "number", "-",
+        "Grading width Dn85 / Dn15 (1 = uniform).", default=1.5, valid_range=Range(minimum=1.0)),
+    Key("underlayer", "rock_shapes", "integer", "-", "Distinct random rock shapes.", default=6,
+        valid_range=Range(minimum=1)),
+    Key("underlayer", "size_classes", "integer", "-",
+        "Sizes the grading is represented by (each shape is built at every size).", default=2,
+        valid_range=Range(minimum=1)),
+    Key("underlayer", "layers", "integer", "-",
+        "Rock layers in the start lattice (they settle into a rough bed).", default=2,
+        valid_range=Range(minimum=1)),
+    Key("underlayer", "from_s", "number", "m", "Lower end of the rock band, along the face.",
+        default=0.0),
+    Key("underlayer", "to_s", "number", "m",
+        "Upper end of the rock band along the face; 0 means the whole face.", default=0.0,
+        valid_range=_NON_NEGATIVE),
+    Key("underlayer", "settle_time", "number", "s", "Longest simulated time to let the rocks settle.",
+        default=2.0, valid_range=_POSITIVE),
+    Key("underlayer", "seed", "integer", "-", "Seed of rock shapes, sizes and orientations.",
+        default=0, valid_range=_NON_NEGATIVE),
+    # [armour]
+    Key("armour", "unit", "string", "-", "Kind of armour unit (approximations of the trademarked "
+        "shapes, see docs/armour-units.md).", choices=UNIT_KINDS),
+    Key("armour", "material", "string", "-", "Material of the units.", references="materials"),
+    Key("armour", "height", "number", "m",
+        "Unit height H; give exactly one of height, nominal_diameter and mass.", default=0.0,
+        valid_range=_NON_NEGATIVE),
+    Key("armour", "nominal_diameter", "number", "m", "Nominal diameter Dn = V^(1/3) of a unit.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("armour", "mass", "number", "kg", "Mass of a unit (with the material's density).",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("armour", "mesh_size", "number", "m",
+        "Target tetrahedron edge length; 0 uses the unit's own default.", default=0.0,
+        valid_range=_NON_NEGATIVE),
+    # [placement]
+    Key("placement", "grid_file", "string", "-",
+        "CSV grid of unit centroids (x, y, z; optional qw, qx, qy, qz or roll, pitch, yaw; "
+        "vx, vy, vz), relative to the case file; empty: a design grid from the keys below.",
+        default=""),
+    Key("placement", "rows", "integer", "-", "Rows of units up the face (design grid).",
+        default=0, valid_range=_NON_NEGATIVE),
+    Key("placement", "units_per_row", "integer", "-", "Units in the first and every other row.",
+        default=0, valid_range=_NON_NEGATIVE),
+    Key("placement", "units_per_alternate_row", "integer", "-",
+        "Units in the rows between (staggered, e.g. 11 between rows of 12); 0: the same.",
+        default=0, valid_range=_NON_NEGATIVE),
+    Key("placement", "packing_density_coefficient", "number", "-",
+        "Packing density of the design grid, phi = N Dn^2 / A; 0: the unit's design value.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("placement", "first_row_s", "number", "m",
+        "Position of the first row along the face from the toe; 0: half a unit height.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("placement", "start_height", "number", "m",
+        "Start height of the centroids above the face; 0: underlayer top plus one unit height.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("placement", "orientation", "string", "-",
+        "Unit orientations: uniform random, random within max_tilt_deg of lying on the face, or "
+        "from the grid file.", default="random", choices=("random", "random_within", "user")),
+    Key("placement", "max_tilt_deg", "number", "deg", "Largest tilt for random_within.",
+        default=30.0, valid_range=Range(minimum=0.0, maximum=180.0)),
+    Key("placement", "initial_velocity", "vector", "m/s",
+        "Velocity of every unit at the start (deposits faster).", default=_ZERO),
+    Key("placement", "settle_time", "number", "s", "Longest simulated time of the placement run.",
+        default=10.0, valid_range=_POSITIVE),
+    Key("placement", "rest_speed", "number", "m/s",
+        "Units rest when every one is slower than this (with rotation at its bounding radius).",
+        default=0.02, valid_range=_POSITIVE),
+    Key("placement", "rest_kinetic_energy", "number", "J",
+        "... and their total kinetic energy is below this; 0: no energy condition.", default=0.0,
+        valid_range=_NON_NEGATIVE),
+    Key("placement", "local_damping", "number", "-",
+        "Settling damping of the deposition runs (numerical, not physics).", default=0.3,
+        valid_range=Range(minimum=0.0, maximum=1.0, maximum_inclusive=False)),
+    Key("placement", "seed", "integer", "-", "Seed of the random orientations.", default=0,
+        valid_range=_NON_NEGATIVE),
     # [output]
     Key("output", "directory", "string", "-",
         "Output folder, relative to the current directory unless the command line overrides it.",
@@ -517,7 +619,9 @@ def render_markdown() -> str:
         "Rules that involve more than one key:",
         "",
         f"- `[[bodies]]` and `[[body_grids]]` together must create at least {MINIMUM_BODY_COUNT} "
-        "body.",
+        "body, except in a placement case (one with `[placement]`, run by `riprap place`), which "
+        "makes its own shapes and bodies from `[slope]`, `[underlayer]`, `[armour]` and "
+        "`[placement]`.",
         "- `name` is unique among `[[materials]]` and among `[[shapes]]`; `shape`, `shapes` and "
         "`material` must name an entry that exists.",
         "- Keys listed under a `type` exist only for that type: giving one for another type is an "

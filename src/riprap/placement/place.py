@@ -37,7 +37,7 @@ _START_OVERLAP_FRACTION = 0.01
 
 @dataclass(frozen=True)
 class PlacementMaterials:
-    """Contact materials of the four kinds of surfaces (names must differ)."""
+    """Contact materials of the four kinds of surfaces."""
 
     unit: Material
     rock: Material
@@ -45,7 +45,11 @@ class PlacementMaterials:
     side_wall: Material
 
     def all(self) -> list[Material]:
-        return [self.unit, self.rock, self.face, self.side_wall]
+        """Each material once (two roles may share one)."""
+        unique = {}
+        for m in (self.unit, self.rock, self.face, self.side_wall):
+            unique.setdefault(m.name, m)
+        return list(unique.values())
 
 
 @dataclass

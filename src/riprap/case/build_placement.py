@@ -1,0 +1,150 @@
+"""``riprap place``: build an armour layer from a case with ``[slope]``, ``[underlayer]``,
+``[armour]`` and ``[placement]`` tables, and write the pack, pictures and summary.
+
+Output folder:
+
+- ``underlayer/``: the rock deposition run (ParaView series, picture, its own summary);
+- ``deposition/``: the unit deposition run (``bodies.pvd``, ``contacts.pvd``, ``final_state.png``);
+- ``pack.toml`` and ``shapes/``: the final layer as a case file, readable by ``riprap run``;
+- ``summary.json``: units placed and at rest, packing density coefficient, porosity and layer
+  thickness against the design values, largest overlap over D_n.
+"""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from riprap.case.build import SMOKE_END_TIME, build_material, smoke_mode
+from riprap.errors import CaseFileError
+from riprap.placement import (PlacementMaterials, Slope, build_underlayer, design_grid,
+                              place_units, unit_orientations)
+
+
+def _material(case, name):
+    for spec in case.materials:
+        if spec.name == name:
+            return build_material(spec)
+    raise CaseFileError(f"{case.source}: no material named {name!r}")
+
+
+def _require_tables(case) -> None:
+    missing = [f"[{name}]" for name in ("slope", "underlayer", "armour", "placement")
+               if getattr(case, name) is None]
+    if missing:
+        raise CaseFileError(f"{case.source}: riprap place needs the tables {', '.join(missing)} "
+                            "(see docs/case-file.md)")
+
+
+def _armour_unit(case):
+    from riprap.geometry.armour_units import armour_unit
+
+    spec = case.armour
+    given = {name: value for name, value in (("height", spec.height),
+                                              ("nominal_diameter", spec.nominal_diameter),
+                                              ("mass", spec.mass)) if value > 0}
+    if len(given) != 1:
+        raise CaseFileError(f"{case.source}: [armour] needs exactly one of height, nominal_diameter "
+                            f"and mass (> 0), got {', '.join(given) or 'none'}")
+    density = _material(case, spec.material).density
+    return armour_unit(spec.unit, density=density, mesh_size=spec.mesh_size or None, **given)
+
+
+def _settings(case, end_time, output_directory, progress) -> dict:
+    sim = case.simulation
+    return dict(end_time=min(end_time, SMOKE_END_TIME) if smoke_mode() else end_time,
+                time_step=sim.time_step, time_step_safety=sim.time_step_safety,
+                gravity=sim.gravity, output_interval=sim.output_interval,
+                local_damping=case.placement.local_damping,
+                rest_speed=case.placement.rest_speed,
+                rest_kinetic_energy=case.placement.rest_kinetic_energy,
+                output_directory=output_directory, paraview=case.output.paraview,
+                picture=case.output.picture, progress=progress)
+
+
+def run_placement(case, *, output_directory=None, progress: bool = True) -> dict:
+    """Build the underlayer and the armour layer of ``case``; returns the summary (also written
+    as ``summary.json``)."""
+    _require_tables(case)
+    from riprap.geometry.rock_grading import RockGrading, rock_library
+    from riprap.io.summary import write_json
+
+    out = Path(output_directory or case.output.directory)
+    out.mkdir(parents=True, exist_ok=True)
+    sl, ul, pl = case.slope, case.underlayer, case.placement
+    slope = Slope(cotangent=sl.cotangent, width=sl.width, length=sl.length, toe_x=sl.toe_x,
+                  toe_level=sl.toe_level)
+    materials = PlacementMaterials(unit=_material(case, case.armour.material),
+                                   rock=_material(case, ul.material),
+                                   face=_material(case, sl.face_material),
+                                   side_wall=_material(case, sl.side_wall_material))
+    unit = _armour_unit(case)
+    rocks = rock_library(RockGrading(dn50=ul.dn50, dn85_over_dn15=ul.dn85_over_dn15),
+                         n_shapes=ul.rock_shapes, n_size_classes=ul.size_classes, seed=ul.seed)
+    underlayer = build_underlayer(
+        slope, rocks, materials=materials, s_range=(ul.from_s, ul.to_s or slope.length),
+        layers=ul.layers, seed=ul.seed,
+        **_settings(case, ul.settle_time, out / "underlayer", progress))
+    if pl.grid_file:
+        from riprap.io.grid_file import read_grid_file
+
+        grid = read_grid_file(case.base_dir / pl.grid_file)
+        positions, velocities, lines = grid.positions, grid.velocities, grid.lines
+        user = grid.orientations
+        lift = False
+    else:
+        if pl.rows < 1 or pl.units_per_row < 1:
+            raise CaseFileError(f"{case.source}: [placement] without grid_file needs rows and "
+                                "units_per_row (a design grid)")
+        counts = (pl.units_per_row, pl.units_per_alternate_row or pl.units_per_row)
+        packing = pl.packing_density_coefficient or unit.design.packing_density_coefficient
+        start = pl.start_height or underlayer.top_level + unit.height
+        generated = design_grid(slope, nominal_diameter=unit.nominal_diameter, rows=pl.rows,
+                                units_per_row=counts, packing_density_coefficient=packing,
+                                first_row_s=pl.first_row_s or 0.5 * unit.height,
+                                start_height=start)
+        positions, velocities, lines, user, lift = generated.positions, None, None, None, True
+    orientations = unit_orientations(len(positions), mode=pl.orientation, slope=slope,
+                                     seed=pl.seed, max_tilt_deg=pl.max_tilt_deg, user=user)
+    result = place_units(slope, unit, underlayer, positions=positions, orientations=orientations,
+                         materials=materials, velocities=velocities, grid_lines=lines,
+                         lift_overlapping=lift, initial_velocity=pl.initial_velocity,
+                         **_settings(case, pl.settle_time, out / "deposition", progress))
+    summary = dict(result.summary)
+    summary["outputs"] = _write_outputs(case, result, materials, slope, out)
+    summary["underlayer_run"] = underlayer.summary
+    write_json(out / "summary.json", summary)
+    return summary
+
+
+def _write_outputs(case, result, materials, slope, out: Path) -> dict:
+    from riprap.io.pack import PackBody, write_pack
+
+    sim = result.simulation
+    solver = sim.solver
+    names = {index: name for name, index in sim._shape_names.items()}
+    shapes = {names[k]: shape.mesh for k, shape in enumerate(solver.shapes)}
+    material_names = [m.name for m in solver.materials]
+    omegas = solver.angular_velocities
+    bodies = [PackBody(shape=names[int(solver.shape_index[b])],
+                       material=material_names[int(solver.material_index_of_body[b])],
+                       position=tuple(solver.positions[b]), orientation=tuple(solver.quaternions[b]),
+                       velocity=tuple(solver.velocities[b]), angular_velocity=tuple(omegas[b]),
+                       fixed=bool(solver.fixed[b]))
+              for b in range(solver.n_bodies)]
+    pack = write_pack(out, shapes=shapes, materials=materials.all(), bodies=bodies,
+                      walls=slope.walls(face_material=materials.face.name,
+                                        side_material=materials.side_wall.name),
+                      simulation={"end_time": case.simulation.end_time,
+                                  "time_step": case.simulation.time_step,
+                                  "time_step_safety": case.simulation.time_step_safety,
+                                  "gravity": list(case.simulation.gravity)},
+                      comment=f"armour layer placed by riprap place from {case.source}")
+    outputs = {"pack": str(pack), "paraview": str(out / "deposition" / "bodies.pvd")}
+    picture = out / "deposition" / "final_state.png"
+    if picture.is_file():
+        shutil.copyfile(picture, out / "final_layer.png")
+        outputs["picture"] = str(out / "final_layer.png")
+    return outputs
+
+
+__all__ = ["run_placement"]
