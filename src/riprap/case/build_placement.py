@@ -91,6 +91,7 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
         positions, velocities, lines = grid.positions, grid.velocities, grid.lines
         user = grid.orientations
         lift = False
+        rows = None
     else:
         if pl.rows < 1 or pl.units_per_row < 1:
             raise CaseFileError(f"{case.source}: [placement] without grid_file needs rows and "
@@ -103,11 +104,13 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
                                 first_row_s=pl.first_row_s or 0.5 * unit.height,
                                 start_height=start)
         positions, velocities, lines, user, lift = generated.positions, None, None, None, True
+        rows = generated.rows
     orientations = unit_orientations(len(positions), mode=pl.orientation, slope=slope,
                                      seed=pl.seed, max_tilt_deg=pl.max_tilt_deg, user=user)
     result = place_units(slope, unit, underlayer, positions=positions, orientations=orientations,
                          materials=materials, velocities=velocities, grid_lines=lines,
                          lift_overlapping=lift, initial_velocity=pl.initial_velocity,
+                         deposition=pl.deposition, rows=rows,
                          **_settings(case, pl.settle_time, out / "deposition", progress))
     summary = dict(result.summary)
     summary["outputs"] = _write_outputs(case, result, materials, slope, out)

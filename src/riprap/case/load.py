@@ -186,6 +186,7 @@ class PlacementSpec:
     orientation: str = _default("placement", "orientation")
     max_tilt_deg: float = _default("placement", "max_tilt_deg")
     initial_velocity: Vector = _default("placement", "initial_velocity")
+    deposition: str = _default("placement", "deposition")
     settle_time: float = _default("placement", "settle_time")
     rest_speed: float = _default("placement", "rest_speed")
     rest_kinetic_energy: float = _default("placement", "rest_kinetic_energy")

@@ -174,7 +174,8 @@ def unit_orientations(count: int, *, mode: str, slope, seed: int = 0, max_tilt_d
 
 def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations, materials,
                 velocities=None, grid_lines=None, lift_overlapping: bool = False,
-                initial_velocity=(0.0, 0.0, 0.0), **run) -> PlacementResult:
+                initial_velocity=(0.0, 0.0, 0.0), deposition: str = "all_at_once", rows=None,
+                **run) -> PlacementResult:
     """Deposit the units on the fixed underlayer and run until they rest.
 
     ``unit``: an :class:`riprap.geometry.armour_units.ArmourUnit` (mesh, height, nominal_diameter,
@@ -182,44 +183,125 @@ def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations,
     unit as built; ``velocities`` (n, 3) or ``initial_velocity`` for all. ``grid_lines``: the grid
     file line of each unit, named in errors. ``lift_overlapping``: lift units that start overlapping
     (generated grids) instead of refusing them.
+
+    ``deposition``: ``"all_at_once"``, or ``"row_by_row"`` as cranes place them: row k is dropped
+    once rows 0..k-1 rest (or their ``end_time`` has passed), onto them. ``rows``: the row of each
+    unit; by default units whose start positions lie within half a D_n of each other along the face
+    form a row. Each row is one run (its outputs in ``row_NN/`` under ``output_directory``); the
+    units already placed carry their state over, except the tangential contact history.
     """
     positions = np.array(positions, dtype=float)
     orientations = np.asarray(orientations, dtype=float)
     n_units = len(positions)
     if velocities is None:
         velocities = np.tile(np.asarray(initial_velocity, dtype=float), (n_units, 1))
+    velocities = np.asarray(velocities, dtype=float)
     unit_shape = RigidShape.from_mesh(unit.mesh, name="armour_unit")
     if lift_overlapping:
         _shift_between_side_walls(slope, unit_shape, positions, orientations)
     _check_inside(slope, unit_shape, positions, orientations, grid_lines)
+    groups = _deposition_groups(slope, positions, unit.nominal_diameter, deposition, rows)
+    state = _UnitState(positions, orientations, velocities)
+    placed: list[int] = []
+    results = []
+    for stage, group in enumerate(groups):
+        members = placed + list(group)
+        stage_run = dict(run)
+        if len(groups) > 1 and "output_directory" in run:
+            stage_run["output_directory"] = Path(run["output_directory"]) / f"row_{stage:02d}"
+        sim = _start_without_overlaps(slope, unit, unit_shape, underlayer, state, members,
+                                      set(group), materials, stage_run, lift_overlapping,
+                                      grid_lines)
+        results.append(sim.run().as_dict())
+        state.update_from(sim.solver, len(underlayer.positions), members)
+        placed = members
+    # Bodies of the last run are underlayer rocks, then the units in deposition order.
+    first_unit = len(underlayer.positions)
+    unit_bodies = np.empty(n_units, dtype=np.int64)
+    unit_bodies[np.asarray(placed)] = np.arange(first_unit, first_unit + n_units)
+    summary = placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies)
+    summary["deposition"] = deposition
+    summary["run"] = _combined_runs(results)
+    return PlacementResult(simulation=sim, unit_bodies=unit_bodies,
+                           grid_lines=None if grid_lines is None else np.asarray(grid_lines),
+                           summary=summary)
+
+
+class _UnitState:
+    """Poses and velocities of every unit between deposition stages; a unit deposited already
+    carries the solver's principal-frame orientation, a new one its orientation as built."""
+
+    def __init__(self, positions, orientations, velocities):
+        self.positions = positions
+        self.orientations = orientations.copy()
+        self.velocities = velocities.copy()
+        self.angular_velocities = np.zeros_like(velocities)
+        self.frames = ["shape"] * len(positions)
+
+    def update_from(self, solver, first_unit, members):
+        omegas = solver.angular_velocities
+        for body, k in enumerate(members, start=first_unit):
+            self.positions[k] = solver.positions[body]
+            self.orientations[k] = solver.quaternions[body]
+            self.velocities[k] = solver.velocities[body]
+            self.angular_velocities[k] = omegas[body]
+            self.frames[k] = "principal"
+
+
+def _deposition_groups(slope, positions, nominal_diameter, deposition, rows) -> list[np.ndarray]:
+    """Unit indices of each deposition stage, lowest row first."""
+    n = len(positions)
+    if deposition == "all_at_once":
+        return [np.arange(n)]
+    if deposition != "row_by_row":
+        raise CaseFileError(f"deposition = {deposition!r}: expected 'all_at_once' or 'row_by_row'")
+    if rows is None:
+        s = slope.to_slope(positions)[:, 0]
+        order = np.argsort(s, kind="stable")
+        rows = np.empty(n, dtype=np.int64)
+        current = 0
+        for rank, k in enumerate(order):
+            if rank > 0 and s[k] - s[order[rank - 1]] > 0.5 * nominal_diameter:
+                current += 1
+            rows[k] = current
+    rows = np.asarray(rows)
+    return [np.flatnonzero(rows == r) for r in np.unique(rows)]
+
+
+def _start_without_overlaps(slope, unit, unit_shape, underlayer, state, members, new, materials,
+                            run, lift_overlapping, grid_lines) -> Simulation:
+    """The stage's simulation, with the new units lifted clear (or refused) if they overlap."""
     for _ in range(_MAX_LIFTS + 1):
-        sim = _placement_simulation(slope, unit_shape, underlayer, positions, orientations,
-                                    velocities, materials, run)
-        overlapping = _overlapping_units(sim, len(underlayer.positions), n_units)
+        sim = _placement_simulation(slope, unit_shape, underlayer, state, members, materials, run)
+        overlapping = [(members[k], what) for k, what in
+                       _overlapping_units(sim, len(underlayer.positions), len(members))
+                       if members[k] in new]
         if not overlapping:
-            break
+            return sim
         if not lift_overlapping:
             lines = [f"  unit {k}" + (f" (grid line {grid_lines[k]})" if grid_lines is not None else "")
                      + f" overlaps {what}" for k, what in overlapping[:20]]
             raise OverlapError(f"{len(overlapping)} unit(s) start overlapping:\n" + "\n".join(lines)
                                + "\nMove them apart or higher in the grid.")
         for k in sorted({k for k, _ in overlapping}):
-            positions[k, 2] += _LIFT_STEP * unit.height
-    else:
-        raise OverlapError(f"units still overlap after lifting them {_MAX_LIFTS} times by "
-                           f"{_LIFT_STEP:g} unit heights: the grid is too dense for this unit")
-    result = sim.run()
-    first_unit = len(underlayer.positions)
-    unit_bodies = np.arange(first_unit, first_unit + n_units)
-    summary = placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies)
-    summary["run"] = result.as_dict()
-    return PlacementResult(simulation=sim, unit_bodies=unit_bodies,
-                           grid_lines=None if grid_lines is None else np.asarray(grid_lines),
-                           summary=summary)
+            state.positions[k, 2] += _LIFT_STEP * unit.height
+    raise OverlapError(f"units still overlap after lifting them {_MAX_LIFTS} times by "
+                       f"{_LIFT_STEP:g} unit heights: the grid is too dense for this unit")
 
 
-def _placement_simulation(slope, unit_shape, underlayer, positions, orientations, velocities,
-                          materials, run) -> Simulation:
+def _combined_runs(results: list[dict]) -> dict:
+    """One run record for all stages: times and steps added, the last stage's end state."""
+    combined = dict(results[-1])
+    for key in ("steps", "wall_time", "simulated_time"):
+        combined[key] = sum(r[key] for r in results)
+    combined["body_steps_per_second"] = (sum(r["body_steps_per_second"] * r["wall_time"] for r in results)
+                                         / max(combined["wall_time"], 1e-9))
+    combined["stages"] = len(results)
+    return combined
+
+
+def _placement_simulation(slope, unit_shape, underlayer, state, members, materials,
+                          run) -> Simulation:
     sim = Simulation(**_run_settings(run))
     for m in materials.all():
         sim.add_material(m)
@@ -232,11 +314,13 @@ def _placement_simulation(slope, unit_shape, underlayer, positions, orientations
         sim.add_body(shape=underlayer.shapes[underlayer.shape_of_rock[k]].name,
                      material=materials.rock.name, position=underlayer.positions[k],
                      orientation=underlayer.quaternions[k], fixed=True, frame="principal")
-    for k in range(len(positions)):
-        # The unit's mesh as built is given to RigidShape.from_mesh, which moved it to its
-        # principal frame: orientations apply to the mesh as built, hence frame="shape".
-        sim.add_body(shape=unit_shape.name, material=materials.unit.name, position=positions[k],
-                     orientation=orientations[k], velocity=velocities[k], frame="shape")
+    for k in members:
+        # New units: orientations apply to the unit's mesh as built (frame "shape"); units carried
+        # over from an earlier stage have the solver's principal-frame orientation.
+        sim.add_body(shape=unit_shape.name, material=materials.unit.name,
+                     position=state.positions[k], orientation=state.orientations[k],
+                     velocity=state.velocities[k], angular_velocity=state.angular_velocities[k],
+                     frame=state.frames[k])
     return sim
 
 
