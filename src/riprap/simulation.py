@@ -31,6 +31,16 @@ _RUNAWAY_SPEED = 1.0e3
 _MAX_STABILITY_RATIO = 0.5
 # A body rests when its net force is below this fraction of its weight (and it is slow).
 _REST_FORCE_RATIO = 0.1
+# Adaptive time step (``adaptive_time_step``): grow by _STEP_GROWTH while the measured stability
+# ratio stays below _GROW_BELOW_RATIO, cut by _STEP_CUT (from the last good state) when a chunk
+# goes above _MAX_STABILITY_RATIO or blows up; never above _MAX_STEP_OVER_ESTIMATE times the
+# automatic estimate nor below _MIN_STEP_OVER_ESTIMATE times it.
+_GROW_BELOW_RATIO = 0.2
+_STEP_GROWTH = 1.25
+_STEP_CUT = 0.5
+_MAX_STEP_OVER_ESTIMATE = 30.0
+_MIN_STEP_OVER_ESTIMATE = 1e-3
+_MAX_MOTION_PER_STEP = 0.1
 # Wall-clock seconds between progress updates (and rest checks).
 _PROGRESS_PERIOD = 0.25
 
@@ -51,6 +61,9 @@ class RunSummary:
     max_speed: float
     frames: int
     stability_ratio_max: float = 0.0
+    time_step_min: float = 0.0
+    time_step_max: float = 0.0
+    time_step_cuts: int = 0
     outputs: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
@@ -81,6 +94,11 @@ class Simulation:
         rotational speed at its bounding radius).
     rest_kinetic_energy : float
         If > 0, resting also needs the total kinetic energy of the free bodies below this (J).
+    adaptive_time_step : bool
+        Let the time step follow the contacts actually present: grow it while their measured
+        stability ratio dt / (2 sqrt(m/k)) stays below 0.2, halve it and repeat the chunk from the
+        last good state when it passes 0.5 or the state blows up. For settling and packing runs;
+        physics runs keep a fixed step (and a failure stops them).
     output_directory : str or Path
     paraview, picture : bool
         Write a ``.pvd`` series / a PNG of the final state.
@@ -92,7 +110,8 @@ class Simulation:
                  gravity=(0.0, 0.0, -9.81), output_interval: float = 0.05,
                  checkpoint_interval: float = 0.0, local_damping: float = 0.0,
                  rest_speed: float = 0.0, output_directory="riprap-out", paraview: bool = True,
-                 picture: bool = True, progress: bool = True, rest_kinetic_energy: float = 0.0):
+                 picture: bool = True, progress: bool = True, rest_kinetic_energy: float = 0.0,
+                 adaptive_time_step: bool = False):
         _require(end_time > 0, "end_time", end_time, "> 0 s")
         _require(time_step >= 0, "time_step", time_step, ">= 0 s (0 = automatic)")
         _require(0 < time_step_safety <= 1, "time_step_safety", time_step_safety, "in (0, 1]")
@@ -101,6 +120,8 @@ class Simulation:
         _require(rest_speed >= 0, "rest_speed", rest_speed, ">= 0 m/s")
         _require(rest_kinetic_energy >= 0, "rest_kinetic_energy", rest_kinetic_energy, ">= 0 J")
         self.rest_kinetic_energy = float(rest_kinetic_energy)
+        self.adaptive_time_step = bool(adaptive_time_step)
+        self._last_stability_ratio = 0.0
         self.end_time = float(end_time)
         self.requested_time_step = float(time_step)
         self.time_step_safety = float(time_step_safety)
@@ -195,17 +216,18 @@ class Simulation:
             contact_series = vtk.ParaViewSeries(out, "contacts", append=self._restarted)
             if not self._restarted:
                 self._write_frame(series, contact_series)
-        dt = solver.time_step
-        total_steps = int(round(self.end_time / dt))
+        estimate = solver.time_step
+        smallest_step = largest_step = solver.time_step
+        cuts = 0
         start_wall = wallclock.perf_counter()
         start_steps = solver.step_count
         end_reason = "end_time"
         good = solver.state_arrays()
         chunk = 10
         with _Progress(self.progress, self.end_time) as progress:
-            while solver.step_count < total_steps:
+            while solver.step_count < self._steps_at(self.end_time):
                 next_frame = self._steps_at(self._frame_index * self.output_interval)
-                targets = [total_steps, next_frame]
+                targets = [self._steps_at(self.end_time), next_frame]
                 if self.checkpoint_interval > 0:
                     targets.append(self._steps_at(self._checkpoint_index * self.checkpoint_interval))
                 target = min(t for t in targets if t > solver.step_count)
@@ -216,6 +238,15 @@ class Simulation:
                     self._check_runaway()
                     self._check_contact_stability()
                 except InstabilityError as error:
+                    if self.adaptive_time_step and (solver.time_step * _STEP_CUT
+                                                    >= _MIN_STEP_OVER_ESTIMATE * estimate):
+                        cut = solver.time_step * _STEP_CUT
+                        solver.load_state_arrays(good)
+                        solver.set_time_step(cut)
+                        smallest_step = min(smallest_step, cut)
+                        cuts += 1
+                        chunk = max(1, chunk // 2)
+                        continue
                     path = self._write_checkpoint(checkpoint_io, good, "failure_checkpoint.npz")
                     raise InstabilityError(f"{error}\nThe last good state (t = {good['clock'][0]:.6g} s) "
                                            f"was written to {path}; restart from it with a smaller "
@@ -235,7 +266,13 @@ class Simulation:
                 if self.rest_speed > 0 and self.at_rest():
                     end_reason = "at_rest"
                     break
+                if (self.adaptive_time_step and self._last_stability_ratio < _GROW_BELOW_RATIO
+                        and solver.time_step * _STEP_GROWTH <= _MAX_STEP_OVER_ESTIMATE * estimate
+                        and self._step_keeps_motion_small(solver.time_step * _STEP_GROWTH)):
+                    solver.set_time_step(solver.time_step * _STEP_GROWTH)
+                    largest_step = max(largest_step, solver.time_step)
         wall = wallclock.perf_counter() - start_wall
+        dt = solver.time_step
         if series is not None and series.frames and series.frames[-1][0] < solver.time - 0.5 * dt:
             self._write_frame(series, contact_series)
         outputs = {"checkpoint": str(self._write_checkpoint(checkpoint_io, solver.state_arrays(),
@@ -253,13 +290,24 @@ class Simulation:
                              kinetic_energy=solver.kinetic_energy(), max_speed=self.max_speed(),
                              frames=self._frame_index,
                              stability_ratio_max=getattr(self, "_max_stability_ratio", 0.0),
-                             outputs=outputs)
+                             time_step_min=smallest_step, time_step_max=largest_step,
+                             time_step_cuts=cuts, outputs=outputs)
         from riprap.io.summary import write_json
         write_json(out / "summary.json", summary.as_dict())
         return summary
 
+    def _step_keeps_motion_small(self, time_step: float) -> bool:
+        """No body moves more than _MAX_MOTION_PER_STEP of the smallest boundary sub-tet height in
+        one step, so that a contact cannot go from nothing to a deep overlap in one step."""
+        smallest = min(shape.min_subtet_height for shape in self.solver.shapes)
+        return self.max_speed() * time_step <= _MAX_MOTION_PER_STEP * smallest
+
     def _steps_at(self, time: float) -> int:
-        return int(math.ceil(time / self.solver.time_step - 1e-9))
+        """The step count at which the clock reaches ``time`` (at the current time step)."""
+        s = self.solver
+        if s._time_origin is None:
+            return int(math.ceil(time / s.time_step - 1e-9))
+        return s._step_origin + int(math.ceil((time - s._time_origin) / s.time_step - 1e-9))
 
     def _check_runaway(self) -> None:
         speeds = np.linalg.norm(self.solver.velocities, axis=1)
@@ -303,6 +351,7 @@ class Simulation:
 
     def _check_contact_stability(self) -> None:
         ratio = self.stability_ratio()
+        self._last_stability_ratio = ratio
         self._max_stability_ratio = max(getattr(self, "_max_stability_ratio", 0.0), ratio)
         if ratio > _MAX_STABILITY_RATIO:
             raise InstabilityError(

@@ -85,7 +85,7 @@ class PlacementResult:
 def _run_settings(kwargs: dict) -> dict:
     keys = ("end_time", "time_step", "time_step_safety", "output_interval", "checkpoint_interval",
             "local_damping", "rest_speed", "rest_kinetic_energy", "output_directory", "paraview",
-            "picture", "progress", "gravity")
+            "picture", "progress", "gravity", "adaptive_time_step")
     return {k: v for k, v in kwargs.items() if k in keys}
 
 

@@ -262,6 +262,14 @@ class SolidSolver:
         if status == stepper.STATUS_NOT_FINITE:
             self.check_finite()
 
+    def set_time_step(self, time_step: float) -> None:
+        """Use ``time_step`` from now on; the clock keeps counting from its current value."""
+        if time_step == self.time_step:
+            return
+        self._time_origin = self.time
+        self._step_origin = self.step_count
+        self.time_step = float(time_step)
+
     def step(self) -> None:
         """Advance by one time step."""
         self.advance(1)
@@ -346,7 +354,11 @@ class SolidSolver:
     def state_arrays(self) -> dict[str, np.ndarray]:
         self.finalize()
         arrays = {name: getattr(self, name).copy() for name in self.STATE_ARRAYS}
-        arrays["clock"] = np.array([self.time, float(self.step_count), self.time_step])
+        # time, steps, time step, and the clock's anchor (time and step count of the last time
+        # step change; NaN when time = steps x time step), so a restart counts time identically.
+        origin = np.nan if self._time_origin is None else self._time_origin
+        arrays["clock"] = np.array([self.time, float(self.step_count), self.time_step, origin,
+                                    float(self._step_origin)])
         return arrays
 
     def load_state_arrays(self, arrays: dict[str, np.ndarray]) -> None:
@@ -361,8 +373,13 @@ class SolidSolver:
         self.time = float(arrays["clock"][0])
         self.step_count = int(arrays["clock"][1])
         self.time_step = float(arrays["clock"][2])
-        self._time_origin = None if self.time == self.step_count * self.time_step else self.time
-        self._step_origin = self.step_count
+        clock = np.asarray(arrays["clock"])
+        if len(clock) >= 5:
+            self._time_origin = None if np.isnan(clock[3]) else float(clock[3])
+            self._step_origin = int(clock[4])
+        else:
+            self._time_origin = None if self.time == self.step_count * self.time_step else self.time
+            self._step_origin = self.step_count
         self._omegas = integrate.angular_velocities(self.quaternions, self.angular_momenta,
                                                     self.inverse_principal_inertia)
         self._piece_cache = interactions.empty_piece_cache()
