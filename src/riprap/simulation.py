@@ -199,8 +199,13 @@ class Simulation:
             solver.time_step = solver.stable_time_step(self.time_step_safety)
         solver.finalize()
 
-    def run(self, *, restart_from=None) -> RunSummary:
-        """Run to ``end_time`` (or rest); write frames, checkpoints, picture and summary."""
+    def run(self, *, restart_from=None, after_chunk=None) -> RunSummary:
+        """Run to ``end_time`` (or rest); write frames, checkpoints, picture and summary.
+
+        ``after_chunk(simulation)``, if given, is called after every chunk of steps (a few per
+        second of wall time) and may change the state (e.g. fix bodies); the run stops with
+        end reason "done" when it returns True.
+        """
         from riprap.io import checkpoint as checkpoint_io
         from riprap.io import vtk
 
@@ -263,6 +268,10 @@ class Simulation:
                     self._checkpoint_index += 1
                     self._write_checkpoint(checkpoint_io, good, "checkpoint.npz")
                 progress.update(solver, start_wall, start_steps)
+                if after_chunk is not None and after_chunk(self):
+                    end_reason = "done"
+                    break
+                good = solver.state_arrays()
                 if self.rest_speed > 0 and self.at_rest():
                     end_reason = "at_rest"
                     break
@@ -420,6 +429,8 @@ class Simulation:
         s = self.solver
         points, triangles, owners = self.surface_arrays()
         free = ~s.fixed[owners]
+        if not free.any():       # everything held (a finished underlayer): show it all
+            free[:] = True
         box = None
         if self.container_box is not None:
             # Show the container only up to a little above the bodies, not its full height.

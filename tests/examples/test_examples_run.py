@@ -52,3 +52,23 @@ def test_check_command_reports_errors(tmp_path, capsys):
     assert main(["check", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "bad.toml:3" in err and "end_tme" in err
+
+
+PLACEMENT_KEYS = ("units_placed", "units_at_rest", "packing_density_coefficient",
+                  "design_packing_density_coefficient", "porosity", "layer_thickness_m",
+                  "max_overlap_over_dn")
+
+
+def test_small_placement_example_runs(tmp_path):
+    """`riprap place` on examples/coreloc_small.toml (smoke mode: 0.01 s per deposition run)
+    writes the pack, the deposition series, the picture and the summary keys the issue names."""
+    case = EXAMPLES / "coreloc_small.toml"
+    assert "riprap place examples/coreloc_small.toml" in case.read_text()
+    out = tmp_path / "coreloc_small"
+    assert main(["place", str(case), "--out", str(out), "--quiet"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    for key in PLACEMENT_KEYS:
+        assert key in summary, key
+    assert summary["units_placed"] == 25
+    assert (out / "pack.toml").is_file() and (out / "deposition" / "bodies.pvd").is_file()
+    assert main(["check", str(out / "pack.toml")]) == 0

@@ -3,7 +3,9 @@
 Two stages, each one rigid FEMDEM run (:class:`riprap.simulation.Simulation`):
 
 1. :func:`build_underlayer`: graded rocks start on a loose lattice above the face (no two bounding
-   spheres touch), fall onto it and settle with a settling damping; they are then held fixed.
+   spheres touch) and fall onto it; each rock is held fixed where it first touches the face or a
+   rock already held (a compacted bed: loose rocks on a face near their angle of repose would roll
+   down to the toe instead).
 2. :func:`place_units`: units start at the grid's centroids (a user file or a design grid) with
    user, random (uniform on rotations) or limited random orientations and an optional initial
    velocity, fall onto the fixed underlayer and run until every unit rests (``rest_speed`` and
@@ -31,6 +33,9 @@ _ROCK_LATTICE_GAP = 0.05
 # A unit is lifted by this fraction of its height at a time while it overlaps something.
 _LIFT_STEP = 0.25
 _MAX_LIFTS = 40
+# Generated units reaching through a side wall are moved inside, this fraction of their width
+# clear of it.
+_SIDE_WALL_GAP = 0.01
 # Overlap tolerance at the start, as a fraction of the smallest boundary sub-tet height.
 _START_OVERLAP_FRACTION = 0.01
 
@@ -132,7 +137,7 @@ def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range, la
         x, y, z, w = orientations[k]
         sim.add_body(shape=shapes[choice[k]].name, material=materials.rock.name, position=world[k],
                      orientation=(w, x, y, z))
-    summary = sim.run()
+    summary = sim.run(after_chunk=_stick_to_face)
     solver = sim.solver
     underlayer = Underlayer(shapes=shapes, shape_of_rock=choice.astype(np.int64),
                             positions=solver.positions.copy(), quaternions=solver.quaternions.copy(),
@@ -140,6 +145,27 @@ def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range, la
                             top_level=0.0, summary=summary.as_dict())
     underlayer.top_level = layer_metrics.underlayer_top(slope, underlayer.node_sets())
     return underlayer
+
+
+def _stick_to_face(sim: Simulation) -> bool:
+    """Hold every rock that touches the face, the bed or a rock already held: the underlayer is
+    built like a compacted bed, each rock staying where it first lands (loose rocks on a face
+    near the angle of repose would otherwise roll to the toe). True once every rock is held."""
+    solver = sim.solver
+    contacts = solver.contacts
+    while True:
+        fixed = solver.fixed
+        body_i, body_j = contacts.body_i, contacts.body_j
+        # Walls 0 and 1 are the bed and the face (Slope.walls order).
+        on_ground = (body_j == -1) | (body_j == -2)
+        j_fixed = np.where(body_j >= 0, fixed[np.maximum(body_j, 0)], False)
+        i_fixed = fixed[body_i]
+        landing = set(body_i[(on_ground | j_fixed) & ~i_fixed].tolist())
+        landing |= set(body_j[(body_j >= 0) & i_fixed & ~j_fixed].tolist())
+        if not landing:
+            break
+        solver.fix_bodies(sorted(landing))
+    return bool(solver.fixed.all())
 
 
 def unit_orientations(count: int, *, mode: str, slope, seed: int = 0, max_tilt_deg: float = 180.0,
@@ -273,20 +299,31 @@ def _start_without_overlaps(slope, unit, unit_shape, underlayer, state, members,
     """The stage's simulation, with the new units lifted clear (or refused) if they overlap."""
     for _ in range(_MAX_LIFTS + 1):
         sim = _placement_simulation(slope, unit_shape, underlayer, state, members, materials, run)
-        overlapping = [(members[k], what) for k, what in
+        overlapping = [(members[k], None if other is None else members[other], what)
+                       for k, other, what in
                        _overlapping_units(sim, len(underlayer.positions), len(members))
                        if members[k] in new]
         if not overlapping:
             return sim
         if not lift_overlapping:
             lines = [f"  unit {k}" + (f" (grid line {grid_lines[k]})" if grid_lines is not None else "")
-                     + f" overlaps {what}" for k, what in overlapping[:20]]
+                     + f" overlaps {what}" for k, _, what in overlapping[:20]]
             raise OverlapError(f"{len(overlapping)} unit(s) start overlapping:\n" + "\n".join(lines)
                                + "\nMove them apart or higher in the grid.")
-        for k in sorted({k for k, _ in overlapping}):
-            state.positions[k, 2] += _LIFT_STEP * unit.height
+        # Lift a unit unless what it overlaps is lifted too (then they would move together);
+        # lowest units first, so a chain of overlaps is undone from its bottom.
+        lifted: set[int] = set()
+        for k, other, _ in sorted(overlapping, key=lambda item: item[0]):
+            if k in lifted or (other is not None and other in lifted):
+                continue
+            lifted.add(k)
+            # Along the face normal: a vertical lift would also move the unit up the face, into
+            # the next row.
+            state.positions[k] += _LIFT_STEP * unit.height * slope.normal
+    listing = "; ".join(f"unit {k} overlaps {what}" for k, _, what in overlapping[:5])
     raise OverlapError(f"units still overlap after lifting them {_MAX_LIFTS} times by "
-                       f"{_LIFT_STEP:g} unit heights: the grid is too dense for this unit")
+                       f"{_LIFT_STEP:g} unit heights ({listing}): the grid is too dense for this "
+                       "unit, or a unit reaches through a wall")
 
 
 def _combined_runs(results: list[dict]) -> dict:
@@ -324,8 +361,10 @@ def _placement_simulation(slope, unit_shape, underlayer, state, members, materia
     return sim
 
 
-def _overlapping_units(sim: Simulation, first_unit: int, n_units: int) -> list[tuple[int, str]]:
-    """(unit number, what it overlaps) for every unit that starts overlapping something."""
+def _overlapping_units(sim: Simulation, first_unit: int,
+                       n_units: int) -> list[tuple[int, int | None, str]]:
+    """(unit, the other unit or None, what it overlaps) for every unit that starts overlapping
+    something; of two overlapping units the later one is listed."""
     sim.build_without_checks()
     solver = sim.solver
     tolerance = _START_OVERLAP_FRACTION * min(s.min_subtet_height for s in solver.shapes)
@@ -339,7 +378,8 @@ def _overlapping_units(sim: Simulation, first_unit: int, n_units: int) -> list[t
                     what = f"underlayer rock {b}"
                 else:
                     what = f"unit {b - first_unit}"
-                found.append((a - first_unit, f"{what} (depth {depth:.2e} m)"))
+                other = b - first_unit if b >= first_unit else None
+                found.append((a - first_unit, other, f"{what} (depth {depth:.2e} m)"))
                 break
     return found
 
@@ -355,13 +395,14 @@ def _shift_between_side_walls(slope, unit_shape, positions, orientations) -> Non
     """Move generated units that reach through a side wall back inside (in place)."""
     for k in range(len(positions)):
         y = slope.to_slope(_world_nodes(unit_shape, positions[k], orientations[k]))[:, 1]
-        if y.max() - y.min() > slope.width:
+        if (1.0 + 2.0 * _SIDE_WALL_GAP) * (y.max() - y.min()) > slope.width:
             raise CaseFileError(f"unit {k} is {y.max() - y.min():.3f} m wide across the flume, more "
                                 f"than its width {slope.width:g} m")
-        if y.min() < 0.0:
-            positions[k, 1] -= y.min()
-        elif y.max() > slope.width:
-            positions[k, 1] -= y.max() - slope.width
+        gap = _SIDE_WALL_GAP * (y.max() - y.min())
+        if y.min() < gap:
+            positions[k, 1] += gap - y.min()
+        elif y.max() > slope.width - gap:
+            positions[k, 1] -= y.max() - (slope.width - gap)
 
 
 def _check_inside(slope, unit_shape, positions, orientations, grid_lines) -> None:

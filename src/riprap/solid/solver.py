@@ -262,6 +262,17 @@ class SolidSolver:
         if status == stepper.STATUS_NOT_FINITE:
             self.check_finite()
 
+    def fix_bodies(self, bodies) -> None:
+        """Hold these bodies fixed from now on, where they are (their velocities are zeroed)."""
+        self.finalize()
+        bodies = np.asarray(bodies, dtype=np.int64)
+        self.fixed[bodies] = True
+        self.inverse_masses[bodies] = 0.0
+        self.inverse_principal_inertia[bodies] = 0.0
+        self.velocities[bodies] = 0.0
+        self.angular_momenta[bodies] = 0.0
+        self._omegas[bodies] = 0.0
+
     def set_time_step(self, time_step: float) -> None:
         """Use ``time_step`` from now on; the clock keeps counting from its current value."""
         if time_step == self.time_step:
