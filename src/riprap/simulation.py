@@ -41,6 +41,7 @@ _STEP_CUT = 0.5
 _MAX_STEP_OVER_ESTIMATE = 30.0
 _MIN_STEP_OVER_ESTIMATE = 1e-3
 _MAX_MOTION_PER_STEP = 0.1
+_ADAPT_CHUNK_STEPS = 50
 # Wall-clock seconds between progress updates (and rest checks).
 _PROGRESS_PERIOD = 0.25
 
@@ -250,14 +251,18 @@ class Simulation:
                         solver.set_time_step(cut)
                         smallest_step = min(smallest_step, cut)
                         cuts += 1
-                        chunk = max(1, chunk // 2)
                         continue
                     path = self._write_checkpoint(checkpoint_io, good, "failure_checkpoint.npz")
                     raise InstabilityError(f"{error}\nThe last good state (t = {good['clock'][0]:.6g} s) "
                                            f"was written to {path}; restart from it with a smaller "
                                            "time step.") from None
                 elapsed = wallclock.perf_counter() - tick
-                chunk = max(1, min(100000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
+                if self.adaptive_time_step:
+                    # Time step decisions at fixed step counts, not wall-clock ones, so that a
+                    # run is reproducible.
+                    chunk = _ADAPT_CHUNK_STEPS
+                else:
+                    chunk = max(1, min(100000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
                 good = solver.state_arrays()
                 if solver.step_count >= next_frame and series is not None:
                     self._write_frame(series, contact_series)

@@ -58,7 +58,9 @@ def _settings(case, end_time, output_directory, progress) -> dict:
                 rest_speed=case.placement.rest_speed,
                 rest_kinetic_energy=case.placement.rest_kinetic_energy,
                 output_directory=output_directory, paraview=case.output.paraview,
-                picture=case.output.picture, progress=progress)
+                picture=case.output.picture, progress=progress,
+                # Settling runs: the time step follows the contacts present (see Simulation).
+                adaptive_time_step=True)
 
 
 def run_placement(case, *, output_directory=None, progress: bool = True) -> dict:
@@ -72,7 +74,7 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
     out.mkdir(parents=True, exist_ok=True)
     sl, ul, pl = case.slope, case.underlayer, case.placement
     slope = Slope(cotangent=sl.cotangent, width=sl.width, length=sl.length, toe_x=sl.toe_x,
-                  toe_level=sl.toe_level)
+                  toe_level=sl.toe_level, toe_stop_distance=sl.toe_stop_distance)
     materials = PlacementMaterials(unit=_material(case, case.armour.material),
                                    rock=_material(case, ul.material),
                                    face=_material(case, sl.face_material),

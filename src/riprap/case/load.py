@@ -140,6 +140,7 @@ class SlopeSpec:
     length: float
     toe_x: float = _default("slope", "toe_x")
     toe_level: float = _default("slope", "toe_level")
+    toe_stop_distance: float = _default("slope", "toe_stop_distance")
     face_material: str
     side_wall_material: str
 

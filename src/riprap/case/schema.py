@@ -383,6 +383,10 @@ KEYS: tuple[Key, ...] = (
     Key("slope", "toe_x", "number", "m", "Horizontal position of the toe line.", default=0.0),
     Key("slope", "toe_level", "number", "m", "Level of the toe line and of the bed in front of it.",
         default=0.0),
+    Key("slope", "toe_stop_distance", "number", "m",
+        "Distance in front of the toe line of a vertical toe stop (the toe structure holding the "
+        "lowest row); 0: no stop, units may slide off onto the bed.", default=0.0,
+        valid_range=_NON_NEGATIVE),
     Key("slope", "face_material", "string", "-",
         "Material of the face and the bed (the core's surface).", references="materials"),
     Key("slope", "side_wall_material", "string", "-", "Material of the flume's side walls.",

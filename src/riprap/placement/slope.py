@@ -39,6 +39,9 @@ class Slope:
         Length of the face from toe to crest, measured along the face (m).
     toe_x, toe_level : float
         Horizontal position and level of the toe line (m).
+    toe_stop_distance : float
+        If > 0, a vertical wall this far in front of the toe line (m) stands for the toe structure
+        (toe berm) that holds the lowest row of a real armour layer; 0: the bed is open.
     """
 
     cotangent: float
@@ -46,12 +49,15 @@ class Slope:
     length: float
     toe_x: float = 0.0
     toe_level: float = 0.0
+    toe_stop_distance: float = 0.0
 
     def __post_init__(self):
         for name in ("cotangent", "width", "length"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise CaseFileError(f"slope: {name} = {value!r} must be a positive number")
+        if not (np.isfinite(self.toe_stop_distance) and self.toe_stop_distance >= 0):
+            raise CaseFileError(f"slope: toe_stop_distance = {self.toe_stop_distance!r} must be >= 0 m")
         if self.cotangent < 0.5:
             raise CaseFileError(f"slope: cotangent = {self.cotangent!r} is steeper than 1:0.5 "
                                 "(63 degrees); no armour layer stands on that")
@@ -98,12 +104,18 @@ class Slope:
         return np.stack([d @ self.tangent, d[..., 1], d @ self.normal], axis=-1)
 
     def walls(self, *, face_material: str, side_material: str) -> list[Wall]:
-        """Bed, slope face and the two side walls, as half-space walls."""
-        return (walls.plane(point=self.toe, normal=(0.0, 0.0, 1.0), material=face_material)
-                + walls.plane(point=self.toe, normal=self.normal, material=face_material)
-                + walls.plane(point=(0.0, 0.0, 0.0), normal=(0.0, 1.0, 0.0), material=side_material)
-                + walls.plane(point=(0.0, self.width, 0.0), normal=(0.0, -1.0, 0.0),
-                              material=side_material))
+        """Bed, slope face, the two side walls and the toe stop if any, as half-space walls
+        (in that order: walls 0 and 1 are the ground the underlayer rests on)."""
+        planes = (walls.plane(point=self.toe, normal=(0.0, 0.0, 1.0), material=face_material)
+                  + walls.plane(point=self.toe, normal=self.normal, material=face_material)
+                  + walls.plane(point=(0.0, 0.0, 0.0), normal=(0.0, 1.0, 0.0),
+                                material=side_material)
+                  + walls.plane(point=(0.0, self.width, 0.0), normal=(0.0, -1.0, 0.0),
+                                material=side_material))
+        if self.toe_stop_distance > 0:
+            planes += walls.plane(point=(self.toe_x - self.toe_stop_distance, 0.0, 0.0),
+                                  normal=(1.0, 0.0, 0.0), material=face_material)
+        return planes
 
     def slope_area(self, s_low: float, s_high: float) -> float:
         """Area of the face between two slope positions (m^2)."""
