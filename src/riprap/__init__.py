@@ -9,10 +9,12 @@ The public API, one namespace::
 """
 __version__ = "0.1.0"
 
-from riprap import errors
+from riprap import errors, placement
 from riprap.case.build import build_simulation
 from riprap.case.load import load_case, parse_case
 from riprap.geometry import shapes
+from riprap.geometry.armour_units import ArmourUnit, armour_unit
+from riprap.geometry.rock_grading import RockGrading, rock_library
 from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.tetmesh import TetMesh
 from riprap.simulation import RunSummary, Simulation
@@ -22,6 +24,7 @@ from riprap.solid.shape import RigidShape
 from riprap.solid.solver import ContactRecords, SolidSolver
 
 __all__ = [
-    "ContactRecords", "Material", "RigidShape", "RunSummary", "Simulation", "SolidSolver", "TetMesh",
-    "build_simulation", "errors", "load_case", "mass_properties", "parse_case", "shapes", "walls",
+    "ArmourUnit", "ContactRecords", "Material", "RigidShape", "RockGrading", "RunSummary",
+    "Simulation", "SolidSolver", "TetMesh", "armour_unit", "build_simulation", "errors",
+    "load_case", "mass_properties", "parse_case", "placement", "rock_library", "shapes", "walls",
 ]

@@ -47,6 +47,7 @@ def test_design_grid_has_the_target_packing_density():
     # Units per area of the grid = 1 / (dx dy) = phi / Dn^2.
     assert dn ** 2 / (grid.horizontal_spacing * grid.upslope_spacing) == pytest.approx(0.62)
     assert np.allclose(grid.slope_coordinates[:, 2], 2.0)
+    assert np.allclose(grid.positions[:, 0], slope.to_world(grid.slope_coordinates[:, 0] - 2.0 * np.tan(slope.angle), 0, 0)[:, 0])
     assert grid.slope_coordinates[:, 1].min() == pytest.approx(0.5)
     assert grid.slope_coordinates[:, 1].max() == pytest.approx(11.5)
 

@@ -31,7 +31,8 @@ class DesignGrid:
 def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12, 11),
                 packing_density_coefficient: float, first_row_s: float,
                 start_height: float) -> DesignGrid:
-    """Staggered rows of unit centroids on ``slope`` at ``start_height`` above the face (m)."""
+    """Staggered rows of unit centroids straight above their design points on ``slope``,
+    ``start_height`` (m) clear of the face along its normal."""
     counts = tuple(int(n) for n in np.atleast_1d(units_per_row))
     if rows < 1:
         raise CaseFileError(f"design grid: rows = {rows} must be >= 1")
@@ -59,7 +60,11 @@ def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12,
             f"s = {s.max():.3f} m along the face, beyond its length {slope.length:g} m; "
             "use fewer rows, a longer slope or a lower first row")
     y = np.array(y_list)
-    h = np.full(len(s), float(start_height))
-    return DesignGrid(positions=slope.to_world(s, y, h), rows=np.array(row_list, dtype=np.int64),
-                      slope_coordinates=np.stack([s, y, h], axis=1), horizontal_spacing=dx,
+    # Each unit starts straight above its design point on the face, start_height clear of the face
+    # along its normal, so that it falls onto that point (a start offset along the normal would
+    # move the lower rows out over the toe).
+    above = slope.to_world(s, y, np.zeros(len(s)))
+    above[:, 2] += float(start_height) / np.cos(slope.angle)
+    return DesignGrid(positions=above, rows=np.array(row_list, dtype=np.int64),
+                      slope_coordinates=slope.to_slope(above), horizontal_spacing=dx,
                       upslope_spacing=dy)

@@ -317,9 +317,13 @@ def _start_without_overlaps(slope, unit, unit_shape, underlayer, state, members,
             if k in lifted or (other is not None and other in lifted):
                 continue
             lifted.add(k)
-            # Along the face normal: a vertical lift would also move the unit up the face, into
-            # the next row.
-            state.positions[k] += _LIFT_STEP * unit.height * slope.normal
+            if other is None:
+                # Off a rock or a wall (the toe stop, the face): straight up.
+                state.positions[k, 2] += _LIFT_STEP * unit.height
+            else:
+                # Off another unit: along the face normal, as a vertical lift would also move
+                # the unit up the face, into the next row.
+                state.positions[k] += _LIFT_STEP * unit.height * slope.normal
     listing = "; ".join(f"unit {k} overlaps {what}" for k, _, what in overlapping[:5])
     raise OverlapError(f"units still overlap after lifting them {_MAX_LIFTS} times by "
                        f"{_LIFT_STEP:g} unit heights ({listing}): the grid is too dense for this "
