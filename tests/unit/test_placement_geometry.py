@@ -78,3 +78,31 @@ def test_layer_figures_of_a_perfect_tiling_of_cubes():
     assert figures["packing_density_coefficient"] == pytest.approx(1.0, rel=1e-9)
     assert figures["layer_thickness_m"] == pytest.approx(a, rel=1e-12)
     assert figures["porosity"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_limited_random_orientations_stay_within_the_tilt_of_the_face():
+    """random_within: the unit's z axis ends within max_tilt_deg of the face normal, and the spins
+    about it are spread over all directions."""
+    from scipy.spatial.transform import Rotation
+
+    from riprap.placement import unit_orientations
+
+    slope = Slope(cotangent=1.5, width=3.0, length=6.0)
+    q = unit_orientations(400, mode="random_within", slope=slope, seed=2, max_tilt_deg=30.0)
+    rotations = Rotation.from_quat(np.concatenate([q[:, 1:], q[:, :1]], axis=1))
+    z_axes = rotations.apply([0.0, 0.0, 1.0])
+    tilt = np.degrees(np.arccos(np.clip(z_axes @ slope.normal, -1.0, 1.0)))
+    assert tilt.max() <= 30.0 + 1e-9
+    assert tilt.max() > 25.0
+    x_axes = rotations.apply([1.0, 0.0, 0.0])
+    assert abs(x_axes.mean(axis=0)).max() < 0.15      # no preferred spin
+
+
+def test_orientation_mode_errors():
+    from riprap.placement import unit_orientations
+
+    slope = Slope(cotangent=1.5, width=3.0, length=6.0)
+    with pytest.raises(CaseFileError, match="orientation = 'upright'"):
+        unit_orientations(3, mode="upright", slope=slope)
+    with pytest.raises(CaseFileError, match="needs orientations in the grid file"):
+        unit_orientations(3, mode="user", slope=slope)

@@ -188,7 +188,7 @@ def unit_orientations(count: int, *, mode: str, slope, seed: int = 0, max_tilt_d
         if not 0.0 <= max_tilt_deg <= 180.0:
             raise CaseFileError(f"max_tilt_deg = {max_tilt_deg!r} must lie in 0..180 degrees")
         to_face = Rotation.from_rotvec(np.array([0.0, -slope.angle, 0.0]))
-        spin = Rotation.from_euler("z", rng.uniform(0.0, 2.0 * np.pi, count))
+        spin = Rotation.from_euler("z", rng.uniform(0.0, 2.0 * np.pi, count)[:, None])
         azimuth = rng.uniform(0.0, 2.0 * np.pi, count)
         tilt = np.radians(max_tilt_deg) * np.sqrt(rng.uniform(0.0, 1.0, count))
         axes = np.stack([np.cos(azimuth), np.sin(azimuth), np.zeros(count)], axis=1)
