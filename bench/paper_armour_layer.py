@@ -1,5 +1,5 @@
 """The seed paper's armour layer end to end: 242 Core-Loc-like units in 21 rows on a rough
-underlayer of ~3,500 rocks (examples/coreloc_paper_242.toml), with ``riprap place``.
+underlayer of ~1,900 rocks (examples/coreloc_paper_242.toml), with ``riprap place``.
 
 Prints the wall time of the underlayer (meshing the rocks, depositing them until at rest) and of
 the armour layer (meshing the unit, lifting overlapping start positions, depositing until at rest),
