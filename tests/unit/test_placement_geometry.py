@@ -41,13 +41,18 @@ def test_design_grid_has_the_target_packing_density():
     slope = Slope(cotangent=1.33, width=12.0, length=60.0)
     dn = 1.2
     grid = design_grid(slope, nominal_diameter=dn, rows=21, units_per_row=(12, 11),
-                       packing_density_coefficient=0.62, first_row_s=1.0, start_height=2.0)
+                       packing_density_coefficient=0.62, first_row_s=1.0, centroid_height=0.8,
+                       drop_height=2.0)
     assert len(grid.positions) == 11 * 12 + 10 * 11 == 242          # the seed paper's layer
     assert grid.horizontal_spacing == pytest.approx(1.0)
-    # Units per area of the grid = 1 / (dx dy) = phi / Dn^2.
-    assert dn ** 2 / (grid.horizontal_spacing * grid.upslope_spacing) == pytest.approx(0.62)
-    assert np.allclose(grid.slope_coordinates[:, 2], 2.0)
-    assert np.allclose(grid.positions[:, 0], slope.to_world(grid.slope_coordinates[:, 0] - 2.0 * np.tan(slope.angle), 0, 0)[:, 0])
+    # Every pair of rows holds 12 + 11 units on 2 dy x width of face: phi = N Dn^2 / A.
+    assert 23 * dn ** 2 / (2 * grid.upslope_spacing * slope.width) == pytest.approx(0.62)
+    # ... and so does the whole grid, each row owning one row spacing of face.
+    assert 242 * dn ** 2 / (21 * grid.upslope_spacing * slope.width) == pytest.approx(0.62, rel=0.01)
+    assert np.allclose(grid.slope_coordinates[:, 2], 0.8)
+    # The units start straight above their design centroids.
+    design = slope.to_world(*grid.slope_coordinates.T)
+    assert np.allclose(grid.positions - design, [0.0, 0.0, 2.0])
     assert grid.slope_coordinates[:, 1].min() == pytest.approx(0.5)
     assert grid.slope_coordinates[:, 1].max() == pytest.approx(11.5)
 
@@ -56,7 +61,7 @@ def test_design_grid_longer_than_the_face_is_refused():
     slope = Slope(cotangent=1.5, width=2.0, length=3.0)
     with pytest.raises(CaseFileError, match="beyond its length"):
         design_grid(slope, nominal_diameter=1.0, rows=10, units_per_row=2,
-                    packing_density_coefficient=0.6, first_row_s=0.5, start_height=1.0)
+                    packing_density_coefficient=0.6, first_row_s=0.5, centroid_height=1.0)
 
 
 def test_layer_figures_of_a_perfect_tiling_of_cubes():
@@ -66,18 +71,41 @@ def test_layer_figures_of_a_perfect_tiling_of_cubes():
     corners = np.array([[x, y, z] for x in (-a / 2, a / 2) for y in (-a / 2, a / 2) for z in (-a / 2, a / 2)])
     s_values = np.arange(0.25, 6.0, a)
     y_values = np.arange(0.25, 4.0, a)
-    centres, node_sets = [], []
-    for s in s_values:
+    centres, node_sets, rows = [], [], []
+    for row, s in enumerate(s_values):
         for y in y_values:
+            rows.append(row)
             local = np.column_stack([s + corners[:, 0], y + corners[:, 1], a / 2 + corners[:, 2]])
             node_sets.append(slope.to_world(*local.T))
             centres.append(slope.to_world(s, y, a / 2))
-    figures = layer_metrics.layer_figures(slope, np.array(centres), node_sets, nominal_diameter=a,
+    figures = layer_metrics.layer_figures(slope, np.array(centres), node_sets, rows=rows,
+                                          nominal_diameter=a,
                                           unit_volume=a ** 3, underlayer_level=0.0)
-    assert figures["units_in_measuring_band"] == (len(s_values) - 3) * len(y_values)
+    # Half the first and the last row, all rows between, on the face between the two.
+    assert figures["units_measured"] == (len(s_values) - 1) * len(y_values)
+    assert figures["measuring_area_m2"] == pytest.approx((len(s_values) - 1) * 4.0 * a, rel=1e-9)
     assert figures["packing_density_coefficient"] == pytest.approx(1.0, rel=1e-9)
     assert figures["layer_thickness_m"] == pytest.approx(a, rel=1e-12)
     assert figures["porosity"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_packing_density_of_a_staggered_grid_does_not_depend_on_the_number_of_rows():
+    """Rows of 4 and 3 units between side walls (the small example's pattern): the grid's phi for
+    any number of rows, odd or even (a fixed measuring band would count 3 or 4 rows in the same
+    length), also when the rows are found from positions alone."""
+    slope = Slope(cotangent=1.33, width=4.4, length=20.0)
+    dn, phi = 0.56, 0.6
+    for rows in (2, 3, 5, 6, 7, 8):
+        grid = design_grid(slope, nominal_diameter=dn, rows=rows, units_per_row=(4, 3),
+                           packing_density_coefficient=phi, first_row_s=0.8, centroid_height=0.5)
+        design = slope.to_world(*grid.slope_coordinates.T)
+        nodes = [p + np.zeros((4, 3)) for p in design]
+        found = layer_metrics.rows_by_position(grid.slope_coordinates[:, 0], dn)
+        assert np.array_equal(found, grid.rows)
+        figures = layer_metrics.layer_figures(slope, design, nodes, rows=grid.rows,
+                                              nominal_diameter=dn, unit_volume=0.1,
+                                              underlayer_level=0.0)
+        assert figures["packing_density_coefficient"] == pytest.approx(phi, rel=1e-12)
 
 
 def test_limited_random_orientations_stay_within_the_tilt_of_the_face():

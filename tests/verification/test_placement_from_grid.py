@@ -4,8 +4,9 @@ Source: the placement requirement of POSITIT (Xiang et al. 2012, seed paper: "un
 just touching and not overlapping ... in static force equilibrium"). Case: six 0.3 m concrete cubes
 (random orientations, two staggered rows of 3 and 2 plus one) dropped from a design grid onto a rough
 1:1.5 face (friction 0.9 > tan 33.7 deg = 0.67, so a cube cannot slide on it) between glass side
-walls, settled with local damping 0.3; all at once, and row by row (each row dropped onto the rows
-below once they rest).
+walls, settled with local damping 0.3; all at once, row by row (each row dropped onto the rows
+below once they rest), and lowered straight down until touching before release (as a crane sets
+them down).
 
 Tolerances: every unit ends with speed below ``REST_SPEED`` = 0.02 m/s (translation plus rotation
 at its bounding radius); the largest mean overlap depth of any contact is below ``OVERLAP_OVER_DN``
@@ -52,16 +53,17 @@ def _no_underlayer():
                       nominal_diameters=np.zeros(0), top_level=0.0)
 
 
-@pytest.fixture(scope="module", params=["all_at_once", "row_by_row"])
+@pytest.fixture(scope="module", params=[("all_at_once", "free_fall"), ("row_by_row", "free_fall"),
+                                        ("all_at_once", "on_contact")])
 def placed(request, tmp_path_factory):
     slope = Slope(cotangent=1.5, width=1.0, length=2.0)
     unit = _cube_unit()
     grid = design_grid(slope, nominal_diameter=SIDE, rows=3, units_per_row=(3, 2),
-                       packing_density_coefficient=0.5, first_row_s=0.3, start_height=0.3)
+                       packing_density_coefficient=0.5, first_row_s=0.3, centroid_height=0.3)
     q = unit_orientations(len(grid.positions), mode="random", slope=slope, seed=5)
     result = place_units(slope, unit, _no_underlayer(), positions=grid.positions, orientations=q,
                          materials=_materials(), lift_overlapping=True, end_time=2.5,
-                         deposition=request.param,
+                         deposition=request.param[0], release=request.param[1],
                          time_step_safety=0.3, local_damping=0.3, rest_speed=REST_SPEED,
                          output_directory=tmp_path_factory.mktemp("placement"), paraview=False,
                          picture=False, progress=False)

@@ -7,13 +7,13 @@ published Core-Loc porosity was found). Case: ``examples/coreloc_small.toml`` ru
 about 140 rocks, a few minutes here).
 
 Tolerances: at least 80 % of the units at rest on the face; largest contact overlap below 1 % of
-Dn; packing density coefficient within ``PACKING_TOLERANCE`` = 25 % of the design value. Measured
-here (2-core machine, 2026-11-23; grid at the design packing density, units falling straight onto
-their design points): 0.495 against 0.606 (-18 %), 25 of 25 units at rest, overlap 0.36 % of Dn,
-51 s. The issue asks for 10 %, which this example does NOT meet yet; the tolerance states what
-is measured. A deposition is chaotic and a 25-unit layer's packing density moved between 0.47 and
-0.81 over the deposition variants tried (start offsets, grid densities 0.46-0.606), so the
-statistic of so small a layer is itself uncertain by about that much.
+Dn; packing density coefficient within ``PACKING_TOLERANCE`` = 10 % of the design value (the
+issue's figure). The layer's phi is counted row by row (``riprap.placement.layer_metrics``: half
+the first and last rows, whole rows between, over the face between them). Measured here (2-core
+machine, 2026-11-23; units lowered straight down onto the layer until they touch, grid phi 0.50):
+0.633 (seed 0) and 0.642 (seed 3) against 0.606, i.e. +4.5 % and +6 %, all 25 units at rest,
+overlap 0.34-0.39 % of Dn, about a minute. The same runs with the grid at phi 0.606 ended at
+0.687 (+13 %) for both seeds, and units let fall from above instead at 0.495 (-18 %).
 """
 from pathlib import Path
 
@@ -23,7 +23,7 @@ from riprap.case.build_placement import run_placement
 from riprap.case.load import load_case
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "coreloc_small.toml"
-PACKING_TOLERANCE = 0.25
+PACKING_TOLERANCE = 0.10
 AT_REST_FRACTION = 0.8
 OVERLAP_OVER_DN = 0.01
 

@@ -100,11 +100,16 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
                                 "units_per_row (a design grid)")
         counts = (pl.units_per_row, pl.units_per_alternate_row or pl.units_per_row)
         packing = pl.packing_density_coefficient or unit.design.packing_density_coefficient
-        start = pl.start_height or underlayer.top_level + unit.height
+        # Design centroids half a design layer thickness above the underlayer top.
+        design = unit.design
+        centroid_height = (underlayer.top_level
+                           + 0.5 * design.layer_thickness_coefficient * unit.nominal_diameter)
         generated = design_grid(slope, nominal_diameter=unit.nominal_diameter, rows=pl.rows,
                                 units_per_row=counts, packing_density_coefficient=packing,
                                 first_row_s=pl.first_row_s or 0.5 * unit.height,
-                                start_height=start)
+                                centroid_height=centroid_height,
+                                drop_height=(pl.drop_height or unit.height
+                                             if pl.release == "free_fall" else 0.0))
         positions, velocities, lines, user, lift = generated.positions, None, None, None, True
         rows = generated.rows
     orientations = unit_orientations(len(positions), mode=pl.orientation, slope=slope,
@@ -112,7 +117,7 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
     result = place_units(slope, unit, underlayer, positions=positions, orientations=orientations,
                          materials=materials, velocities=velocities, grid_lines=lines,
                          lift_overlapping=lift, initial_velocity=pl.initial_velocity,
-                         deposition=pl.deposition, rows=rows,
+                         deposition=pl.deposition, rows=rows, release=pl.release,
                          **_settings(case, pl.settle_time, out / "deposition", progress))
     summary = dict(result.summary)
     summary["outputs"] = _write_outputs(case, result, materials, slope, out)

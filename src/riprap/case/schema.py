@@ -446,9 +446,13 @@ KEYS: tuple[Key, ...] = (
     Key("placement", "first_row_s", "number", "m",
         "Position of the first row along the face from the toe; 0: half a unit height.",
         default=0.0, valid_range=_NON_NEGATIVE),
-    Key("placement", "start_height", "number", "m",
-        "Start height of the centroids above the face; 0: underlayer top plus one unit height.",
-        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("placement", "release", "string", "-",
+        "How units are let go: lowered straight down until they touch the underlayer or a unit "
+        "set down before them, then released (as a crane places them), or dropped from their "
+        "start positions.", default="on_contact", choices=("on_contact", "free_fall")),
+    Key("placement", "drop_height", "number", "m",
+        "free_fall from a design grid: how far straight above its design centroid each unit "
+        "starts; 0: one unit height.", default=0.0, valid_range=_NON_NEGATIVE),
     Key("placement", "orientation", "string", "-",
         "Unit orientations: uniform random, random within max_tilt_deg of lying on the face, or "
         "from the grid file.", default="random", choices=("random", "random_within", "user")),

@@ -5,7 +5,9 @@ Units per area is phi / D_n^2 (CEM VI-5, see ``layer_metrics``). With ``units_pe
 the rows alternate between n1 and n2 units, the longer rows spanning the flume width with a
 horizontal spacing dx = width / max(n1, n2) and the shorter ones centred between them (a staggered
 pattern, as cranes place single-layer units); the spacing up the face is then
-dy = D_n^2 / (phi dx), so that the grid itself has the target packing density. The seed paper's
+dy = D_n^2 (n1 + n2) / (2 phi width), so that the grid itself has the target packing density
+(a pair of rows holds n1 + n2 units on 2 dy x width of face; with dx dy instead, the short rows
+would leave a 12-row flume's grid 1/24 and a 4-row one's 1/8 below its target). The seed paper's
 Core-Loc layer is 21 rows alternating 12 and 11 units.
 """
 from __future__ import annotations
@@ -30,9 +32,9 @@ class DesignGrid:
 
 def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12, 11),
                 packing_density_coefficient: float, first_row_s: float,
-                start_height: float) -> DesignGrid:
-    """Staggered rows of unit centroids straight above their design points on ``slope``,
-    ``start_height`` (m) clear of the face along its normal."""
+                centroid_height: float, drop_height: float = 0.0) -> DesignGrid:
+    """Staggered rows of unit centroids: the design centroids lie ``centroid_height`` (m) above the
+    face along its normal, and the units start ``drop_height`` (m) straight above them."""
     counts = tuple(int(n) for n in np.atleast_1d(units_per_row))
     if rows < 1:
         raise CaseFileError(f"design grid: rows = {rows} must be >= 1")
@@ -44,7 +46,8 @@ def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12,
                             f"{packing_density_coefficient!r} must be > 0")
     widest = max(counts)
     dx = slope.width / widest
-    dy = nominal_diameter ** 2 / (packing_density_coefficient * dx)
+    mean_count = 0.5 * (counts[0] + counts[-1])
+    dy = nominal_diameter ** 2 * mean_count / (packing_density_coefficient * slope.width)
     s_list, y_list, row_list = [], [], []
     for r in range(rows):
         n = counts[r % len(counts)]
@@ -60,11 +63,10 @@ def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12,
             f"s = {s.max():.3f} m along the face, beyond its length {slope.length:g} m; "
             "use fewer rows, a longer slope or a lower first row")
     y = np.array(y_list)
-    # Each unit starts straight above its design point on the face, start_height clear of the face
-    # along its normal, so that it falls onto that point (a start offset along the normal would
-    # move the lower rows out over the toe).
-    above = slope.to_world(s, y, np.zeros(len(s)))
-    above[:, 2] += float(start_height) / np.cos(slope.angle)
+    # Straight above (not along the face normal from) the design centroids: a unit let go or
+    # lowered from there comes down on its own place rather than one row further down the face.
+    design = slope.to_world(s, y, np.full(len(s), float(centroid_height)))
+    above = design + np.array([0.0, 0.0, float(drop_height)])
     return DesignGrid(positions=above, rows=np.array(row_list, dtype=np.int64),
-                      slope_coordinates=slope.to_slope(above), horizontal_spacing=dx,
+                      slope_coordinates=slope.to_slope(design), horizontal_spacing=dx,
                       upslope_spacing=dy)

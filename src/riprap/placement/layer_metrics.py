@@ -7,12 +7,15 @@ Definitions (n layers of units of nominal diameter D_n = V^(1/3) on a face of ar
   normal; the design value is t = n k_t D_n,
 - layer porosity  n_v = 1 - N V / (A t),  so that phi = n k_t (1 - n_v) when t = n k_t D_n.
 
-They are measured on a band of the face that leaves out the first and last rows (edge rows rest
-against the toe or have no row above them, as in a flume test's measuring section): units whose
-centroid lies in [``s_low + D_n``, ``s_high - D_n``) along the face, where s_low, s_high are
-the lowest and highest unit centroids. The tops are measured per body as its highest point above
-the face (a probe with a foot about a unit wide reads the unit tops); the underlayer top is the
-mean of those of the underlayer rocks in the upper half of the rock tops.
+They are measured row by row, as the layer was built: with rows 1..R (the design rows; their
+mean positions s_1 < ... < s_R along the face after settling), the face between the first and the
+last row, A = width x (s_R - s_1), holds half of the first and of the last row and all the rows
+between (the trapezoidal rule: N = n_1/2 + n_2 + ... + n_(R-1) + n_R/2). Counting whole rows
+inside a fixed measuring band instead would jump by a whole row (a quarter of a small layer's
+count) with where the band's ends happen to fall. Units that rolled off the face are not counted.
+The tops are measured per body as its highest point above the face (a probe with a foot about a
+unit wide reads the unit tops), over the rows between the first and the last; the underlayer top
+is the mean of those of the underlayer rocks in the upper half of the rock tops.
 """
 from __future__ import annotations
 
@@ -33,32 +36,45 @@ def underlayer_top(slope, rock_node_sets) -> float:
     return float(upper.mean())
 
 
-def measuring_band(s_positions, nominal_diameter) -> tuple[float, float, np.ndarray]:
-    """(s_low, s_high, mask of the units inside) with one D_n left out at each end."""
+def rows_by_position(s_positions, nominal_diameter) -> np.ndarray:
+    """Row of each unit from positions along the face: sorted, a gap over half a D_n starts a row."""
     s = np.asarray(s_positions, dtype=float)
-    low = s.min() + nominal_diameter
-    high = s.max() - nominal_diameter
-    if high <= low:          # too few rows to trim: measure over the whole layer
-        low, high = s.min() - 0.5 * nominal_diameter, s.max() + 0.5 * nominal_diameter
-    # Half-open, so that a band whose ends fall on rows counts one of them, not both.
-    inside = (s >= low) & (s < high)
-    return float(low), float(high), inside
+    order = np.argsort(s, kind="stable")
+    rows = np.empty(len(s), dtype=np.int64)
+    current = 0
+    for rank, k in enumerate(order):
+        if rank > 0 and s[k] - s[order[rank - 1]] > 0.5 * nominal_diameter:
+            current += 1
+        rows[k] = current
+    return rows
 
 
-def layer_figures(slope, unit_positions, unit_node_sets, *, nominal_diameter, unit_volume,
+def layer_figures(slope, unit_positions, unit_node_sets, *, rows, nominal_diameter, unit_volume,
                   underlayer_level) -> dict:
     """Packing density coefficient, layer thickness and porosity of the units resting on the face.
 
-    ``unit_positions`` (n, 3) world centroids; ``unit_node_sets`` world nodes of each unit.
+    ``unit_positions`` (n, 3) world centroids; ``unit_node_sets`` world nodes of each unit;
+    ``rows`` (n,) the row each unit was placed in.
     """
-    coords = slope.to_slope(unit_positions)
-    low, high, inside = measuring_band(coords[:, 0], nominal_diameter)
-    count = int(inside.sum())
-    area = slope.slope_area(low, high)
-    tops = body_tops(slope, [unit_node_sets[k] for k in np.flatnonzero(inside)])
-    thickness = float(tops.mean() - underlayer_level) if count else 0.0
-    packing = count * nominal_diameter ** 2 / area if area > 0 else 0.0
-    porosity = 1.0 - count * unit_volume / (area * thickness) if area > 0 and thickness > 0 else 1.0
+    coords = slope.to_slope(np.asarray(unit_positions, dtype=float))
+    rows = np.asarray(rows)
+    labels = np.unique(rows)
+    if len(labels) < 2:
+        return {"packing_density_coefficient": float("nan"), "layer_thickness_m": float("nan"),
+                "porosity": float("nan"), "units_measured": 0, "measuring_area_m2": 0.0,
+                "rows_measured": int(len(labels))}
+    counts = np.array([(rows == r).sum() for r in labels], dtype=float)
+    means = np.array([coords[rows == r, 0].mean() for r in labels])
+    order = np.argsort(means)
+    counts, means, labels = counts[order], means[order], labels[order]
+    weighted = counts.sum() - 0.5 * (counts[0] + counts[-1])
+    area = slope.slope_area(means[0], means[-1])
+    inner = np.isin(rows, labels[1:-1]) if len(labels) > 2 else np.ones(len(rows), dtype=bool)
+    tops = body_tops(slope, [unit_node_sets[k] for k in np.flatnonzero(inner)])
+    thickness = float(tops.mean() - underlayer_level)
+    packing = weighted * nominal_diameter ** 2 / area if area > 0 else float("nan")
+    porosity = (1.0 - weighted * unit_volume / (area * thickness) if area > 0 and thickness > 0
+                else float("nan"))
     return {"packing_density_coefficient": float(packing), "layer_thickness_m": thickness,
-            "porosity": float(porosity), "measuring_band_m": [low, high],
-            "units_in_measuring_band": count, "measuring_area_m2": area}
+            "porosity": float(porosity), "units_measured": float(weighted),
+            "measuring_area_m2": float(area), "rows_measured": int(len(labels))}

@@ -8,8 +8,9 @@ Two stages, each one rigid FEMDEM run (:class:`riprap.simulation.Simulation`):
    down to the toe instead).
 2. :func:`place_units`: units start at the grid's centroids (a user file or a design grid) with
    user, random (uniform on rotations) or limited random orientations and an optional initial
-   velocity, fall onto the fixed underlayer and run until every unit rests (``rest_speed`` and
-   ``rest_kinetic_energy``) or ``max_time`` passes.
+   velocity, are lowered straight down until they touch (``release="on_contact"``, as a crane
+   sets them down) or let fall from there (``"free_fall"``) onto the fixed underlayer, and run
+   until every unit rests (``rest_speed`` and ``rest_kinetic_energy``) or ``max_time`` passes.
 
 A unit that starts overlapping another unit, a rock or a wall is an error naming the unit and the
 grid line it came from; with a generated grid, units are lifted until they are clear instead.
@@ -24,6 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from riprap.errors import CaseFileError, OverlapError
 from riprap.placement import layer_metrics
+from riprap.placement.lowering import Surface, VerticalLowering
 from riprap.simulation import Simulation
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
@@ -38,6 +40,8 @@ _MAX_LIFTS = 40
 _SIDE_WALL_GAP = 0.01
 # Overlap tolerance at the start, as a fraction of the smallest boundary sub-tet height.
 _START_OVERLAP_FRACTION = 0.01
+# Units lowered onto the layer are released this fraction of D_n above what they touch.
+_RELEASE_GAP = 0.002
 
 
 @dataclass(frozen=True)
@@ -123,6 +127,10 @@ def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range, la
                 points.append((s_low + (i + 0.5) * spacing + shift, y0 + j * spacing + shift,
                                radius * (1.0 + _ROCK_LATTICE_GAP) + layer * spacing))
     points = np.array(points)
+    if slope.toe_stop_distance > 0:
+        # Upper layers of the lattice lean out over the toe: keep them behind the toe stop.
+        x = slope.to_world(points[:, 0], points[:, 1], points[:, 2])[:, 0]
+        points = points[x - radius * (1.0 + _ROCK_LATTICE_GAP) > slope.toe_x - slope.toe_stop_distance]
     sim = Simulation(**_run_settings(run))
     for m in materials.all():
         sim.add_material(m)
@@ -201,7 +209,7 @@ def unit_orientations(count: int, *, mode: str, slope, seed: int = 0, max_tilt_d
 def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations, materials,
                 velocities=None, grid_lines=None, lift_overlapping: bool = False,
                 initial_velocity=(0.0, 0.0, 0.0), deposition: str = "all_at_once", rows=None,
-                **run) -> PlacementResult:
+                release: str = "free_fall", **run) -> PlacementResult:
     """Deposit the units on the fixed underlayer and run until they rest.
 
     ``unit``: an :class:`riprap.geometry.armour_units.ArmourUnit` (mesh, height, nominal_diameter,
@@ -215,7 +223,13 @@ def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations,
     unit; by default units whose start positions lie within half a D_n of each other along the face
     form a row. Each row is one run (its outputs in ``row_NN/`` under ``output_directory``); the
     units already placed carry their state over, except the tangential contact history.
+
+    ``release``: ``"free_fall"`` lets each unit go where it starts; ``"on_contact"`` first lowers it
+    straight down (a crane) until it touches the underlayer, the face or a unit set down before it
+    (lowest rows first, :mod:`riprap.placement.lowering`), and lets it go there.
     """
+    if release not in ("free_fall", "on_contact"):
+        raise CaseFileError(f"release = {release!r}: expected 'free_fall' or 'on_contact'")
     positions = np.array(positions, dtype=float)
     orientations = np.asarray(orientations, dtype=float)
     n_units = len(positions)
@@ -225,19 +239,27 @@ def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations,
     unit_shape = RigidShape.from_mesh(unit.mesh, name="armour_unit")
     if lift_overlapping:
         _shift_between_side_walls(slope, unit_shape, positions, orientations)
-    _check_inside(slope, unit_shape, positions, orientations, grid_lines)
-    groups = _deposition_groups(slope, positions, unit.nominal_diameter, deposition, rows)
+    # Lowered units are first raised clear of the face, so only the side walls bound their start.
+    _check_inside(slope, unit_shape, positions, orientations, grid_lines,
+                  above_face=release == "free_fall")
+    if rows is None:
+        rows = layer_metrics.rows_by_position(slope.to_slope(positions)[:, 0], unit.nominal_diameter)
+    rows = np.asarray(rows)
+    groups = _deposition_groups(deposition, rows)
     state = _UnitState(positions, orientations, velocities)
     placed: list[int] = []
     results = []
+    rock_surfaces = (_rock_surfaces(underlayer) if release == "on_contact" else [])
     for stage, group in enumerate(groups):
+        if release == "on_contact":
+            _lower_onto_layer(slope, unit, unit_shape, rock_surfaces, state, placed, group)
         members = placed + list(group)
         stage_run = dict(run)
         if len(groups) > 1 and "output_directory" in run:
             stage_run["output_directory"] = Path(run["output_directory"]) / f"row_{stage:02d}"
         sim = _start_without_overlaps(slope, unit, unit_shape, underlayer, state, members,
                                       set(group), materials, stage_run, lift_overlapping,
-                                      grid_lines)
+                                      grid_lines, release)
         results.append(sim.run().as_dict())
         state.update_from(sim.solver, len(underlayer.positions), members)
         placed = members
@@ -245,7 +267,7 @@ def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations,
     first_unit = len(underlayer.positions)
     unit_bodies = np.empty(n_units, dtype=np.int64)
     unit_bodies[np.asarray(placed)] = np.arange(first_unit, first_unit + n_units)
-    summary = placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies)
+    summary = placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies, rows)
     summary["deposition"] = deposition
     summary["run"] = _combined_runs(results)
     return PlacementResult(simulation=sim, unit_bodies=unit_bodies,
@@ -274,57 +296,79 @@ class _UnitState:
             self.frames[k] = "principal"
 
 
-def _deposition_groups(slope, positions, nominal_diameter, deposition, rows) -> list[np.ndarray]:
+def _rock_surfaces(underlayer) -> list[Surface]:
+    faces = [shape.mesh.boundary_faces() for shape in underlayer.shapes]
+    return [Surface.from_nodes(nodes, faces[underlayer.shape_of_rock[k]])
+            for k, nodes in enumerate(underlayer.node_sets())]
+
+
+def _unit_nodes(unit_shape, state, k) -> np.ndarray:
+    if state.frames[k] == "shape":
+        return _world_nodes(unit_shape, state.positions[k], state.orientations[k])
+    rotation = Rotation.from_quat(np.roll(state.orientations[k], -1)).as_matrix()
+    return unit_shape.mesh.nodes @ rotation.T + state.positions[k]
+
+
+def _lower_onto_layer(slope, unit, unit_shape, rock_surfaces, state, placed, group) -> None:
+    """Lower the units of ``group`` (lowest first along the face) straight down onto the rocks and
+    the units ``placed`` before them; their start positions give the vertical each one travels."""
+    faces = unit_shape.mesh.boundary_faces()
+    lowering = VerticalLowering(slope, gap=_RELEASE_GAP * unit.nominal_diameter)
+    lowering.add(*rock_surfaces)
+    lowering.add(*(Surface.from_nodes(_unit_nodes(unit_shape, state, k), faces) for k in placed))
+    along = slope.to_slope(state.positions[np.asarray(group)])
+    for k in np.asarray(group)[np.lexsort((along[:, 1], along[:, 0]))]:
+        surface = Surface.from_nodes(_unit_nodes(unit_shape, state, k), faces)
+        dz = lowering.lower(surface)
+        state.positions[k, 2] += dz
+        lowering.add(surface.moved(dz))
+
+
+def _deposition_groups(deposition, rows) -> list[np.ndarray]:
     """Unit indices of each deposition stage, lowest row first."""
-    n = len(positions)
     if deposition == "all_at_once":
-        return [np.arange(n)]
+        return [np.arange(len(rows))]
     if deposition != "row_by_row":
         raise CaseFileError(f"deposition = {deposition!r}: expected 'all_at_once' or 'row_by_row'")
-    if rows is None:
-        s = slope.to_slope(positions)[:, 0]
-        order = np.argsort(s, kind="stable")
-        rows = np.empty(n, dtype=np.int64)
-        current = 0
-        for rank, k in enumerate(order):
-            if rank > 0 and s[k] - s[order[rank - 1]] > 0.5 * nominal_diameter:
-                current += 1
-            rows[k] = current
-    rows = np.asarray(rows)
     return [np.flatnonzero(rows == r) for r in np.unique(rows)]
 
 
 def _start_without_overlaps(slope, unit, unit_shape, underlayer, state, members, new, materials,
-                            run, lift_overlapping, grid_lines) -> Simulation:
+                            run, lift_overlapping, grid_lines, release) -> Simulation:
     """The stage's simulation, with the new units lifted clear (or refused) if they overlap."""
-    for _ in range(_MAX_LIFTS + 1):
+    for attempt in range(_MAX_LIFTS + 1):
         sim = _placement_simulation(slope, unit_shape, underlayer, state, members, materials, run)
-        overlapping = [(members[k], None if other is None else members[other], what)
-                       for k, other, what in
+        overlapping = [(members[k], None if other is None else members[other], what, depth)
+                       for k, other, what, depth in
                        _overlapping_units(sim, len(underlayer.positions), len(members))
                        if members[k] in new]
         if not overlapping:
             return sim
         if not lift_overlapping:
             lines = [f"  unit {k}" + (f" (grid line {grid_lines[k]})" if grid_lines is not None else "")
-                     + f" overlaps {what}" for k, _, what in overlapping[:20]]
+                     + f" overlaps {what}" for k, _, what, _ in overlapping[:20]]
             raise OverlapError(f"{len(overlapping)} unit(s) start overlapping:\n" + "\n".join(lines)
                                + "\nMove them apart or higher in the grid.")
         # Lift a unit unless what it overlaps is lifted too (then they would move together);
         # lowest units first, so a chain of overlaps is undone from its bottom.
         lifted: set[int] = set()
-        for k, other, _ in sorted(overlapping, key=lambda item: item[0]):
+        for k, other, _, depth in sorted(overlapping, key=lambda item: item[0]):
             if k in lifted or (other is not None and other in lifted):
                 continue
             lifted.add(k)
-            if other is None:
+            if release == "on_contact":
+                # Lowered onto what it overlaps (two edges crossing that the lowering's sample
+                # points missed): a little higher on the same vertical, more each time.
+                state.positions[k, 2] += min(2.0 * depth + _RELEASE_GAP * unit.nominal_diameter
+                                             * 2.0 ** attempt, _LIFT_STEP * unit.height)
+            elif other is None:
                 # Off a rock or a wall (the toe stop, the face): straight up.
                 state.positions[k, 2] += _LIFT_STEP * unit.height
             else:
                 # Off another unit: along the face normal, as a vertical lift would also move
                 # the unit up the face, into the next row.
                 state.positions[k] += _LIFT_STEP * unit.height * slope.normal
-    listing = "; ".join(f"unit {k} overlaps {what}" for k, _, what in overlapping[:5])
+    listing = "; ".join(f"unit {k} overlaps {what}" for k, _, what, _ in overlapping[:5])
     raise OverlapError(f"units still overlap after lifting them {_MAX_LIFTS} times by "
                        f"{_LIFT_STEP:g} unit heights ({listing}): the grid is too dense for this "
                        "unit, or a unit reaches through a wall")
@@ -366,8 +410,8 @@ def _placement_simulation(slope, unit_shape, underlayer, state, members, materia
 
 
 def _overlapping_units(sim: Simulation, first_unit: int,
-                       n_units: int) -> list[tuple[int, int | None, str]]:
-    """(unit, the other unit or None, what it overlaps) for every unit that starts overlapping
+                       n_units: int) -> list[tuple[int, int | None, str, float]]:
+    """(unit, the other unit or None, what it overlaps, depth) for every unit that starts overlapping
     something; of two overlapping units the later one is listed."""
     sim.build_without_checks()
     solver = sim.solver
@@ -383,7 +427,7 @@ def _overlapping_units(sim: Simulation, first_unit: int,
                 else:
                     what = f"unit {b - first_unit}"
                 other = b - first_unit if b >= first_unit else None
-                found.append((a - first_unit, other, f"{what} (depth {depth:.2e} m)"))
+                found.append((a - first_unit, other, f"{what} (depth {depth:.2e} m)", depth))
                 break
     return found
 
@@ -396,8 +440,14 @@ def _world_nodes(unit_shape, position, quaternion) -> np.ndarray:
 
 
 def _shift_between_side_walls(slope, unit_shape, positions, orientations) -> None:
-    """Move generated units that reach through a side wall back inside (in place)."""
+    """Move generated units that reach through a side wall or the toe stop back inside (in place)."""
+    stop_x = slope.toe_x - slope.toe_stop_distance
     for k in range(len(positions)):
+        if slope.toe_stop_distance > 0:
+            x = _world_nodes(unit_shape, positions[k], orientations[k])[:, 0]
+            gap = _SIDE_WALL_GAP * (x.max() - x.min())
+            if x.min() < stop_x + gap:
+                positions[k, 0] += stop_x + gap - x.min()
         y = slope.to_slope(_world_nodes(unit_shape, positions[k], orientations[k]))[:, 1]
         if (1.0 + 2.0 * _SIDE_WALL_GAP) * (y.max() - y.min()) > slope.width:
             raise CaseFileError(f"unit {k} is {y.max() - y.min():.3f} m wide across the flume, more "
@@ -409,7 +459,7 @@ def _shift_between_side_walls(slope, unit_shape, positions, orientations) -> Non
             positions[k, 1] -= y.max() - (slope.width - gap)
 
 
-def _check_inside(slope, unit_shape, positions, orientations, grid_lines) -> None:
+def _check_inside(slope, unit_shape, positions, orientations, grid_lines, above_face=True) -> None:
     """Every unit must start inside the flume (between the side walls, above the face)."""
     problems = []
     for k in range(len(positions)):
@@ -418,7 +468,7 @@ def _check_inside(slope, unit_shape, positions, orientations, grid_lines) -> Non
         if coords[:, 1].min() < 0.0 or coords[:, 1].max() > slope.width:
             problems.append(f"  {where} reaches y = {coords[:, 1].min():.3f}..{coords[:, 1].max():.3f} m, "
                             f"outside the side walls at 0 and {slope.width:g} m")
-        elif coords[:, 2].min() < 0.0:
+        elif above_face and coords[:, 2].min() < 0.0:
             problems.append(f"  {where} starts {-coords[:, 2].min():.3f} m inside the slope face")
     if problems:
         more = f"\n  ... and {len(problems) - 20} more" if len(problems) > 20 else ""
@@ -426,8 +476,9 @@ def _check_inside(slope, unit_shape, positions, orientations, grid_lines) -> Non
                             + "\n".join(problems[:20]) + more)
 
 
-def placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies) -> dict:
-    """The layer as designers read it (``layer_metrics``) plus what came to rest."""
+def placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies, unit_rows) -> dict:
+    """The layer as designers read it (``layer_metrics``) plus what came to rest; ``unit_rows``:
+    the row each unit was placed in."""
     solver = sim.solver
     rotations = solver.rotation_matrices()
     node_sets = [unit_shape.mesh.nodes @ rotations[b].T + solver.positions[b] for b in unit_bodies]
@@ -444,7 +495,8 @@ def placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies) -> 
     on_face = ~rolled_off
     figures = layer_metrics.layer_figures(
         slope, solver.positions[unit_bodies][on_face], [n for n, ok in zip(node_sets, on_face) if ok],
-        nominal_diameter=dn, unit_volume=unit.volume, underlayer_level=underlayer.top_level)
+        rows=np.asarray(unit_rows)[on_face], nominal_diameter=dn, unit_volume=unit.volume,
+        underlayer_level=underlayer.top_level)
     overlaps = [depth for i, j, depth in solver.overlaps(0.0)
                 if i in set(unit_bodies.tolist()) or j in set(unit_bodies.tolist())]
     design = unit.design

@@ -1,0 +1,1 @@
+"""Compiled kernels of the placement tools (flat arrays in, flat arrays out)."""
