@@ -10,10 +10,11 @@ Tolerances: at least 80 % of the units at rest on the face; largest contact over
 Dn; packing density coefficient within ``PACKING_TOLERANCE`` = 10 % of the design value (the
 issue's figure). The layer's phi is counted row by row (``riprap.placement.layer_metrics``: half
 the first and last rows, whole rows between, over the face between them). Measured here (2-core
-machine, 2026-11-23; units lowered straight down onto the layer until they touch, grid phi 0.50):
-0.633 (seed 0) and 0.642 (seed 3) against 0.606, i.e. +4.5 % and +6 %, all 25 units at rest,
-overlap 0.34-0.39 % of Dn, about a minute. The same runs with the grid at phi 0.606 ended at
-0.687 (+13 %) for both seeds, and units let fall from above instead at 0.495 (-18 %).
+machine, 2026-11-23; units lowered straight down onto the layer until they touch, grid at the
+design phi, first row against the toe stop): 0.602 (the example's seed 0), 0.617 (seed 3) and
+0.576 (seed 1) against 0.606, i.e. -0.7 %, +1.8 % and -5 %; all 25 units at rest, overlap
+0.32-0.39 % of Dn, under a minute. Earlier variants: units let fall from above, 0.495 (-18 %);
+the first row pushed up the face by the toe stop onto the second, 0.63-0.69 (+5 to +14 %).
 """
 from pathlib import Path
 
