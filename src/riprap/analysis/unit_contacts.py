@@ -54,3 +54,29 @@ def unit_contacts(n_bodies: int, contacts, group=None) -> UnitContacts:
     return UnitContacts(coordination_number=coordination, max_contact_force=largest,
                         max_contact_force_unit_unit=same, max_contact_force_unit_underlayer=other,
                         total_contact_force=total)
+
+
+def sliding_factor_of_safety(n_bodies: int, contacts, friction_coefficient) -> np.ndarray:
+    """Factor of safety of each body against sliding on its contacts (inf for a body touching
+    nothing or carrying no tangential force).
+
+    Limit-equilibrium definition (shear strength available over shear force mobilised, as for
+    slopes, e.g. Duncan 1996, J. Geotech. Eng. 122(7)), over all the body's contacts together:
+    FoS = sum_c mu_c |N_c| / sum_c |T_c|. A block resting on a plane inclined at theta carries
+    N = W cos theta and T = W sin theta, so FoS = mu / tan theta; FoS = 1 means every contact is at
+    its Coulomb limit. ``friction_coefficient``: one value, or one per contact row.
+    """
+    body_i = np.asarray(contacts.body_i, dtype=np.int64)
+    body_j = np.asarray(contacts.body_j, dtype=np.int64)
+    mu = np.broadcast_to(np.asarray(friction_coefficient, dtype=float), body_i.shape)
+    normal = np.linalg.norm(np.asarray(contacts.normal_forces), axis=1) if len(body_i) else np.zeros(0)
+    tangential = (np.linalg.norm(np.asarray(contacts.tangential_forces), axis=1) if len(body_i)
+                  else np.zeros(0))
+    strength = np.zeros(n_bodies)
+    mobilised = np.zeros(n_bodies)
+    is_body = body_j >= 0
+    for side, rows in ((body_i, slice(None)), (body_j[is_body], is_body)):
+        np.add.at(strength, side, (mu * normal)[rows])
+        np.add.at(mobilised, side, tangential[rows])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(mobilised > 0, strength / np.where(mobilised > 0, mobilised, 1.0), np.inf)
