@@ -238,7 +238,7 @@ def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations,
     velocities = np.asarray(velocities, dtype=float)
     unit_shape = RigidShape.from_mesh(unit.mesh, name="armour_unit")
     if lift_overlapping:
-        _shift_between_side_walls(slope, unit_shape, positions, orientations)
+        _shift_inside_walls(slope, unit_shape, positions, orientations)
     # Lowered units are first raised clear of the face, so only the side walls bound their start.
     _check_inside(slope, unit_shape, positions, orientations, grid_lines,
                   above_face=release == "free_fall")
@@ -439,7 +439,7 @@ def _world_nodes(unit_shape, position, quaternion) -> np.ndarray:
     return rotation.apply(np.array(unit_shape.mesh.nodes)) + position
 
 
-def _shift_between_side_walls(slope, unit_shape, positions, orientations) -> None:
+def _shift_inside_walls(slope, unit_shape, positions, orientations) -> None:
     """Move generated units that reach through a side wall or the toe stop back inside (in place)."""
     stop_x = slope.toe_x - slope.toe_stop_distance
     for k in range(len(positions)):
