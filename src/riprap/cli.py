@@ -3,6 +3,8 @@
     riprap demo [--out DIR]            drop rocks and tetrapods into a box (embedded case)
     riprap run CASE.toml [--out DIR] [--restart CHECKPOINT]
     riprap place CASE.toml [--out DIR]   build an armour layer on a slope (pack, pictures, summary)
+    riprap analyse PACK_OR_RUN [MORE ...] --out DIR   per-unit contact forces, coordination
+                                       numbers, stereonet, factors of safety, report.html
     riprap check CASE.toml             validate a case file and report every problem
     riprap info                        versions and threads
 """
@@ -57,6 +59,38 @@ def _place_case(path: Path, out: str | None, quiet: bool) -> int:
     return 0
 
 
+def _analyse(paths: list[Path], out: str | None, frame: int, labels: list[str] | None) -> int:
+    from riprap.analysis import analyse, compare_layers
+
+    if len(paths) == 1:
+        out = out or str((paths[0] if paths[0].is_dir() else paths[0].parent) / "analysis")
+        analysis = analyse(paths[0], out=out, frame=frame)
+        layer = analysis.layer
+        print(f"riprap: analysed {layer['source']}: {layer['units']} {layer['unit']} units on "
+              f"{layer['underlayer_bodies']} underlayer bodies")
+        print(f"riprap: coordination number {layer['coordination_number_min']}..."
+              f"{layer['coordination_number_max']} (mean {layer['coordination_number_mean']:.2f}); "
+              f"largest contact force {layer['max_contact_force_N']:.4g} N "
+              f"({layer['max_contact_force_N'] / max(layer['unit_weight_N'], 1e-300):.2f} unit "
+              f"weights); smallest factor of safety {layer['factor_of_safety_min']:.3f}, "
+              f"{len(layer['units_below_factor_of_safety_1'])} unit(s) below 1")
+        print(f"riprap: packing density coefficient {layer['packing_density_coefficient']:.3f} "
+              f"(design {layer['design_packing_density_coefficient']:.3f}), porosity "
+              f"{layer['porosity']:.3f}, layer thickness {layer['layer_thickness_m']:.3f} m")
+        print(f"riprap: report: {layer['outputs']['report']}")
+        return 0
+    if out is None:
+        raise RiprapError("riprap analyse with several packs compares them: give --out DIR")
+    analyses = compare_layers(paths, out=out, labels=labels, frame=frame)
+    for analysis in analyses:
+        layer = analysis.layer
+        print(f"riprap: {layer['source']}: packing density {layer['packing_density_coefficient']:.3f}, "
+              f"mean coordination {layer['coordination_number_mean']:.2f}, largest contact force "
+              f"{layer['max_contact_force_N']:.4g} N, smallest FoS {layer['factor_of_safety_min']:.3f}")
+    print(f"riprap: comparison: {Path(out) / 'comparison.html'}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="riprap", description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -72,6 +106,16 @@ def main(argv: list[str] | None = None) -> int:
     place.add_argument("case", type=Path)
     place.add_argument("--out", default=None, help="output directory (default: [output] directory)")
     place.add_argument("--quiet", action="store_true", help="no progress bar")
+    analyse = sub.add_parser(
+        "analyse", help="analyse an armour layer (a pack folder or a run started from one); "
+                        "two or more are compared side by side")
+    analyse.add_argument("paths", type=Path, nargs="+", metavar="PACK_OR_RUN")
+    analyse.add_argument("--out", default=None,
+                         help="output directory (default: PACK/analysis for one pack)")
+    analyse.add_argument("--frame", type=int, default=-1,
+                         help="frame of a run to analyse (0 the first, -1 the last; default -1)")
+    analyse.add_argument("--labels", nargs="+", default=None,
+                         help="names of the compared layers (default: their folder names)")
     check = sub.add_parser("check", help="validate a case file")
     check.add_argument("case", type=Path)
     sub.add_parser("info", help="versions and threads")
@@ -86,6 +130,8 @@ def main(argv: list[str] | None = None) -> int:
             return _run_case(args.case, args.out, args.restart, args.quiet)
         if args.command == "place":
             return _place_case(args.case, args.out, args.quiet)
+        if args.command == "analyse":
+            return _analyse(args.paths, args.out, args.frame, args.labels)
         if args.command == "check":
             from riprap.case.load import load_case
 

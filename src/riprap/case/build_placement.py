@@ -14,8 +14,11 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import numpy as np
+
 from riprap.case.build import SMOKE_END_TIME, build_material, smoke_mode
 from riprap.errors import CaseFileError
+from riprap.placement.place import UNIT_SHAPE_NAME
 from riprap.placement import (PlacementMaterials, Slope, build_underlayer, design_grid,
                               place_units, unit_orientations)
 
@@ -112,6 +115,11 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
                                              if pl.release == "free_fall" else 0.0))
         positions, velocities, lines, user, lift = generated.positions, None, None, None, True
         rows = generated.rows
+    # Where each unit was meant to go: the grid point of its centroid (a free-fall drop height
+    # is not part of the design).
+    design_positions = np.array(positions, dtype=float)
+    if not pl.grid_file and pl.release == "free_fall":
+        design_positions[:, 2] -= pl.drop_height or unit.height
     orientations = unit_orientations(len(positions), mode=pl.orientation, slope=slope,
                                      seed=pl.seed, max_tilt_deg=pl.max_tilt_deg, user=user)
     result = place_units(slope, unit, underlayer, positions=positions, orientations=orientations,
@@ -120,13 +128,35 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
                          deposition=pl.deposition, rows=rows, release=pl.release,
                          **_settings(case, pl.settle_time, out / "deposition", progress))
     summary = dict(result.summary)
-    summary["outputs"] = _write_outputs(case, result, materials, slope, out)
+    layer = _layer_description(unit, slope, underlayer, result, design_positions)
+    summary["outputs"] = _write_outputs(case, result, materials, slope, out, layer)
     summary["underlayer_run"] = underlayer.summary
     write_json(out / "summary.json", summary)
     return summary
 
 
-def _write_outputs(case, result, materials, slope, out: Path) -> dict:
+def _layer_description(unit, slope, underlayer, result, design_positions):
+    """What ``riprap analyse`` needs to know of the layer (written as ``layer.json``)."""
+    from riprap.analysis.layer_state import LayerDescription
+
+    sim = result.simulation
+    unit_shape = sim.solver.shapes[sim._shape_names[UNIT_SHAPE_NAME]]
+    # The pack stores each shape in its principal frame: turn the unit's axes into it.
+    axes = {name: unit_shape.frame_rotation.T @ axis for name, axis in unit.axes.items()}
+    design = unit.design
+    return LayerDescription(
+        unit_kind=unit.kind, unit_shape=UNIT_SHAPE_NAME, nominal_diameter=unit.nominal_diameter,
+        unit_volume=unit.volume, unit_height=unit.height, unit_axes=axes, slope=slope,
+        underlayer_top=underlayer.top_level, unit_bodies=np.asarray(result.unit_bodies),
+        rows=np.asarray(result.rows), design_positions=design_positions,
+        design={"packing_density_coefficient": design.packing_density_coefficient,
+                "layer_thickness_m": design.layers * design.layer_thickness_coefficient
+                * unit.nominal_diameter,
+                "porosity": design.porosity})
+
+
+def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
+    from riprap.io.layer_file import CONTACTS_FILE_NAME, write_contact_table, write_layer_file
     from riprap.io.pack import PackBody, write_pack
 
     sim = result.simulation
@@ -149,7 +179,9 @@ def _write_outputs(case, result, materials, slope, out: Path) -> dict:
                                   "time_step_safety": case.simulation.time_step_safety,
                                   "gravity": list(case.simulation.gravity)},
                       comment=f"armour layer placed by riprap place from {case.source}")
-    outputs = {"pack": str(pack), "paraview": str(out / "deposition" / "bodies.pvd")}
+    outputs = {"pack": str(pack), "paraview": str(out / "deposition" / "bodies.pvd"),
+               "layer": str(write_layer_file(out, layer)),
+               "contacts": str(write_contact_table(out / CONTACTS_FILE_NAME, solver.contacts))}
     picture = out / "deposition" / "final_state.png"
     if picture.is_file():
         shutil.copyfile(picture, out / "final_layer.png")

@@ -44,6 +44,10 @@ _START_OVERLAP_FRACTION = 0.01
 _RELEASE_GAP = 0.002
 
 
+#: Name of the armour unit's shape in the placement runs (and in the pack they write).
+UNIT_SHAPE_NAME = "armour_unit"
+
+
 @dataclass(frozen=True)
 class PlacementMaterials:
     """Contact materials of the four kinds of surfaces."""
@@ -89,6 +93,7 @@ class PlacementResult:
     unit_bodies: np.ndarray          # body index of each unit
     grid_lines: np.ndarray | None    # grid-file line of each unit (None for a generated grid)
     summary: dict
+    rows: np.ndarray | None = None   # placement row of each unit
 
 
 def _run_settings(kwargs: dict) -> dict:
@@ -236,7 +241,7 @@ def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations,
     if velocities is None:
         velocities = np.tile(np.asarray(initial_velocity, dtype=float), (n_units, 1))
     velocities = np.asarray(velocities, dtype=float)
-    unit_shape = RigidShape.from_mesh(unit.mesh, name="armour_unit")
+    unit_shape = RigidShape.from_mesh(unit.mesh, name=UNIT_SHAPE_NAME)
     if lift_overlapping:
         _shift_inside_walls(slope, unit_shape, positions, orientations)
     # Lowered units are first raised clear of the face, so only the side walls bound their start.
@@ -272,7 +277,7 @@ def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations,
     summary["run"] = _combined_runs(results)
     return PlacementResult(simulation=sim, unit_bodies=unit_bodies,
                            grid_lines=None if grid_lines is None else np.asarray(grid_lines),
-                           summary=summary)
+                           summary=summary, rows=rows)
 
 
 class _UnitState:

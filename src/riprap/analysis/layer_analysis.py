@@ -1,0 +1,201 @@
+"""The analysis of an armour layer: one row per unit, one set of figures per layer.
+
+Per unit (``LayerAnalysis.units``, the columns of ``units.csv``, units in ``docs/outputs.md``):
+where it is (world and slope coordinates, height above the face and above the underlayer,
+distance from its design position), what it touches (coordination number: bodies and walls
+touched; how many of them units), the largest contact force it carries (all contacts, with
+units, with the underlayer), its weight, factors of safety against sliding
+(:func:`~riprap.analysis.unit_contacts.sliding_factor_of_safety`) and rocking
+(:func:`~riprap.analysis.rocking.rocking_factor_of_safety`), ``factor_of_safety`` the smaller of
+the two, and for each named axis of the unit its world direction, trend and plunge and its point
+on the lower-hemisphere equal-area net.
+
+Per layer (``LayerAnalysis.layer``): packing density coefficient, porosity and layer thickness
+(:mod:`riprap.placement.layer_metrics`, the same definitions as ``riprap place``), against the
+design values; coordination-number histogram and statistics; contact-force percentiles; the
+units below a factor of safety of 1; the fabric of the nose axes (eigenvalues of the orientation
+tensor, Woodcock 1977, Geol. Soc. Am. Bull. 88: 1231-1236: S1 = S2 = S3 = 1/3 for uniformly
+random axes, S1 -> 1 when all axes are parallel).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from riprap.analysis.orientations import equal_area_points, lower_hemisphere, trend_plunge
+from riprap.analysis.rocking import rocking_factor_of_safety
+from riprap.analysis.unit_contacts import sliding_factor_of_safety, unit_contacts
+from riprap.placement import layer_metrics
+
+__all__ = ["LayerAnalysis", "analyse_layer", "CONTACT_FORCE_PERCENTILES"]
+
+#: Percentiles of the contact forces reported per layer.
+CONTACT_FORCE_PERCENTILES = (50, 90, 99)
+
+
+@dataclass(frozen=True, eq=False)
+class LayerAnalysis:
+    """Result of :func:`analyse_layer`.
+
+    Attributes
+    ----------
+    units : dict of str to (n_units,) array
+        One column per quantity, in the order of ``units.csv``.
+    layer : dict
+        Layer figures (numbers, lists and small dicts; JSON-ready).
+    unit_unit_forces, unit_underlayer_forces : (m,) float
+        Magnitudes of every contact force between two units / a unit and the underlayer (N).
+    state : LayerState
+        The state analysed.
+    """
+
+    units: dict
+    layer: dict
+    unit_unit_forces: np.ndarray
+    unit_underlayer_forces: np.ndarray
+    state: object
+
+    def body_values(self, column: str, fill: float = np.nan) -> np.ndarray:
+        """A column of ``units`` spread over all bodies (``fill`` for the underlayer)."""
+        values = np.full(self.state.n_bodies, fill, dtype=float)
+        values[self.state.layer.unit_bodies] = self.units[column]
+        return values
+
+
+def _pair_force_magnitudes(state, is_unit):
+    contacts = state.contacts
+    body_i = np.asarray(contacts.body_i, dtype=np.int64)
+    body_j = np.asarray(contacts.body_j, dtype=np.int64)
+    if len(body_i) == 0:
+        return np.zeros(0), np.zeros(0)
+    force = np.linalg.norm(np.asarray(contacts.normal_forces) + np.asarray(contacts.tangential_forces),
+                           axis=1)
+    i_unit = is_unit[body_i]
+    j_unit = (body_j >= 0) & is_unit[np.maximum(body_j, 0)]
+    return force[i_unit & j_unit], force[i_unit ^ j_unit]
+
+
+def _fabric(axes) -> dict:
+    """Eigenvalues S1 >= S2 >= S3 of the normalised orientation tensor of axial data, and the
+    direction (trend, plunge) of the principal (S1) axis."""
+    if len(axes) == 0:
+        return {"S1": float("nan"), "S2": float("nan"), "S3": float("nan")}
+    unit = axes / np.linalg.norm(axes, axis=1)[:, None]
+    tensor = unit.T @ unit / len(unit)
+    values, vectors = np.linalg.eigh(tensor)
+    trend, plunge = trend_plunge(vectors[:, 2])
+    return {"S1": float(values[2]), "S2": float(values[1]), "S3": float(values[0]),
+            "principal_trend_deg": float(trend[0]), "principal_plunge_deg": float(plunge[0])}
+
+
+def analyse_layer(state) -> LayerAnalysis:
+    """Analyse the armour units of ``state`` (a :class:`~riprap.analysis.layer_state.LayerState`)."""
+    layer = state.layer
+    slope = layer.slope
+    bodies = np.asarray(layer.unit_bodies, dtype=np.int64)
+    n_units = len(bodies)
+    group = np.zeros(state.n_bodies, dtype=np.int64)
+    group[bodies] = 1
+    is_unit = group == 1
+    contact_stats = unit_contacts(state.n_bodies, state.contacts, group=group)
+    weights = state.masses() * np.linalg.norm(state.gravity)
+    sliding = sliding_factor_of_safety(state.n_bodies, state.contacts, state.contact_friction())[bodies]
+    rocking = rocking_factor_of_safety(state, bodies, weights, slope)
+
+    # Partners of each unit that are units too.
+    contacts = state.contacts
+    body_i = np.asarray(contacts.body_i, dtype=np.int64)
+    body_j = np.asarray(contacts.body_j, dtype=np.int64)
+    unit_partners = np.zeros(state.n_bodies, dtype=np.int64)
+    both = is_unit[body_i] & (body_j >= 0) & is_unit[np.maximum(body_j, 0)]
+    np.add.at(unit_partners, body_i[both], 1)
+    np.add.at(unit_partners, body_j[both], 1)
+
+    positions = state.positions[bodies]
+    frame = slope.to_slope(positions)
+    design = np.asarray(layer.design_positions, dtype=float).reshape(n_units, 3)
+    columns: dict[str, np.ndarray] = {
+        "unit_id": np.arange(n_units),
+        "body_id": bodies,
+        "row": np.asarray(layer.rows, dtype=np.int64),
+        "x_m": positions[:, 0], "y_m": positions[:, 1], "z_m": positions[:, 2],
+        "along_slope_m": frame[:, 0],
+        "height_above_slope_m": frame[:, 2],
+        "height_above_underlayer_m": frame[:, 2] - layer.underlayer_top,
+        "distance_from_design_m": np.linalg.norm(positions - design, axis=1),
+        "coordination_number": contact_stats.coordination_number[bodies],
+        "unit_contacts": unit_partners[bodies],
+        "underlayer_contacts": contact_stats.coordination_number[bodies] - unit_partners[bodies],
+        "weight_N": weights[bodies],
+        "max_contact_force_N": contact_stats.max_contact_force[bodies],
+        "max_contact_force_unit_unit_N": contact_stats.max_contact_force_unit_unit[bodies],
+        "max_contact_force_unit_underlayer_N": contact_stats.max_contact_force_unit_underlayer[bodies],
+        "max_contact_force_over_weight": contact_stats.max_contact_force[bodies] / weights[bodies],
+        "factor_of_safety": np.minimum(sliding, rocking),
+        "factor_of_safety_sliding": sliding,
+        "factor_of_safety_rocking": rocking,
+    }
+    nose_axes = None
+    for name, axis in layer.unit_axes.items():
+        world = state.rotations[bodies] @ np.asarray(axis, dtype=float)
+        down = lower_hemisphere(world) if n_units else np.zeros((0, 3))
+        trend, plunge = trend_plunge(down) if n_units else (np.zeros(0), np.zeros(0))
+        net = equal_area_points(down) if n_units else np.zeros((0, 2))
+        columns[f"{name}_trend_deg"] = trend
+        columns[f"{name}_plunge_deg"] = plunge
+        columns[f"{name}_net_east"] = net[:, 0]
+        columns[f"{name}_net_north"] = net[:, 1]
+        for component, label in enumerate("xyz"):
+            columns[f"{name}_axis_{label}"] = down[:, component]
+        if name == "nose":
+            nose_axes = down
+
+    unit_unit, unit_underlayer = _pair_force_magnitudes(state, is_unit)
+    dn = layer.nominal_diameter
+    on_face = (frame[:, 0] >= -dn) & (frame[:, 0] <= slope.length)
+    node_sets = [state.world_nodes(b) for b, ok in zip(bodies, on_face) if ok]
+    figures = layer_metrics.layer_figures(
+        slope, positions[on_face], node_sets, rows=columns["row"][on_face], nominal_diameter=dn,
+        unit_volume=layer.unit_volume, underlayer_level=layer.underlayer_top)
+    coordination = columns["coordination_number"]
+    values, counts = np.unique(coordination, return_counts=True)
+    fos = columns["factor_of_safety"]
+    all_forces = np.concatenate([unit_unit, unit_underlayer])
+
+    def percentiles(forces):
+        return {f"p{p}": (float(np.percentile(forces, p)) if len(forces) else 0.0)
+                for p in CONTACT_FORCE_PERCENTILES} | {"max": float(forces.max(initial=0.0)),
+                                                       "mean": float(forces.mean()) if len(forces) else 0.0,
+                                                       "count": int(len(forces))}
+
+    summary = {
+        "source": state.source,
+        "time_s": float(state.time),
+        "unit": layer.unit_kind,
+        "nominal_diameter_m": float(dn),
+        "unit_weight_N": float(weights[bodies].mean()) if n_units else 0.0,
+        "slope_angle_deg": float(slope.angle_deg),
+        "units": int(n_units),
+        "units_on_face": int(on_face.sum()),
+        "underlayer_bodies": int(state.n_bodies - n_units),
+        **figures,
+        "design_packing_density_coefficient": float(layer.design.get("packing_density_coefficient", np.nan)),
+        "design_layer_thickness_m": float(layer.design.get("layer_thickness_m", np.nan)),
+        "design_porosity": float(layer.design.get("porosity", np.nan)),
+        "coordination_number_mean": float(coordination.mean()) if n_units else 0.0,
+        "coordination_number_min": int(coordination.min()) if n_units else 0,
+        "coordination_number_max": int(coordination.max()) if n_units else 0,
+        "coordination_number_histogram": {int(v): int(c) for v, c in zip(values, counts)},
+        "contact_force_N": percentiles(all_forces),
+        "contact_force_unit_unit_N": percentiles(unit_unit),
+        "contact_force_unit_underlayer_N": percentiles(unit_underlayer),
+        "max_contact_force_N": float(columns["max_contact_force_N"].max(initial=0.0)),
+        "factor_of_safety_min": float(fos.min()) if n_units else float("nan"),
+        "factor_of_safety_median": float(np.median(fos)) if n_units else float("nan"),
+        "units_below_factor_of_safety_1": [int(k) for k in np.flatnonzero(fos < 1.0)],
+        "mean_distance_from_design_m": float(columns["distance_from_design_m"].mean()) if n_units else 0.0,
+        "nose_axis_fabric": _fabric(nose_axes) if nose_axes is not None else {},
+    }
+    return LayerAnalysis(units=columns, layer=summary, unit_unit_forces=unit_unit,
+                         unit_underlayer_forces=unit_underlayer, state=state)

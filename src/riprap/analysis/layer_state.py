@@ -1,0 +1,183 @@
+"""What the analysis reads: one state of an armour layer, as flat arrays (no files, no solver).
+
+A :class:`LayerState` is a snapshot of every body (pose, shape, material, fixed or free), the plane
+walls, the contacts between them with their forces, and the :class:`LayerDescription` that says
+which bodies are armour units, where they were meant to go and how the slope lies. It is made
+from a pack folder or a frame of a run by :mod:`riprap.io.analysis_input`, or directly from a
+running :class:`riprap.Simulation` by :func:`state_from_simulation`.
+
+Frames. ``rotations[b]`` turns the mesh of the body's shape, as stored in ``meshes``, into the
+world; a node ``p`` of that mesh is at ``positions[b] + rotations[b] @ (p - mesh_centroids[k])``.
+The unit axes of the description (``unit_axes``) are unit vectors in the frame of the unit's mesh
+as stored, so that a unit's axis in the world is ``rotations[b] @ axis``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from riprap.placement.slope import Slope
+
+__all__ = ["LayerDescription", "LayerState", "state_from_simulation"]
+
+
+@dataclass(frozen=True, eq=False)
+class LayerDescription:
+    """The armour layer of a pack: which bodies are units, their design, the slope.
+
+    Attributes
+    ----------
+    unit_kind : str
+        Armour unit kind (``riprap.geometry.armour_units.UNIT_KINDS``).
+    unit_shape : str
+        Name of the units' shape in the pack.
+    nominal_diameter : float
+        D_n = V^(1/3) of a unit (m).
+    unit_volume : float
+        Volume of one unit (m^3).
+    unit_height : float
+        Characteristic height H of a unit (m).
+    unit_axes : dict of str to (3,) array
+        Named unit vectors in the frame of the unit's mesh as stored (``"nose"`` at least).
+    slope : Slope
+        The face the layer rests on.
+    underlayer_top : float
+        Level of the underlayer's top above the face (m), from which the layer thickness counts.
+    unit_bodies : (n_units,) int
+        Body index of each unit; unit ``k`` of every table is body ``unit_bodies[k]``.
+    rows : (n_units,) int
+        Placement row of each unit.
+    design_positions : (n_units, 3) float
+        Where each unit was meant to go (the grid point of its centroid), world m.
+    design : dict
+        Design figures: ``packing_density_coefficient``, ``layer_thickness_m``, ``porosity``.
+    """
+
+    unit_kind: str
+    unit_shape: str
+    nominal_diameter: float
+    unit_volume: float
+    unit_height: float
+    unit_axes: dict
+    slope: Slope
+    underlayer_top: float
+    unit_bodies: np.ndarray
+    rows: np.ndarray
+    design_positions: np.ndarray
+    design: dict = field(default_factory=dict)
+
+    @property
+    def n_units(self) -> int:
+        return len(self.unit_bodies)
+
+
+@dataclass(frozen=True, eq=False)
+class LayerState:
+    """Bodies, walls and contacts of one state of a layer.
+
+    Attributes
+    ----------
+    positions : (n, 3) float
+        Centroid of each body (m).
+    rotations : (n, 3, 3) float
+        Rotation of each body's mesh (as stored) into the world.
+    shape_of_body : (n,) int
+        Index into ``meshes`` / ``shape_names``.
+    shape_names : list of str
+    meshes : list of TetMesh
+        Each shape's tetrahedral mesh as stored (pack ``shapes/*.vtu``).
+    mesh_centroids : (n_shapes, 3) float
+        Centroid of each mesh (the point that ``positions`` places).
+    material_of_body : (n,) int
+        Index into ``materials``.
+    materials : list of riprap.solid.materials.Material
+    fixed : (n,) bool
+    wall_points, wall_normals : (n_walls, 3) float
+        Plane walls (unit outward normals).
+    wall_materials : (n_walls,) int
+        Index into ``materials``.
+    contacts : riprap.solid.solver.ContactRecords
+        One row per touching pair; forces on ``body_i``; ``body_j = -1 - w`` for wall ``w``.
+    gravity : (3,) float
+        m/s^2.
+    time : float
+        Simulated time of the state (s).
+    layer : LayerDescription
+    source : str
+        Where the state was read from (named in the report and in errors).
+    """
+
+    positions: np.ndarray
+    rotations: np.ndarray
+    shape_of_body: np.ndarray
+    shape_names: list
+    meshes: list
+    mesh_centroids: np.ndarray
+    material_of_body: np.ndarray
+    materials: list
+    fixed: np.ndarray
+    wall_points: np.ndarray
+    wall_normals: np.ndarray
+    wall_materials: np.ndarray
+    contacts: object
+    gravity: np.ndarray
+    time: float
+    layer: LayerDescription
+    source: str = ""
+
+    @property
+    def n_bodies(self) -> int:
+        return len(self.positions)
+
+    def world_nodes(self, body: int) -> np.ndarray:
+        """Nodes of ``body``'s mesh in the world (m)."""
+        k = int(self.shape_of_body[body])
+        local = self.meshes[k].nodes - self.mesh_centroids[k]
+        return local @ self.rotations[body].T + self.positions[body]
+
+    def masses(self) -> np.ndarray:
+        """Mass of each body (kg)."""
+        from riprap.geometry.mass_properties import mass_properties
+
+        volumes = np.array([mass_properties(mesh, density=1.0).volume for mesh in self.meshes])
+        density = np.array([m.density for m in self.materials])
+        return volumes[self.shape_of_body] * density[self.material_of_body]
+
+    def contact_friction(self) -> np.ndarray:
+        """Friction coefficient of each contact row: the smaller of the two materials' (the
+        solver's rule for a pair)."""
+        mu = np.array([m.friction_coefficient for m in self.materials])
+        body_i = np.asarray(self.contacts.body_i, dtype=np.int64)
+        body_j = np.asarray(self.contacts.body_j, dtype=np.int64)
+        first = mu[self.material_of_body[body_i]]
+        is_wall = body_j < 0
+        other_material = np.where(is_wall, self.wall_materials[np.where(is_wall, -1 - body_j, 0)]
+                                  if len(self.wall_materials) else 0,
+                                  self.material_of_body[np.maximum(body_j, 0)])
+        return np.minimum(first, mu[other_material])
+
+
+def state_from_simulation(sim, layer: LayerDescription, *, source: str = "simulation") -> LayerState:
+    """The current state of a :class:`riprap.Simulation` (its solver's bodies, walls and contacts)."""
+    from riprap.geometry.mass_properties import mass_properties
+
+    solver = sim.solver
+    meshes = [shape.mesh for shape in solver.shapes]
+    names = [None] * len(meshes)
+    for name, index in sim._shape_names.items():
+        names[index] = name
+    walls = solver.walls
+    material_index = {m.name: k for k, m in enumerate(solver.materials)}
+    return LayerState(
+        positions=solver.positions.copy(), rotations=solver.rotation_matrices().copy(),
+        shape_of_body=np.asarray(solver.shape_index, dtype=np.int64).copy(), shape_names=names,
+        meshes=meshes,
+        mesh_centroids=np.array([mass_properties(mesh, density=1.0).centroid for mesh in meshes]),
+        material_of_body=np.asarray(solver.material_index_of_body, dtype=np.int64).copy(),
+        materials=list(solver.materials), fixed=np.asarray(solver.fixed, dtype=bool).copy(),
+        wall_points=np.array([w.point for w in walls], dtype=float).reshape(-1, 3),
+        wall_normals=np.array([w.normal for w in walls], dtype=float).reshape(-1, 3),
+        wall_materials=np.array([material_index[w.material] for w in walls], dtype=np.int64),
+        contacts=solver.contacts, gravity=np.asarray(solver.gravity, dtype=float).copy(),
+        time=float(solver.time), layer=layer, source=source)

@@ -1,0 +1,242 @@
+"""Pictures of an analysed armour layer (matplotlib; PNG and SVG).
+
+- ``stereonet``: lower-hemisphere equal-area (Schmidt) net of the units' nose axes, points and
+  density contours (exponential Kamb, mplstereonet; multiples of the density of uniformly random
+  axes), with the fabric eigenvalues in the title;
+- ``layer_<field>``: the units in 3D coloured by a per-unit value (PNG only: a layer has too many
+  faces for a useful SVG);
+- ``slope_<field>``: the layer seen square onto the face (s up the slope, y across), each unit as
+  the outline of its footprint on the face, coloured by a per-unit value, with the underlayer's
+  extent drawn in grey;
+- ``histograms``: coordination numbers, contact forces (unit-unit and unit-underlayer) and
+  factors of safety.
+"""
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["stereonet_figure", "layer_view_png", "slope_view_figure", "histogram_figure",
+           "comparison_stereonets", "comparison_histograms", "PER_UNIT_FIELDS"]
+
+#: Per-unit fields drawn on the layer, with their colour-bar labels and colour maps.
+PER_UNIT_FIELDS = {
+    "max_contact_force_N": ("largest contact force (N)", "viridis"),
+    "coordination_number": ("coordination number (bodies and walls touched)", "plasma"),
+    "factor_of_safety": ("factor of safety (smaller of sliding and rocking)", "RdYlGn"),
+}
+# Factors of safety above this are drawn with the top colour (inf when nothing drives a unit).
+_FOS_DISPLAY_CAP = 5.0
+_DOTS_PER_INCH = 150
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(figure, path: Path, formats=("png", "svg")) -> list[Path]:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    written = []
+    for suffix in formats:
+        target = path.with_suffix(f".{suffix}")
+        figure.savefig(target, dpi=_DOTS_PER_INCH, bbox_inches="tight")
+        written.append(target)
+    _pyplot().close(figure)
+    return written
+
+
+def _display_values(column: str, values) -> np.ndarray:
+    values = np.asarray(values, dtype=float)
+    if column.startswith("factor_of_safety"):
+        return np.minimum(values, _FOS_DISPLAY_CAP)
+    return values
+
+
+def _draw_stereonet(axes, trend, plunge, title, title_pad=26):
+    if len(trend) >= 3:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            contours = axes.density_contourf(plunge, trend, measurement="lines",
+                                             method="exponential_kamb", cmap="Blues")
+    else:
+        contours = None
+    axes.line(plunge, trend, marker="o", markersize=3.5, color="black", linestyle="none")
+    axes.grid(True, linewidth=0.4, alpha=0.6)
+    axes.set_azimuth_ticks([])
+    for x, y, label in ((0.5, 1.035, "N"), (1.035, 0.5, "E"), (0.5, -0.035, "S"), (-0.035, 0.5, "W")):
+        axes.text(x, y, label, transform=axes.transAxes, fontsize=9, ha="center", va="center",
+                  fontweight="bold")
+    axes.set_title(title, fontsize=10, pad=title_pad)
+    return contours
+
+
+def stereonet_figure(path, trend, plunge, *, title: str, slope_dip_direction_deg=None) -> list[Path]:
+    """Nose axes on a lower-hemisphere equal-area net, with density contours (PNG and SVG).
+
+    ``slope_dip_direction_deg``: trend of the direction down the face (drawn as the face's pole
+    for reference), or None."""
+    import mplstereonet  # noqa: F401  (registers the "stereonet" projection)
+
+    plt = _pyplot()
+    figure = plt.figure(figsize=(6.6, 7.0))
+    axes = figure.add_subplot(111, projection="stereonet")
+    contours = _draw_stereonet(axes, np.asarray(trend), np.asarray(plunge), "", title_pad=0)
+    figure.suptitle(title, fontsize=10)
+    if slope_dip_direction_deg is not None:
+        axes.pole(slope_dip_direction_deg[0] - 90.0, slope_dip_direction_deg[1], marker="^",
+                  color="crimson", markersize=8, label="pole of the slope face")
+        axes.legend(loc="lower left", fontsize=8, bbox_to_anchor=(-0.1, -0.12))
+    if contours is not None:
+        bar = figure.colorbar(contours, ax=axes, shrink=0.6, pad=0.1)
+        bar.set_label("density (multiples of uniform)", fontsize=8)
+    return _save(figure, Path(path))
+
+
+def layer_view_png(path, analysis, column: str) -> Path:
+    """The units in 3D coloured by ``column`` of ``analysis.units`` (PNG)."""
+    from riprap.io.picture import render_bodies_png
+
+    state = analysis.state
+    bodies = state.layer.unit_bodies
+    triangles, owners = [], []
+    for body in bodies:
+        mesh = state.meshes[state.shape_of_body[body]]
+        faces = mesh.boundary_faces()
+        triangles.append(state.world_nodes(body)[faces])
+        owners.append(np.full(len(faces), body, dtype=np.int64))
+    label, _ = PER_UNIT_FIELDS.get(column, (column, "viridis"))
+    values = _display_values(column, analysis.body_values(column))
+    return render_bodies_png(path, triangles_world=triangles, body_ids=np.concatenate(owners),
+                             values=values, value_label=label,
+                             title=f"{len(bodies)} units: {label}", view=(30, -125))
+
+
+def _footprints(state, bodies):
+    """Outline (convex hull in the face's (s, y) plane) of each body."""
+    from scipy.spatial import ConvexHull
+
+    slope = state.layer.slope
+    outlines = []
+    for body in bodies:
+        sy = slope.to_slope(state.world_nodes(body))[:, :2]
+        hull = ConvexHull(sy)
+        outlines.append(sy[hull.vertices][:, ::-1])       # (y, s): y across, s up the page
+    return outlines
+
+
+def slope_view_figure(path, analysis, column: str) -> list[Path]:
+    """The layer seen square onto the face, units coloured by ``column`` (PNG and SVG)."""
+    from matplotlib.collections import PolyCollection
+
+    plt = _pyplot()
+    state = analysis.state
+    layer = state.layer
+    label, colour_map = PER_UNIT_FIELDS.get(column, (column, "viridis"))
+    outlines = _footprints(state, layer.unit_bodies)
+    values = _display_values(column, analysis.units[column])
+    extent_s = max(o[:, 1].max() for o in outlines) if outlines else layer.slope.length
+    figure, axes = plt.subplots(figsize=(7.5, 2.0 + 6.0 * min(extent_s / layer.slope.width, 2.0)))
+    rocks = np.setdiff1d(np.arange(state.n_bodies), layer.unit_bodies)
+    if len(rocks):
+        rock_sy = layer.slope.to_slope(state.positions[rocks])
+        axes.scatter(rock_sy[:, 1], rock_sy[:, 0], s=2, color="0.75", zorder=0,
+                     label="underlayer rock centroids")
+    collection = PolyCollection(outlines, array=values, cmap=colour_map, edgecolors="black",
+                                linewidths=0.4)
+    if column.startswith("factor_of_safety"):
+        collection.set_clim(0.0, _FOS_DISPLAY_CAP)
+    axes.add_collection(collection)
+    if len(outlines) <= 60:
+        for k, outline in enumerate(outlines):
+            centre = outline.mean(axis=0)
+            axes.text(centre[0], centre[1], str(k), ha="center", va="center", fontsize=6)
+    axes.set_xlim(0.0, layer.slope.width)
+    all_s = np.concatenate([o[:, 1] for o in outlines]) if outlines else np.zeros(1)
+    axes.set_ylim(min(all_s.min(), 0.0) - 0.05 * layer.nominal_diameter,
+                  all_s.max() + 0.3 * layer.nominal_diameter)
+    axes.set_aspect("equal")
+    axes.set_xlabel("y across the flume (m)")
+    axes.set_ylabel("s up the slope from the toe (m)")
+    axes.set_title(f"Seen square onto the 1:{layer.slope.cotangent:g} face: {label}", fontsize=10)
+    bar = figure.colorbar(collection, ax=axes, shrink=0.8)
+    bar.set_label(label, fontsize=8)
+    if len(rocks):
+        axes.legend(loc="upper right", fontsize=7, markerscale=3)
+    return _save(figure, Path(path))
+
+
+def _histogram_axes(axes, analysis, label=None, colour=None):
+    units = analysis.units
+    coordination = units["coordination_number"]
+    low, high = (int(coordination.min()), int(coordination.max())) if len(coordination) else (0, 0)
+    bins = np.arange(low, high + 2) - 0.5
+    axes[0].hist(coordination, bins=bins, color=colour, alpha=0.6 if label else 0.9,
+                 edgecolor="black", linewidth=0.4, label=label)
+    axes[0].set_xlabel("coordination number")
+    axes[0].set_ylabel("units")
+    forces = [analysis.unit_unit_forces, analysis.unit_underlayer_forces]
+    positive = np.concatenate(forces)
+    positive = positive[positive > 0]
+    if len(positive):
+        edges = np.geomspace(positive.min(), positive.max() * 1.0001, 25)
+        names = ("unit-unit", "unit-underlayer")
+        for k, values in enumerate(forces):
+            values = values[values > 0]
+            if len(values):
+                axes[1].hist(values, bins=edges, histtype="step", linewidth=1.4,
+                             linestyle="-" if k == 0 else "--", color=colour,
+                             label=f"{label + ': ' if label else ''}{names[k]}")
+        axes[1].set_xscale("log")
+        axes[1].legend(fontsize=7)
+    axes[1].set_xlabel("contact force (N)")
+    axes[1].set_ylabel("contacts")
+    fos = _display_values("factor_of_safety", units["factor_of_safety"])
+    axes[2].hist(fos, bins=np.linspace(0.0, _FOS_DISPLAY_CAP, 26), color=colour,
+                 alpha=0.6 if label else 0.9, edgecolor="black", linewidth=0.4, label=label)
+    axes[2].axvline(1.0, color="crimson", linewidth=1.0)
+    axes[2].set_xlabel(f"factor of safety (>= {_FOS_DISPLAY_CAP:g} in the last bin)")
+    axes[2].set_ylabel("units")
+
+
+def histogram_figure(path, analysis) -> list[Path]:
+    """Coordination numbers, contact forces and factors of safety (PNG and SVG)."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(1, 3, figsize=(13.0, 3.6))
+    _histogram_axes(axes, analysis)
+    figure.tight_layout()
+    return _save(figure, Path(path))
+
+
+def comparison_stereonets(path, analyses, labels) -> list[Path]:
+    """Nose-axis stereonets of several layers side by side (PNG and SVG)."""
+    import mplstereonet  # noqa: F401
+
+    plt = _pyplot()
+    figure = plt.figure(figsize=(5.2 * len(analyses), 5.6))
+    for k, (analysis, label) in enumerate(zip(analyses, labels)):
+        axes = figure.add_subplot(1, len(analyses), k + 1, projection="stereonet")
+        fabric = analysis.layer.get("nose_axis_fabric", {})
+        _draw_stereonet(axes, analysis.units["nose_trend_deg"], analysis.units["nose_plunge_deg"],
+                        f"{label}: {len(analysis.units['unit_id'])} nose axes\n"
+                        f"S1 {fabric.get('S1', float('nan')):.2f}, S3 {fabric.get('S3', float('nan')):.2f}")
+    return _save(figure, Path(path))
+
+
+def comparison_histograms(path, analyses, labels) -> list[Path]:
+    """Histograms of several layers overlaid (PNG and SVG)."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(1, 3, figsize=(13.0, 3.6))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for k, (analysis, label) in enumerate(zip(analyses, labels)):
+        _histogram_axes(axes, analysis, label=label, colour=colours[k % len(colours)])
+    axes[0].legend(fontsize=7)
+    axes[2].legend(fontsize=7)
+    figure.tight_layout()
+    return _save(figure, Path(path))

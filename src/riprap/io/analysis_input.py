@@ -1,0 +1,223 @@
+"""Reading what ``riprap analyse`` analyses: a pack folder, or one frame of a run started from one.
+
+- A pack (``riprap place``'s output folder, or its ``pack.toml``): poses from ``pack.toml``, shapes
+  from ``shapes/*.vtu``, contact forces from ``contacts.csv``, the layer from ``layer.json``
+  (:mod:`riprap.io.layer_file`).
+- A run (the output folder of ``riprap run pack.toml``): its ``summary.json`` names the case it
+  ran (``case_file``), which must be a pack; a frame of ``bodies.pvd`` gives every body's world
+  surface, from which its pose is fitted exactly (the rotation that carries the stored mesh's
+  surface nodes onto the frame's, Kabsch 1976, Acta Cryst. A32: 922), and the same frame of
+  ``contacts.pvd`` gives the contacts with their forces.
+"""
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from riprap.errors import CaseFileError
+
+__all__ = ["load_layer_state", "load_pack_state", "load_run_state", "is_run_folder"]
+
+
+def _pack_folder(path: Path) -> tuple[Path, Path]:
+    from riprap.io.pack import PACK_FILE_NAME
+
+    if path.is_dir():
+        return path, path / PACK_FILE_NAME
+    return path.parent, path
+
+
+def is_run_folder(path) -> bool:
+    """Whether ``path`` is the output folder of a run (``bodies.pvd`` and ``summary.json``) and
+    not a pack folder."""
+    path = Path(path)
+    return (path.is_dir() and (path / "bodies.pvd").is_file()
+            and not (path / "pack.toml").is_file())
+
+
+def load_layer_state(path, *, frame: int = -1):
+    """A :class:`~riprap.analysis.layer_state.LayerState` from a pack folder or file, or from
+    frame ``frame`` (index into the run's frames, -1 the last) of a run folder."""
+    path = Path(path)
+    if not path.exists():
+        raise CaseFileError(f"{path}: no such pack or run folder")
+    if is_run_folder(path):
+        return load_run_state(path, frame=frame)
+    return load_pack_state(path)
+
+
+def _case_parts(pack_file: Path):
+    """Case, shape meshes and centroids, materials, walls of a pack file."""
+    from riprap.case.build import build_material, build_shape
+    from riprap.case.load import load_case
+    from riprap.geometry.mass_properties import mass_properties
+
+    case = load_case(pack_file)
+    if case.body_grids:
+        raise CaseFileError(f"{pack_file}: has [[body_grids]]; a pack lists every body in [[bodies]]")
+    shape_names = [spec.name for spec in case.shapes]
+    meshes = [build_shape(spec) for spec in case.shapes]
+    centroids = np.array([mass_properties(mesh, density=1.0).centroid for mesh in meshes])
+    materials = [build_material(spec) for spec in case.materials]
+    material_names = [m.name for m in materials]
+    planes = [w for w in case.walls if w.type == "plane"]
+    if len(planes) != len(case.walls):
+        raise CaseFileError(f"{pack_file}: the analysis reads plane walls only (a pack writes its "
+                            "container as planes); found a box wall")
+    walls = (np.array([w.parameters["point"] for w in planes], dtype=float).reshape(-1, 3),
+             np.array([w.parameters["normal"] for w in planes], dtype=float).reshape(-1, 3),
+             np.array([material_names.index(w.material) for w in planes], dtype=np.int64))
+    return case, shape_names, meshes, centroids, materials, walls
+
+
+def _rotation_matrices(quaternions) -> np.ndarray:
+    q = np.asarray(quaternions, dtype=float).reshape(-1, 4)
+    if len(q) == 0:
+        return np.zeros((0, 3, 3))
+    return Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix()
+
+
+def _check_layer_against_case(layer, case, shape_names, pack_file) -> None:
+    if layer.unit_shape not in shape_names:
+        raise CaseFileError(f"{pack_file.parent / 'layer.json'}: unit_shape '{layer.unit_shape}' is "
+                            f"not a shape of {pack_file} (shapes: {', '.join(shape_names)})")
+    wrong = [int(b) for b in layer.unit_bodies if case.bodies[b].shape != layer.unit_shape]
+    if wrong:
+        raise CaseFileError(f"{pack_file.parent / 'layer.json'}: unit_bodies {wrong[:5]} are not "
+                            f"'{layer.unit_shape}' bodies in {pack_file}")
+
+
+def _check_contacts(contacts, n_bodies, n_walls, where) -> None:
+    body_i, body_j = np.asarray(contacts.body_i), np.asarray(contacts.body_j)
+    bad = (body_i < 0) | (body_i >= n_bodies) | (body_j >= n_bodies) | (body_j < -n_walls)
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        raise CaseFileError(f"{where}: contact {row} joins body {int(body_i[row])} and "
+                            f"{int(body_j[row])}, but there are {n_bodies} bodies and {n_walls} walls")
+
+
+def load_pack_state(path):
+    """The state of a pack folder (or its ``pack.toml``)."""
+    from riprap.analysis.layer_state import LayerState
+    from riprap.io.layer_file import CONTACTS_FILE_NAME, read_contact_table, read_layer_file
+
+    folder, pack_file = _pack_folder(Path(path))
+    case, shape_names, meshes, centroids, materials, walls = _case_parts(pack_file)
+    n_bodies = len(case.bodies)
+    layer = read_layer_file(folder, n_bodies=n_bodies)
+    _check_layer_against_case(layer, case, shape_names, pack_file)
+    contacts = read_contact_table(folder / CONTACTS_FILE_NAME)
+    _check_contacts(contacts, n_bodies, len(walls[0]), folder / CONTACTS_FILE_NAME)
+    return LayerState(
+        positions=np.array([b.position for b in case.bodies], dtype=float).reshape(-1, 3),
+        rotations=_rotation_matrices([b.orientation for b in case.bodies]),
+        shape_of_body=np.array([shape_names.index(b.shape) for b in case.bodies], dtype=np.int64),
+        shape_names=shape_names, meshes=meshes, mesh_centroids=centroids,
+        material_of_body=np.array([[m.name for m in materials].index(b.material)
+                                   for b in case.bodies], dtype=np.int64),
+        materials=materials, fixed=np.array([b.fixed for b in case.bodies], dtype=bool),
+        wall_points=walls[0], wall_normals=walls[1], wall_materials=walls[2],
+        contacts=contacts, gravity=np.asarray(case.simulation.gravity, dtype=float),
+        time=0.0, layer=layer, source=str(pack_file))
+
+
+def _pvd_frames(pvd: Path) -> list[tuple[float, str]]:
+    try:
+        root = ElementTree.parse(pvd).getroot()
+        return sorted((float(d.attrib["timestep"]), d.attrib["file"]) for d in root.iter("DataSet"))
+    except (ElementTree.ParseError, KeyError, ValueError, OSError) as error:
+        raise CaseFileError(f"{pvd}: cannot read the ParaView series: {error}") from None
+
+
+def _fit_pose(local, world, centroid):
+    """Rotation R and position p with world = p + R (local - centroid), least squares (exact for a
+    rigid motion)."""
+    local_mean, world_mean = local.mean(axis=0), world.mean(axis=0)
+    covariance = (world - world_mean).T @ (local - local_mean)
+    u, _, vt = np.linalg.svd(covariance)
+    d = np.sign(np.linalg.det(u @ vt))
+    rotation = u @ np.diag([1.0, 1.0, d]) @ vt
+    return rotation, world_mean - rotation @ (local_mean - centroid)
+
+
+def load_run_state(run_folder, *, frame: int = -1):
+    """The state at frame ``frame`` (index into ``bodies.pvd``'s list, -1 the last) of a run
+    started from a pack."""
+    import meshio
+
+    from riprap.analysis.layer_state import LayerState
+    from riprap.io.layer_file import read_layer_file
+
+    run_folder = Path(run_folder)
+    summary_path = run_folder / "summary.json"
+    try:
+        summary = json.loads(summary_path.read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError) as error:
+        raise CaseFileError(f"{summary_path}: cannot read the run summary ({error}); the analysis "
+                            "of a run needs it to find the case the run was started from") from None
+    case_file = summary.get("case_file")
+    if not case_file:
+        raise CaseFileError(f"{summary_path}: no 'case_file' (runs of this riprap version record "
+                            "the case they ran); analyse the pack instead, or run it again")
+    pack_file = Path(case_file)
+    case, shape_names, meshes, centroids, materials, walls = _case_parts(pack_file)
+    n_bodies = len(case.bodies)
+    layer = read_layer_file(pack_file.parent, n_bodies=n_bodies)
+    _check_layer_against_case(layer, case, shape_names, pack_file)
+    frames = _pvd_frames(run_folder / "bodies.pvd")
+    contact_frames = dict(_pvd_frames(run_folder / "contacts.pvd"))
+    if not frames:
+        raise CaseFileError(f"{run_folder / 'bodies.pvd'}: lists no frames")
+    if not -len(frames) <= frame < len(frames):
+        raise CaseFileError(f"{run_folder}: frame {frame} does not exist; the run wrote "
+                            f"{len(frames)} frames (0..{len(frames) - 1}, or -1 for the last)")
+    time, body_file = frames[frame]
+    if time not in contact_frames:
+        raise CaseFileError(f"{run_folder / 'contacts.pvd'}: no frame at t = {time!r} s")
+    bodies_mesh = meshio.read(run_folder / body_file)
+    points = np.asarray(bodies_mesh.points, dtype=float)
+    triangles = np.asarray(bodies_mesh.cells_dict["triangle"], dtype=np.int64)
+    owners = np.asarray(bodies_mesh.cell_data_dict["body_id"]["triangle"], dtype=np.int64)
+    shape_of_body = np.array([shape_names.index(b.shape) for b in case.bodies], dtype=np.int64)
+    if owners.max(initial=-1) + 1 != n_bodies:
+        raise CaseFileError(f"{run_folder / body_file}: has {owners.max(initial=-1) + 1} bodies, "
+                            f"{pack_file} {n_bodies}: the run was not started from this pack")
+    rotations = np.empty((n_bodies, 3, 3))
+    positions = np.empty((n_bodies, 3))
+    order = np.argsort(owners, kind="stable")
+    starts = np.searchsorted(owners[order], np.arange(n_bodies + 1))
+    for b in range(n_bodies):
+        world = points[np.unique(triangles[order[starts[b]:starts[b + 1]]])]
+        k = shape_of_body[b]
+        local = meshes[k].nodes[np.unique(meshes[k].boundary_faces())]
+        if len(local) != len(world):
+            raise CaseFileError(f"{run_folder / body_file}: body {b} has {len(world)} surface "
+                                f"nodes, its shape '{shape_names[k]}' {len(local)}")
+        rotations[b], positions[b] = _fit_pose(local, world, centroids[k])
+    contact_mesh = meshio.read(run_folder / contact_frames[time])
+    data = contact_mesh.point_data
+    from riprap.solid.solver import ContactRecords
+
+    count = len(contact_mesh.points)
+    contacts = ContactRecords(
+        body_i=np.asarray(data.get("body_i", np.zeros(0)), dtype=np.int64).reshape(count),
+        body_j=np.asarray(data.get("body_j", np.zeros(0)), dtype=np.int64).reshape(count),
+        points=np.asarray(contact_mesh.points, dtype=float).reshape(-1, 3),
+        normal_forces=np.asarray(data["normal_force"], dtype=float).reshape(-1, 3),
+        tangential_forces=np.asarray(data["tangential_force"], dtype=float).reshape(-1, 3),
+        stiffness=np.zeros(count))
+    _check_contacts(contacts, n_bodies, len(walls[0]), run_folder / contact_frames[time])
+    return LayerState(
+        positions=positions, rotations=rotations, shape_of_body=shape_of_body,
+        shape_names=shape_names, meshes=meshes, mesh_centroids=centroids,
+        material_of_body=np.array([[m.name for m in materials].index(b.material)
+                                   for b in case.bodies], dtype=np.int64),
+        materials=materials, fixed=np.array([b.fixed for b in case.bodies], dtype=bool),
+        wall_points=walls[0], wall_normals=walls[1], wall_materials=walls[2],
+        contacts=contacts, gravity=np.asarray(case.simulation.gravity, dtype=float),
+        time=float(time), layer=layer, source=f"{run_folder} frame {frame} (t = {time:g} s)")
+

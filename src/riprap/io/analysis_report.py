@@ -1,0 +1,251 @@
+"""Files of ``riprap analyse``: tables, ParaView output, pictures and a one-page HTML report.
+
+In the output folder (every column and unit in ``docs/outputs.md``):
+
+- ``units.csv``: one row per unit (``LayerAnalysis.units``), ``unit_id`` first;
+- ``contacts.csv``: every contact of the state (:func:`riprap.io.layer_file.write_contact_table`);
+- ``layer_summary.json``: the layer figures (``LayerAnalysis.layer``);
+- ``layer.vtu``: the units' surfaces with per-body ``body_id``, ``unit_id``,
+  ``coordination_number``, ``max_contact_force``, ``factor_of_safety`` (and the sliding and
+  rocking ones) for ParaView; ``underlayer.vtu`` the rocks;
+- ``stereonet.png``/``.svg``, ``layer_<field>.png``, ``slope_<field>.png``/``.svg``,
+  ``histograms.png``/``.svg``;
+- ``report.html``: the summary table and the pictures on one page.
+
+:func:`write_comparison` puts several analysed layers side by side (``comparison.html``).
+"""
+from __future__ import annotations
+
+import html
+import math
+from pathlib import Path
+
+import numpy as np
+
+from riprap.io.summary import write_json
+
+__all__ = ["write_analysis", "write_comparison", "write_units_csv", "SUMMARY_ROWS"]
+
+#: Rows of the report's summary table: (key of LayerAnalysis.layer, label, format).
+SUMMARY_ROWS = (
+    ("units", "units", "{:d}"),
+    ("underlayer_bodies", "underlayer bodies (rocks)", "{:d}"),
+    ("packing_density_coefficient", "packing density coefficient phi = N Dn^2 / A", "{:.3f}"),
+    ("design_packing_density_coefficient", "  design", "{:.3f}"),
+    ("porosity", "layer porosity", "{:.3f}"),
+    ("design_porosity", "  design", "{:.3f}"),
+    ("layer_thickness_m", "layer thickness (m)", "{:.3f}"),
+    ("design_layer_thickness_m", "  design (m)", "{:.3f}"),
+    ("coordination_number_mean", "mean coordination number", "{:.2f}"),
+    ("coordination_number_min", "smallest coordination number", "{:d}"),
+    ("coordination_number_max", "largest coordination number", "{:d}"),
+    ("max_contact_force_N", "largest contact force on a unit (N)", "{:.4g}"),
+    ("unit_weight_N", "weight of a unit (N)", "{:.4g}"),
+    ("factor_of_safety_min", "smallest factor of safety", "{:.3f}"),
+    ("factor_of_safety_median", "median factor of safety", "{:.3f}"),
+    ("mean_distance_from_design_m", "mean distance from the design position (m)", "{:.3f}"),
+)
+
+
+def _csv_number(value) -> str:
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    number = float(value)
+    if math.isinf(number):
+        return "inf" if number > 0 else "-inf"
+    return repr(number)
+
+
+def write_units_csv(path, units: dict) -> Path:
+    """One row per unit, the columns of ``units`` in order."""
+    path = Path(path)
+    names = list(units)
+    lines = [",".join(names)]
+    for k in range(len(units[names[0]]) if names else 0):
+        lines.append(",".join(_csv_number(units[name][k]) for name in names))
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def _write_paraview(out: Path, analysis) -> dict:
+    from riprap.io.vtk import write_vtu
+
+    state = analysis.state
+    unit_of_body = np.full(state.n_bodies, -1, dtype=np.int64)
+    unit_of_body[state.layer.unit_bodies] = np.arange(len(state.layer.unit_bodies))
+    written = {}
+    for name, bodies in (("layer", state.layer.unit_bodies),
+                         ("underlayer", np.setdiff1d(np.arange(state.n_bodies),
+                                                     state.layer.unit_bodies))):
+        if len(bodies) == 0:
+            continue
+        points, triangles, owners, offset = [], [], [], 0
+        for body in bodies:
+            faces = state.meshes[state.shape_of_body[body]].boundary_faces()
+            used, local = np.unique(faces, return_inverse=True)
+            points.append(state.world_nodes(body)[used])
+            triangles.append(local.reshape(faces.shape) + offset)
+            owners.append(np.full(len(faces), body, dtype=np.int64))
+            offset += len(used)
+        owners = np.concatenate(owners)
+        cell_data = {"body_id": owners, "unit_id": unit_of_body[owners]}
+        if name == "layer":
+            for column, label in (("coordination_number", "coordination_number"),
+                                  ("max_contact_force_N", "max_contact_force"),
+                                  ("factor_of_safety", "factor_of_safety"),
+                                  ("factor_of_safety_sliding", "factor_of_safety_sliding"),
+                                  ("factor_of_safety_rocking", "factor_of_safety_rocking"),
+                                  ("row", "row")):
+                values = analysis.body_values(column)[owners]
+                # ParaView colours inf badly; a large finite number reads as "no driving load".
+                cell_data[label] = np.where(np.isinf(values), 1.0e30, values)
+        path = out / f"{name}.vtu"
+        write_vtu(path, points=np.concatenate(points), cells=np.concatenate(triangles),
+                  cell_type="triangle", cell_data=cell_data)
+        written[f"paraview_{name}"] = str(path)
+    return written
+
+
+def _summary_table(layers: list[dict], labels: list[str]) -> str:
+    head = "".join(f"<th>{html.escape(label)}</th>" for label in labels)
+    rows = []
+    for key, label, fmt in SUMMARY_ROWS:
+        cells = []
+        for layer in layers:
+            value = layer.get(key)
+            try:
+                text = fmt.format(value) if value is not None and not (
+                    isinstance(value, float) and math.isnan(value)) else "-"
+            except (ValueError, TypeError):
+                text = str(value)
+            cells.append(f"<td>{html.escape(text)}</td>")
+        rows.append(f"<tr><th class='name'>{html.escape(label)}</th>{''.join(cells)}</tr>")
+    return f"<table><tr><th></th>{head}</tr>{''.join(rows)}</table>"
+
+
+_STYLE = """
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 72em; color: #222; }
+h1 { font-size: 1.5em; } h2 { font-size: 1.15em; margin-top: 1.6em; border-bottom: 1px solid #ccc; }
+table { border-collapse: collapse; font-size: 0.9em; }
+td, th { padding: 0.2em 0.8em; border-bottom: 1px solid #eee; text-align: right; }
+th.name { text-align: left; font-weight: normal; }
+.figures { display: flex; flex-wrap: wrap; gap: 1em; } .figures img { max-width: 34em; }
+img.wide { max-width: 100%; } .note { color: #555; font-size: 0.85em; }
+"""
+
+
+def _page(title: str, body: str) -> str:
+    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
+            f"<style>{_STYLE}</style></head><body><h1>{html.escape(title)}</h1>{body}</body></html>\n")
+
+
+def _lowest_fos_table(units: dict, count: int = 10) -> str:
+    order = np.argsort(units["factor_of_safety"], kind="stable")[:count]
+    columns = (("unit_id", "{:d}"), ("row", "{:d}"), ("coordination_number", "{:d}"),
+               ("max_contact_force_N", "{:.4g}"), ("factor_of_safety_sliding", "{:.3f}"),
+               ("factor_of_safety_rocking", "{:.3f}"), ("height_above_underlayer_m", "{:.3f}"))
+    head = "".join(f"<th>{name}</th>" for name, _ in columns)
+    rows = "".join("<tr>" + "".join(f"<td>{fmt.format(units[name][k].item())}</td>"
+                                    for name, fmt in columns) + "</tr>" for k in order)
+    return f"<table><tr>{head}</tr>{rows}</table>"
+
+
+def write_analysis(out, analysis) -> dict:
+    """Every file of one analysed layer in ``out``; returns ``{what: path}``."""
+    from riprap.io import analysis_figures as figures
+    from riprap.io.layer_file import write_contact_table
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    state, layer, units = analysis.state, analysis.layer, analysis.units
+    outputs = {"units": str(write_units_csv(out / "units.csv", units)),
+               "contacts": str(write_contact_table(out / "contacts.csv", state.contacts)),
+               "summary": str(write_json(out / "layer_summary.json", layer))}
+    outputs.update(_write_paraview(out, analysis))
+    fabric = layer.get("nose_axis_fabric", {})
+    slope = state.layer.slope
+    figures.stereonet_figure(
+        out / "stereonet.png", units["nose_trend_deg"], units["nose_plunge_deg"],
+        title=(f"Nose axes of {layer['units']} {layer['unit']} units, lower hemisphere, equal area\n"
+               f"fabric S1 {fabric.get('S1', float('nan')):.2f}, S2 {fabric.get('S2', float('nan')):.2f}, "
+               f"S3 {fabric.get('S3', float('nan')):.2f} (random: 0.33 each)"),
+        slope_dip_direction_deg=(270.0, slope.angle_deg))
+    outputs["stereonet"] = str(out / "stereonet.png")
+    for column in figures.PER_UNIT_FIELDS:
+        outputs[f"layer_{column}"] = str(figures.layer_view_png(out / f"layer_{column}.png",
+                                                                analysis, column))
+        figures.slope_view_figure(out / f"slope_{column}.png", analysis, column)
+        outputs[f"slope_{column}"] = str(out / f"slope_{column}.png")
+    figures.histogram_figure(out / "histograms.png", analysis)
+    outputs["histograms"] = str(out / "histograms.png")
+    outputs["report"] = str(_write_report(out, analysis))
+    return outputs
+
+
+def _write_report(out: Path, analysis) -> Path:
+    from riprap.io.analysis_figures import PER_UNIT_FIELDS
+
+    layer, units = analysis.layer, analysis.units
+    histogram = ", ".join(f"{k}: {v}" for k, v in layer["coordination_number_histogram"].items())
+    low = layer["units_below_factor_of_safety_1"]
+    fields = "".join(
+        f"<h2>{html.escape(label.capitalize())}</h2><div class='figures'>"
+        f"<img src='layer_{column}.png' alt='layer, {html.escape(label)}'>"
+        f"<img src='slope_{column}.svg' alt='face view, {html.escape(label)}'></div>"
+        for column, (label, _) in PER_UNIT_FIELDS.items())
+    body = (
+        f"<p class='note'>Analysed: {html.escape(str(layer['source']))}, t = {layer['time_s']:g} s. "
+        f"{layer['units']} {html.escape(layer['unit'])} units (D<sub>n</sub> = "
+        f"{layer['nominal_diameter_m']:.3f} m) on a {layer['slope_angle_deg']:.1f}&deg; slope. "
+        "Tables: <a href='units.csv'>units.csv</a> (one row per unit), "
+        "<a href='contacts.csv'>contacts.csv</a>, <a href='layer_summary.json'>layer_summary.json</a>; "
+        "ParaView: <code>layer.vtu</code>, <code>underlayer.vtu</code>.</p>"
+        f"<h2>Summary</h2>{_summary_table([layer], ['this layer'])}"
+        f"<p>Coordination numbers (value: units): {html.escape(histogram)}. "
+        f"Units with a factor of safety below 1: {len(low)}"
+        f"{' (' + ', '.join(map(str, low[:20])) + (' ...' if len(low) > 20 else '') + ')' if low else ''}.</p>"
+        "<h2>Orientation of the nose axes</h2><div class='figures'>"
+        "<img src='stereonet.svg' alt='stereonet of the nose axes'></div>"
+        f"{fields}"
+        "<h2>Distributions</h2><img class='wide' src='histograms.svg' alt='histograms'>"
+        f"<h2>Units with the smallest factor of safety</h2>{_lowest_fos_table(units)}"
+        "<p class='note'>Definitions. Coordination number: bodies and walls a unit touches. Largest "
+        "contact force: magnitude of the normal plus friction force of the unit's most loaded "
+        "contact. Factor of safety against sliding: sum of mu |N| over sum of |T| of the unit's "
+        "contacts (limit equilibrium). Against rocking: restoring over overturning moments of the "
+        "weight and of the forces from units up the slope, about the support point furthest down "
+        "the slope (Goodman &amp; Bray 1976). Packing density, porosity and thickness are counted "
+        "row by row (riprap/placement/layer_metrics.py). Stereonet: lower hemisphere, equal area, "
+        "exponential Kamb contours.</p>")
+    path = out / "report.html"
+    path.write_text(_page("riprap armour layer analysis", body), encoding="utf-8")
+    return path
+
+
+def write_comparison(out, analyses, labels) -> dict:
+    """Each layer's files in ``out/<label>/`` and ``comparison.html`` with the figures side by side."""
+    from riprap.io import analysis_figures as figures
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    outputs = {}
+    for analysis, label in zip(analyses, labels):
+        outputs[label] = write_analysis(out / label, analysis)
+    figures.comparison_stereonets(out / "comparison_stereonets.png", analyses, labels)
+    figures.comparison_histograms(out / "comparison_histograms.png", analyses, labels)
+    write_json(out / "comparison.json", {label: a.layer for label, a in zip(labels, analyses)})
+    faces = "".join(f"<figure><img src='{html.escape(label)}/slope_max_contact_force_N.svg' "
+                    f"alt='{html.escape(label)}'><figcaption>{html.escape(label)}</figcaption></figure>"
+                    for label in labels)
+    sources = "".join(f"<li>{html.escape(label)}: {html.escape(str(a.layer['source']))} "
+                      f"(<a href='{html.escape(label)}/report.html'>report</a>)</li>"
+                      for label, a in zip(labels, analyses))
+    body = (f"<ul>{sources}</ul><h2>Summary</h2>"
+            f"{_summary_table([a.layer for a in analyses], list(labels))}"
+            "<h2>Nose axes</h2><img class='wide' src='comparison_stereonets.svg' alt='stereonets'>"
+            "<h2>Distributions</h2><img class='wide' src='comparison_histograms.svg' alt='histograms'>"
+            f"<h2>Largest contact force, face view</h2><div class='figures'>{faces}</div>")
+    path = out / "comparison.html"
+    path.write_text(_page("riprap armour layer comparison", body), encoding="utf-8")
+    outputs["comparison"] = str(path)
+    return outputs
