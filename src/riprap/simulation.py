@@ -66,6 +66,7 @@ class RunSummary:
     time_step_max: float = 0.0
     time_step_cuts: int = 0
     outputs: dict = field(default_factory=dict)
+    case_file: str = ""          # the case file run (absolute), "" when built in Python
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -132,6 +133,9 @@ class Simulation:
         self.output_directory = Path(output_directory)
         self.paraview = bool(paraview)
         self.picture = bool(picture)
+        # The case file this simulation was built from (set by build_simulation); recorded in
+        # summary.json so that `riprap analyse RUN` finds the pack a run started from.
+        self.case_file = ""
         self.progress = bool(progress)
         self.solver = SolidSolver(gravity=gravity, local_damping=local_damping)
         self._shape_names: dict[str, int] = {}
@@ -305,7 +309,7 @@ class Simulation:
                              frames=self._frame_index,
                              stability_ratio_max=getattr(self, "_max_stability_ratio", 0.0),
                              time_step_min=smallest_step, time_step_max=largest_step,
-                             time_step_cuts=cuts, outputs=outputs)
+                             time_step_cuts=cuts, outputs=outputs, case_file=self.case_file)
         from riprap.io.summary import write_json
         write_json(out / "summary.json", summary.as_dict())
         return summary
@@ -409,17 +413,38 @@ class Simulation:
         gravity = np.where(s.fixed[:, None], 0.0, s.masses[:, None] * s.gravity)
         return s.forces - gravity
 
+    def contact_statistics(self) -> dict:
+        """Per body: coordination number, largest contact force (N) and factor of safety against
+        sliding (:mod:`riprap.analysis.unit_contacts`; inf where nothing pushes a body sideways)."""
+        from riprap.analysis.unit_contacts import (pair_friction, sliding_factor_of_safety,
+                                                   unit_contacts)
+
+        s = self.solver
+        contacts = s.contacts
+        stats = unit_contacts(s.n_bodies, contacts)
+        friction = pair_friction(contacts, [m.friction_coefficient for m in s.materials],
+                                 s.material_index_of_body, s.wall_materials)
+        return {"coordination_number": stats.coordination_number,
+                "max_contact_force": stats.max_contact_force,
+                "factor_of_safety_sliding": sliding_factor_of_safety(s.n_bodies, contacts, friction)}
+
     def _write_frame(self, series, contact_series) -> None:
         s = self.solver
         points, triangles, owners = self.surface_arrays()
         omegas = s.angular_velocities
         contact = self.contact_forces_on_bodies()
+        statistics = self.contact_statistics()
+        # ParaView colours inf badly; a huge finite number reads as "nothing pushes it sideways".
+        safety = np.minimum(statistics["factor_of_safety_sliding"], 1.0e30)
         series.add(s.time, points=points, cells=triangles, cell_type="triangle",
                    cell_data={"body_id": owners, "velocity": s.velocities[owners],
                               "speed": np.linalg.norm(s.velocities, axis=1)[owners],
                               "angular_velocity": omegas[owners],
                               "contact_force": contact[owners],
-                              "fixed": s.fixed[owners].astype(np.int64)})
+                              "fixed": s.fixed[owners].astype(np.int64),
+                              "coordination_number": statistics["coordination_number"][owners],
+                              "max_contact_force": statistics["max_contact_force"][owners],
+                              "factor_of_safety_sliding": safety[owners]})
         c = s.contacts
         contact_series.add(s.time, points=c.points, cells=np.arange(len(c)).reshape(-1, 1),
                            cell_type="vertex",

@@ -81,3 +81,22 @@ def run_through_contact():
                     f"{max_steps} steps (time step {solver.time_step:.3e} s)")
 
     return run
+
+
+@pytest.fixture(scope="session")
+def small_placement(tmp_path_factory):
+    """``examples/coreloc_small.toml`` placed in full once per session: (summary, output folder)."""
+    from pathlib import Path
+
+    from riprap.case.build_placement import run_placement
+    from riprap.case.load import load_case
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "coreloc_small.toml"
+    folder = tmp_path_factory.mktemp("coreloc_small")
+    previous = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        summary = run_placement(load_case(example), output_directory=folder, progress=False)
+    finally:
+        numba.set_num_threads(previous)
+    return summary, folder

@@ -16,23 +16,16 @@ design phi, first row against the toe stop): 0.602 (the example's seed 0), 0.617
 0.32-0.39 % of Dn, under a minute. Earlier variants: units let fall from above, 0.495 (-18 %);
 the first row pushed up the face by the toe stop onto the second, 0.63-0.69 (+5 to +14 %).
 """
-from pathlib import Path
-
 import pytest
 
-from riprap.case.build_placement import run_placement
-from riprap.case.load import load_case
-
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "coreloc_small.toml"
 PACKING_TOLERANCE = 0.10
 AT_REST_FRACTION = 0.8
 OVERLAP_OVER_DN = 0.01
 
 
 @pytest.fixture(scope="module")
-def summary(tmp_path_factory):
-    return run_placement(load_case(EXAMPLE), output_directory=tmp_path_factory.mktemp("small"),
-                         progress=False)
+def summary(small_placement):
+    return small_placement[0]
 
 
 def test_packing_density_within_ten_percent_of_design(summary):

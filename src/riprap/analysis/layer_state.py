@@ -71,6 +71,27 @@ class LayerDescription:
     def n_units(self) -> int:
         return len(self.unit_bodies)
 
+    @classmethod
+    def for_unit(cls, unit, unit_shape, *, slope, underlayer_top, unit_bodies, rows,
+                 design_positions) -> "LayerDescription":
+        """The description of a layer of ``unit`` (an ``ArmourUnit``) whose bodies use
+        ``unit_shape`` (its ``RigidShape``, whose principal-frame mesh the pack stores)."""
+        # The unit's axes are given in the frame it was built in; the pack stores the mesh in
+        # its principal frame, nodes p = A^T (b - c): an axis v becomes A^T v.
+        axes = {name: unit_shape.frame_rotation.T @ np.asarray(axis, dtype=float)
+                for name, axis in unit.axes.items()}
+        design = unit.design
+        return cls(
+            unit_kind=unit.kind, unit_shape=unit_shape.name, nominal_diameter=unit.nominal_diameter,
+            unit_volume=unit.volume, unit_height=unit.height, unit_axes=axes, slope=slope,
+            underlayer_top=float(underlayer_top), unit_bodies=np.asarray(unit_bodies, dtype=np.int64),
+            rows=np.asarray(rows, dtype=np.int64),
+            design_positions=np.asarray(design_positions, dtype=float).reshape(-1, 3),
+            design={"packing_density_coefficient": design.packing_density_coefficient,
+                    "layer_thickness_m": design.layers * design.layer_thickness_coefficient
+                    * unit.nominal_diameter,
+                    "porosity": design.porosity})
+
 
 @dataclass(frozen=True, eq=False)
 class LayerState:
@@ -145,17 +166,11 @@ class LayerState:
         return volumes[self.shape_of_body] * density[self.material_of_body]
 
     def contact_friction(self) -> np.ndarray:
-        """Friction coefficient of each contact row: the smaller of the two materials' (the
-        solver's rule for a pair)."""
-        mu = np.array([m.friction_coefficient for m in self.materials])
-        body_i = np.asarray(self.contacts.body_i, dtype=np.int64)
-        body_j = np.asarray(self.contacts.body_j, dtype=np.int64)
-        first = mu[self.material_of_body[body_i]]
-        is_wall = body_j < 0
-        other_material = np.where(is_wall, self.wall_materials[np.where(is_wall, -1 - body_j, 0)]
-                                  if len(self.wall_materials) else 0,
-                                  self.material_of_body[np.maximum(body_j, 0)])
-        return np.minimum(first, mu[other_material])
+        """Friction coefficient of each contact row (the smaller of the two materials')."""
+        from riprap.analysis.unit_contacts import pair_friction
+
+        return pair_friction(self.contacts, [m.friction_coefficient for m in self.materials],
+                             self.material_of_body, self.wall_materials)
 
 
 def state_from_simulation(sim, layer: LayerDescription, *, source: str = "simulation") -> LayerState:

@@ -56,6 +56,22 @@ def unit_contacts(n_bodies: int, contacts, group=None) -> UnitContacts:
                         total_contact_force=total)
 
 
+def pair_friction(contacts, friction_of_material, material_of_body, material_of_wall) -> np.ndarray:
+    """Friction coefficient of each contact row: the smaller of the two materials' (the solver's
+    rule for a pair). ``friction_of_material`` (n_materials,), ``material_of_body`` (n_bodies,),
+    ``material_of_wall`` (n_walls,) material indices."""
+    mu = np.asarray(friction_of_material, dtype=float)
+    material_of_body = np.asarray(material_of_body, dtype=np.int64)
+    material_of_wall = np.asarray(material_of_wall, dtype=np.int64)
+    body_i = np.asarray(contacts.body_i, dtype=np.int64)
+    body_j = np.asarray(contacts.body_j, dtype=np.int64)
+    is_wall = body_j < 0
+    walls = np.where(is_wall, -1 - body_j, 0)
+    other = np.where(is_wall, material_of_wall[walls] if len(material_of_wall) else 0,
+                     material_of_body[np.maximum(body_j, 0)])
+    return np.minimum(mu[material_of_body[body_i]], mu[other])
+
+
 def sliding_factor_of_safety(n_bodies: int, contacts, friction_coefficient) -> np.ndarray:
     """Factor of safety of each body against sliding on its contacts (inf for a body touching
     nothing or carrying no tangential force).

@@ -72,6 +72,8 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
         local_damping=settings.local_damping, rest_speed=settings.rest_speed,
         output_directory=output_directory or case.output.directory,
         paraview=case.output.paraview, picture=case.output.picture, progress=progress)
+    if case.source and Path(case.source).is_file():
+        sim.case_file = str(Path(case.source).resolve())
     for m in case.materials:
         sim.add_material(build_material(m))
     for spec in case.shapes:

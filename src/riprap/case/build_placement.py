@@ -141,18 +141,10 @@ def _layer_description(unit, slope, underlayer, result, design_positions):
 
     sim = result.simulation
     unit_shape = sim.solver.shapes[sim._shape_names[UNIT_SHAPE_NAME]]
-    # The pack stores each shape in its principal frame: turn the unit's axes into it.
-    axes = {name: unit_shape.frame_rotation.T @ axis for name, axis in unit.axes.items()}
-    design = unit.design
-    return LayerDescription(
-        unit_kind=unit.kind, unit_shape=UNIT_SHAPE_NAME, nominal_diameter=unit.nominal_diameter,
-        unit_volume=unit.volume, unit_height=unit.height, unit_axes=axes, slope=slope,
-        underlayer_top=underlayer.top_level, unit_bodies=np.asarray(result.unit_bodies),
-        rows=np.asarray(result.rows), design_positions=design_positions,
-        design={"packing_density_coefficient": design.packing_density_coefficient,
-                "layer_thickness_m": design.layers * design.layer_thickness_coefficient
-                * unit.nominal_diameter,
-                "porosity": design.porosity})
+    return LayerDescription.for_unit(unit, unit_shape, slope=slope,
+                                     underlayer_top=underlayer.top_level,
+                                     unit_bodies=result.unit_bodies, rows=result.rows,
+                                     design_positions=design_positions)
 
 
 def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:

@@ -144,6 +144,39 @@ def _fit_pose(local, world, centroid):
     return rotation, world_mean - rotation @ (local_mean - centroid)
 
 
+def _read_contacts_vtu(path: Path):
+    """Contact records of one frame of ``contacts.pvd`` (``body_i``, ``body_j``, forces)."""
+    import meshio
+
+    from riprap.solid.solver import ContactRecords
+
+    try:
+        mesh = meshio.read(path)
+    except ValueError as error:
+        # meshio cannot read a VTU without points: a frame with no contacts.
+        pieces = [piece.attrib.get("NumberOfPoints") for piece in
+                  ElementTree.parse(path).getroot().iter("Piece")]
+        if pieces and all(count == "0" for count in pieces):
+            return ContactRecords(body_i=np.zeros(0, np.int64), body_j=np.zeros(0, np.int64),
+                                  points=np.zeros((0, 3)), normal_forces=np.zeros((0, 3)),
+                                  tangential_forces=np.zeros((0, 3)), stiffness=np.zeros(0))
+        raise CaseFileError(f"{path}: cannot read the contacts frame: {error}") from None
+    data = mesh.point_data
+    missing = [name for name in ("body_i", "body_j", "normal_force", "tangential_force")
+               if name not in data]
+    if missing:
+        raise CaseFileError(f"{path}: the contacts frame lacks {', '.join(missing)} (written by an "
+                            "older riprap?); analyse the pack instead")
+    count = len(mesh.points)
+    return ContactRecords(
+        body_i=np.asarray(data["body_i"], dtype=np.int64).reshape(count),
+        body_j=np.asarray(data["body_j"], dtype=np.int64).reshape(count),
+        points=np.asarray(mesh.points, dtype=float).reshape(-1, 3),
+        normal_forces=np.asarray(data["normal_force"], dtype=float).reshape(-1, 3),
+        tangential_forces=np.asarray(data["tangential_force"], dtype=float).reshape(-1, 3),
+        stiffness=np.zeros(count))
+
+
 def load_run_state(run_folder, *, frame: int = -1):
     """The state at frame ``frame`` (index into ``bodies.pvd``'s list, -1 the last) of a run
     started from a pack."""
@@ -198,18 +231,7 @@ def load_run_state(run_folder, *, frame: int = -1):
             raise CaseFileError(f"{run_folder / body_file}: body {b} has {len(world)} surface "
                                 f"nodes, its shape '{shape_names[k]}' {len(local)}")
         rotations[b], positions[b] = _fit_pose(local, world, centroids[k])
-    contact_mesh = meshio.read(run_folder / contact_frames[time])
-    data = contact_mesh.point_data
-    from riprap.solid.solver import ContactRecords
-
-    count = len(contact_mesh.points)
-    contacts = ContactRecords(
-        body_i=np.asarray(data.get("body_i", np.zeros(0)), dtype=np.int64).reshape(count),
-        body_j=np.asarray(data.get("body_j", np.zeros(0)), dtype=np.int64).reshape(count),
-        points=np.asarray(contact_mesh.points, dtype=float).reshape(-1, 3),
-        normal_forces=np.asarray(data["normal_force"], dtype=float).reshape(-1, 3),
-        tangential_forces=np.asarray(data["tangential_force"], dtype=float).reshape(-1, 3),
-        stiffness=np.zeros(count))
+    contacts = _read_contacts_vtu(run_folder / contact_frames[time])
     _check_contacts(contacts, n_bodies, len(walls[0]), run_folder / contact_frames[time])
     return LayerState(
         positions=positions, rotations=rotations, shape_of_body=shape_of_body,
