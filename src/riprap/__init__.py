@@ -9,7 +9,8 @@ The public API, one namespace::
 """
 __version__ = "0.1.0"
 
-from riprap import errors, placement
+from riprap import analysis, errors, placement
+from riprap.analysis import analyse, compare_layers
 from riprap.case.build import build_simulation
 from riprap.case.load import load_case, parse_case
 from riprap.geometry import shapes
@@ -24,7 +25,7 @@ from riprap.solid.shape import RigidShape
 from riprap.solid.solver import ContactRecords, SolidSolver
 
 __all__ = [
-    "ArmourUnit", "ContactRecords", "Material", "RigidShape", "RockGrading", "RunSummary",
+    "ArmourUnit", "ContactRecords", "analyse", "analysis", "compare_layers", "Material", "RigidShape", "RockGrading", "RunSummary",
     "Simulation", "SolidSolver", "TetMesh", "armour_unit", "build_simulation", "errors",
     "load_case", "mass_properties", "parse_case", "placement", "rock_library", "shapes", "walls",
 ]

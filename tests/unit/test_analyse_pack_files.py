@@ -189,3 +189,27 @@ def test_frames_of_a_run_started_from_the_pack_are_analysed(pack, tmp_path, monk
     assert "t = " in last.layer["source"]
     with pytest.raises(CaseFileError, match="frame 7 does not exist"):
         analyse(tmp_path / "run", frame=7)
+
+
+def test_two_packs_are_compared_side_by_side(pack, tmp_path):
+    from riprap.analysis import compare_layers
+
+    other = _copy_pack(pack, tmp_path / "other")
+    analyses = compare_layers([pack, other], out=tmp_path / "cmp", labels=["first", "second"])
+    assert [a.units["nose_trend_deg"][0] for a in analyses] == pytest.approx([TREND, TREND])
+    for name in ("comparison.html", "comparison_stereonets.svg", "comparison_histograms.png",
+                 "first/report.html", "second/units.csv"):
+        assert (tmp_path / "cmp" / name).is_file(), name
+    page = (tmp_path / "cmp" / "comparison.html").read_text()
+    assert "first" in page and "second" in page
+    with pytest.raises(CaseFileError, match="two or more"):
+        compare_layers([pack], out=tmp_path / "one")
+
+
+def test_command_line_analyse(pack, tmp_path, capsys):
+    from riprap.cli import main
+
+    assert main(["analyse", str(pack), "--out", str(tmp_path / "a")]) == 0
+    assert "report:" in capsys.readouterr().out
+    assert main(["analyse", str(tmp_path / "missing")]) == 2
+    assert "no such pack or run folder" in capsys.readouterr().err

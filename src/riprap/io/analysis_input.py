@@ -100,29 +100,50 @@ def _check_contacts(contacts, n_bodies, n_walls, where) -> None:
                             f"{int(body_j[row])}, but there are {n_bodies} bodies and {n_walls} walls")
 
 
-def load_pack_state(path):
-    """The state of a pack folder (or its ``pack.toml``)."""
-    from riprap.analysis.layer_state import LayerState
-    from riprap.io.layer_file import CONTACTS_FILE_NAME, read_contact_table, read_layer_file
+def _read_pack(pack_file: Path) -> dict:
+    """Everything of a pack but the poses and contacts: the case's shapes, materials, walls and
+    bodies, and its layer description (checked against the case)."""
+    from riprap.io.layer_file import read_layer_file
 
-    folder, pack_file = _pack_folder(Path(path))
     case, shape_names, meshes, centroids, materials, walls = _case_parts(pack_file)
-    n_bodies = len(case.bodies)
-    layer = read_layer_file(folder, n_bodies=n_bodies)
+    layer = read_layer_file(pack_file.parent, n_bodies=len(case.bodies))
     _check_layer_against_case(layer, case, shape_names, pack_file)
-    contacts = read_contact_table(folder / CONTACTS_FILE_NAME)
-    _check_contacts(contacts, n_bodies, len(walls[0]), folder / CONTACTS_FILE_NAME)
+    material_names = [m.name for m in materials]
+    return {"case": case, "shape_names": shape_names, "meshes": meshes, "centroids": centroids,
+            "materials": materials, "walls": walls, "layer": layer,
+            "shape_of_body": np.array([shape_names.index(b.shape) for b in case.bodies],
+                                      dtype=np.int64),
+            "material_of_body": np.array([material_names.index(b.material) for b in case.bodies],
+                                         dtype=np.int64)}
+
+
+def _layer_state(pack: dict, *, positions, rotations, contacts, time: float, source: str):
+    from riprap.analysis.layer_state import LayerState
+
+    case, walls = pack["case"], pack["walls"]
+    _check_contacts(contacts, len(case.bodies), len(walls[0]), source)
     return LayerState(
-        positions=np.array([b.position for b in case.bodies], dtype=float).reshape(-1, 3),
-        rotations=_rotation_matrices([b.orientation for b in case.bodies]),
-        shape_of_body=np.array([shape_names.index(b.shape) for b in case.bodies], dtype=np.int64),
-        shape_names=shape_names, meshes=meshes, mesh_centroids=centroids,
-        material_of_body=np.array([[m.name for m in materials].index(b.material)
-                                   for b in case.bodies], dtype=np.int64),
-        materials=materials, fixed=np.array([b.fixed for b in case.bodies], dtype=bool),
+        positions=positions, rotations=rotations, shape_of_body=pack["shape_of_body"],
+        shape_names=pack["shape_names"], meshes=pack["meshes"], mesh_centroids=pack["centroids"],
+        material_of_body=pack["material_of_body"], materials=pack["materials"],
+        fixed=np.array([b.fixed for b in case.bodies], dtype=bool),
         wall_points=walls[0], wall_normals=walls[1], wall_materials=walls[2],
         contacts=contacts, gravity=np.asarray(case.simulation.gravity, dtype=float),
-        time=0.0, layer=layer, source=str(pack_file))
+        time=float(time), layer=pack["layer"], source=source)
+
+
+def load_pack_state(path):
+    """The state of a pack folder (or its ``pack.toml``)."""
+    from riprap.io.layer_file import CONTACTS_FILE_NAME, read_contact_table
+
+    folder, pack_file = _pack_folder(Path(path))
+    pack = _read_pack(pack_file)
+    bodies = pack["case"].bodies
+    return _layer_state(
+        pack, positions=np.array([b.position for b in bodies], dtype=float).reshape(-1, 3),
+        rotations=_rotation_matrices([b.orientation for b in bodies]),
+        contacts=read_contact_table(folder / CONTACTS_FILE_NAME), time=0.0,
+        source=str(pack_file))
 
 
 def _pvd_frames(pvd: Path) -> list[tuple[float, str]]:
@@ -182,9 +203,6 @@ def load_run_state(run_folder, *, frame: int = -1):
     started from a pack."""
     import meshio
 
-    from riprap.analysis.layer_state import LayerState
-    from riprap.io.layer_file import read_layer_file
-
     run_folder = Path(run_folder)
     summary_path = run_folder / "summary.json"
     try:
@@ -197,10 +215,9 @@ def load_run_state(run_folder, *, frame: int = -1):
         raise CaseFileError(f"{summary_path}: no 'case_file' (runs of this riprap version record "
                             "the case they ran); analyse the pack instead, or run it again")
     pack_file = Path(case_file)
-    case, shape_names, meshes, centroids, materials, walls = _case_parts(pack_file)
-    n_bodies = len(case.bodies)
-    layer = read_layer_file(pack_file.parent, n_bodies=n_bodies)
-    _check_layer_against_case(layer, case, shape_names, pack_file)
+    pack = _read_pack(pack_file)
+    n_bodies = len(pack["case"].bodies)
+    shape_names, meshes, centroids = pack["shape_names"], pack["meshes"], pack["centroids"]
     frames = _pvd_frames(run_folder / "bodies.pvd")
     contact_frames = dict(_pvd_frames(run_folder / "contacts.pvd"))
     if not frames:
@@ -215,7 +232,7 @@ def load_run_state(run_folder, *, frame: int = -1):
     points = np.asarray(bodies_mesh.points, dtype=float)
     triangles = np.asarray(bodies_mesh.cells_dict["triangle"], dtype=np.int64)
     owners = np.asarray(bodies_mesh.cell_data_dict["body_id"]["triangle"], dtype=np.int64)
-    shape_of_body = np.array([shape_names.index(b.shape) for b in case.bodies], dtype=np.int64)
+    shape_of_body = pack["shape_of_body"]
     if owners.max(initial=-1) + 1 != n_bodies:
         raise CaseFileError(f"{run_folder / body_file}: has {owners.max(initial=-1) + 1} bodies, "
                             f"{pack_file} {n_bodies}: the run was not started from this pack")
@@ -232,14 +249,7 @@ def load_run_state(run_folder, *, frame: int = -1):
                                 f"nodes, its shape '{shape_names[k]}' {len(local)}")
         rotations[b], positions[b] = _fit_pose(local, world, centroids[k])
     contacts = _read_contacts_vtu(run_folder / contact_frames[time])
-    _check_contacts(contacts, n_bodies, len(walls[0]), run_folder / contact_frames[time])
-    return LayerState(
-        positions=positions, rotations=rotations, shape_of_body=shape_of_body,
-        shape_names=shape_names, meshes=meshes, mesh_centroids=centroids,
-        material_of_body=np.array([[m.name for m in materials].index(b.material)
-                                   for b in case.bodies], dtype=np.int64),
-        materials=materials, fixed=np.array([b.fixed for b in case.bodies], dtype=bool),
-        wall_points=walls[0], wall_normals=walls[1], wall_materials=walls[2],
-        contacts=contacts, gravity=np.asarray(case.simulation.gravity, dtype=float),
-        time=float(time), layer=layer, source=f"{run_folder} frame {frame} (t = {time:g} s)")
+    return _layer_state(pack, positions=positions, rotations=rotations, contacts=contacts,
+                        time=time, source=f"{run_folder} frame {frame} (t = {time:g} s)")
+
 
