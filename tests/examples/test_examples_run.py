@@ -72,3 +72,10 @@ def test_small_placement_example_runs(tmp_path):
     assert summary["units_placed"] == 25
     assert (out / "pack.toml").is_file() and (out / "deposition" / "bodies.pvd").is_file()
     assert main(["check", str(out / "pack.toml")]) == 0
+    # The README's analysis command on the (smoke) pack: the files.
+    assert main(["analyse", str(out), "--out", str(out / "analysis")]) == 0
+    for name in ("report.html", "stereonet.png", "units.csv"):
+        assert (out / "analysis" / name).is_file(), name
+    header = (out / "analysis" / "units.csv").read_text().splitlines()[0].split(",")
+    for column in ("unit_id", "coordination_number", "max_contact_force_N", "factor_of_safety"):
+        assert column in header

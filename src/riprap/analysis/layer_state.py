@@ -146,10 +146,18 @@ class LayerState:
     time: float
     layer: LayerDescription
     source: str = ""
+    _faces: dict = field(default_factory=dict, repr=False)
 
     @property
     def n_bodies(self) -> int:
         return len(self.positions)
+
+    def boundary_faces(self, body: int) -> np.ndarray:
+        """Boundary triangles (node indices of the stored mesh) of ``body``'s shape."""
+        k = int(self.shape_of_body[body])
+        if k not in self._faces:         # one per shape: thousands of rocks share a few shapes
+            self._faces[k] = self.meshes[k].boundary_faces()
+        return self._faces[k]
 
     def world_nodes(self, body: int) -> np.ndarray:
         """Nodes of ``body``'s mesh in the world (m)."""

@@ -107,8 +107,7 @@ def layer_view_png(path, analysis, column: str) -> Path:
     bodies = state.layer.unit_bodies
     triangles, owners = [], []
     for body in bodies:
-        mesh = state.meshes[state.shape_of_body[body]]
-        faces = mesh.boundary_faces()
+        faces = state.boundary_faces(body)
         triangles.append(state.world_nodes(body)[faces])
         owners.append(np.full(len(faces), body, dtype=np.int64))
     label, _ = PER_UNIT_FIELDS.get(column, (column, "viridis"))

@@ -240,10 +240,13 @@ def load_run_state(run_folder, *, frame: int = -1):
     positions = np.empty((n_bodies, 3))
     order = np.argsort(owners, kind="stable")
     starts = np.searchsorted(owners[order], np.arange(n_bodies + 1))
+    # A frame writes each body's surface nodes in the order of the stored mesh (Simulation.
+    # surface_arrays), so the nodes pair up one to one.
+    surface_nodes = [mesh.nodes[np.unique(mesh.boundary_faces())] for mesh in meshes]
     for b in range(n_bodies):
         world = points[np.unique(triangles[order[starts[b]:starts[b + 1]]])]
         k = shape_of_body[b]
-        local = meshes[k].nodes[np.unique(meshes[k].boundary_faces())]
+        local = surface_nodes[k]
         if len(local) != len(world):
             raise CaseFileError(f"{run_folder / body_file}: body {b} has {len(world)} surface "
                                 f"nodes, its shape '{shape_names[k]}' {len(local)}")

@@ -81,7 +81,7 @@ def _write_paraview(out: Path, analysis) -> dict:
             continue
         points, triangles, owners, offset = [], [], [], 0
         for body in bodies:
-            faces = state.meshes[state.shape_of_body[body]].boundary_faces()
+            faces = state.boundary_faces(body)
             used, local = np.unique(faces, return_inverse=True)
             points.append(state.world_nodes(body)[used])
             triangles.append(local.reshape(faces.shape) + offset)
