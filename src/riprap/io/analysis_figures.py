@@ -163,7 +163,8 @@ def slope_view_figure(path, analysis, column: str) -> list[Path]:
     axes.set_aspect("equal")
     axes.set_xlabel("y across the flume (m)")
     axes.set_ylabel("s up the slope from the toe (m)")
-    axes.set_title(f"Seen square onto the 1:{layer.slope.cotangent:g} face: {label}", fontsize=10)
+    axes.set_title(f"{len(outlines)} units on the 1:{layer.slope.cotangent:g} face, seen square on",
+                   fontsize=10)
     bar = figure.colorbar(collection, ax=axes, shrink=0.8)
     bar.set_label(label, fontsize=8)
     if len(rocks):
