@@ -1,0 +1,1 @@
+"""Two-phase (air and water) incompressible flow on a staggered Cartesian grid with a sharp interface."""
