@@ -274,6 +274,20 @@ class ParaViewSeries:
         CaseFileError
             If ``time`` is not finite or not later than the last frame's time.
         """
+        return self._add_frame(time, "vtu", lambda path: write_vtu(
+            path, points=points, cells=cells, cell_type=cell_type, point_data=point_data,
+            cell_data=cell_data))
+
+    def add_image(self, time: float, *, origin, spacing: float, cells, cell_data) -> Path:
+        """Write one frame of a uniform grid (``.vti``, :func:`riprap.io.vti.write_vti`) and list
+        it in the ``.pvd``; ``cells`` = (nx, ny, nz), ``cell_data`` arrays of that shape (or with
+        a trailing 3 for vectors)."""
+        from riprap.io.vti import write_vti
+
+        return self._add_frame(time, "vti", lambda path: write_vti(
+            path, origin=origin, spacing=spacing, cells=cells, cell_data=cell_data))
+
+    def _add_frame(self, time: float, extension: str, write) -> Path:
         time = float(time)
         if not math.isfinite(time):
             raise CaseFileError(f"{self.pvd_path}: frame time {time} is not finite.")
@@ -286,22 +300,15 @@ class ParaViewSeries:
                 f"{self._frames[-1][0]!r} s; times must increase (use append=True to restart "
                 "a series from an earlier time)."
             )
-        file_name = f"{self.name}_{self._next_index():06d}.vtu"
+        file_name = f"{self.name}_{self._next_index():06d}.{extension}"
         path = self.directory / file_name
-        write_vtu(
-            path,
-            points=points,
-            cells=cells,
-            cell_type=cell_type,
-            point_data=point_data,
-            cell_data=cell_data,
-        )
+        write(path)
         self._frames.append((time, file_name))
         self._write_pvd()
         return path
 
     def _next_index(self) -> int:
-        pattern = re.compile(rf"^{re.escape(self.name)}_(\d+)\.vtu$")
+        pattern = re.compile(rf"^{re.escape(self.name)}_(\d+)\.vt[ui]$")
         indices = [int(match.group(1)) for _, file_name in self._frames
                    if (match := pattern.match(file_name))]
         return max(indices, default=-1) + 1

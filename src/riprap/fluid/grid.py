@@ -1,0 +1,145 @@
+"""The fluid grid: a uniform Cartesian grid of cubic cells, staggered (MAC) like Harlow & Welch (1965).
+
+Layout (every fluid array is C-ordered and indexed [i, j, k] for x, y, z; z is up):
+
+- cell centres hold the pressure ``p`` and the water fraction ``f``: shape (nx, ny, nz);
+- face centres hold the normal velocity: ``u`` (nx+1, ny, nz) on x-faces (``u[i]`` between cells
+  i-1 and i), ``v`` (nx, ny+1, nz), ``w`` (nx, ny, nz+1).
+
+A 2D problem (the x-z plane of a flume) is ``ny == 1``: ``v`` stays zero and nothing moves in y.
+Cells are cubes: a domain whose lengths are not whole numbers of one cell size is refused, since
+the volume-of-fluid sweeps and the multigrid levels assume equal spacing in every direction.
+
+Boundaries: each side of the box is ``"no_slip"`` or ``"free_slip"`` (a wall, no flow through
+it), and the top may be ``"open"`` (the atmosphere: pressure 0 there, air and water may leave or
+enter).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from riprap.errors import CaseFileError
+
+__all__ = ["FluidGrid", "BOUNDARY_KINDS", "SIDES"]
+
+#: Sides of the box, in the order of the ``boundaries`` mapping.
+SIDES = ("x_low", "x_high", "y_low", "y_high", "z_low", "z_high")
+#: Kinds of boundary; ``open`` only on ``z_high``.
+BOUNDARY_KINDS = ("no_slip", "free_slip", "open")
+# Cell lengths that differ by less than this (relative) are the same cube side.
+_CUBE_TOLERANCE = 1e-9
+# Multigrid and the sweeps are fine with any size, but a grid this small has no interior.
+_MINIMUM_CELLS = 2
+
+
+def _default_boundaries() -> dict:
+    return {"x_low": "no_slip", "x_high": "no_slip", "y_low": "no_slip", "y_high": "no_slip",
+            "z_low": "no_slip", "z_high": "open"}
+
+
+@dataclass(frozen=True)
+class FluidGrid:
+    """A box ``lower`` .. ``upper`` (m) cut into ``cells`` = (nx, ny, nz) cubic cells.
+
+    ``boundaries``: side -> kind (``SIDES``, ``BOUNDARY_KINDS``); missing sides take the default
+    (walls with no slip, open top). ``ny == 1`` is a 2D problem in the x-z plane.
+    """
+
+    lower: tuple
+    upper: tuple
+    cells: tuple
+    boundaries: dict = field(default_factory=_default_boundaries)
+
+    def __post_init__(self):
+        lower = np.asarray(self.lower, dtype=float).reshape(-1)
+        upper = np.asarray(self.upper, dtype=float).reshape(-1)
+        cells = np.asarray(self.cells).reshape(-1)
+        if lower.size != 3 or upper.size != 3 or not (np.isfinite(lower).all() and np.isfinite(upper).all()):
+            raise CaseFileError(f"fluid grid: lower {self.lower!r} and upper {self.upper!r} must be "
+                                "3 finite numbers each (m)")
+        if cells.size != 3 or cells.dtype.kind not in "iu":
+            raise CaseFileError(f"fluid grid: cells = {self.cells!r} must be 3 integers [nx, ny, nz]")
+        if np.any(upper <= lower):
+            raise CaseFileError(f"fluid grid: upper {upper.tolist()} must exceed lower "
+                                f"{lower.tolist()} in every direction")
+        if cells[0] < _MINIMUM_CELLS or cells[2] < _MINIMUM_CELLS or cells[1] < 1:
+            raise CaseFileError(f"fluid grid: cells = {cells.tolist()}: nx and nz need at least "
+                                f"{_MINIMUM_CELLS} cells, ny at least 1 (1 for a 2D flume)")
+        sizes = (upper - lower) / cells
+        h = sizes[0]
+        directions = [0, 2] if cells[1] == 1 else [0, 1, 2]
+        if any(abs(sizes[d] - h) > _CUBE_TOLERANCE * h for d in directions):
+            suggestion = np.round((upper - lower) / h).astype(int)
+            raise CaseFileError(
+                f"fluid grid: cells must be cubes, but the box {(upper - lower).tolist()} m in "
+                f"{cells.tolist()} cells gives cells of {sizes.tolist()} m; with cells of {h:g} m "
+                f"use cells = {suggestion.tolist()} (and make the lengths whole multiples of it)")
+        boundaries = _default_boundaries()
+        for side, kind in dict(self.boundaries).items():
+            if side not in SIDES:
+                raise CaseFileError(f"fluid grid: unknown side '{side}'; sides: {', '.join(SIDES)}")
+            if kind not in BOUNDARY_KINDS:
+                raise CaseFileError(f"fluid grid: boundary {side} = '{kind}' is not one of "
+                                    f"{', '.join(BOUNDARY_KINDS)}")
+            if kind == "open" and side != "z_high":
+                raise CaseFileError(f"fluid grid: boundary {side} = 'open': only the top (z_high) "
+                                    "can be open to the atmosphere")
+            boundaries[side] = kind
+        object.__setattr__(self, "lower", tuple(float(v) for v in lower))
+        object.__setattr__(self, "upper", tuple(float(v) for v in upper))
+        object.__setattr__(self, "cells", tuple(int(v) for v in cells))
+        object.__setattr__(self, "boundaries", boundaries)
+
+    @property
+    def cell_size(self) -> float:
+        """Side of a cubic cell (m)."""
+        return (self.upper[0] - self.lower[0]) / self.cells[0]
+
+    @property
+    def shape(self) -> tuple:
+        return self.cells
+
+    @property
+    def two_dimensional(self) -> bool:
+        return self.cells[1] == 1
+
+    @property
+    def n_cells(self) -> int:
+        return self.cells[0] * self.cells[1] * self.cells[2]
+
+    @property
+    def cell_volume(self) -> float:
+        """Volume of a cell (m^3); in 2D, per the cell's width in y (the box's)."""
+        h = self.cell_size
+        return h * h * (self.upper[1] - self.lower[1] if self.two_dimensional else h)
+
+    @property
+    def open_top(self) -> bool:
+        return self.boundaries["z_high"] == "open"
+
+    def centres(self, axis: int) -> np.ndarray:
+        """Cell-centre coordinates along ``axis`` (m)."""
+        n = self.cells[axis]
+        step = (self.upper[axis] - self.lower[axis]) / n
+        return self.lower[axis] + (np.arange(n) + 0.5) * step
+
+    def faces(self, axis: int) -> np.ndarray:
+        """Face coordinates along ``axis`` (m)."""
+        n = self.cells[axis]
+        return np.linspace(self.lower[axis], self.upper[axis], n + 1)
+
+    def cell_of(self, point) -> tuple:
+        """Index (i, j, k) of the cell holding ``point``, or raise naming the point."""
+        point = np.asarray(point, dtype=float)
+        index = []
+        for axis in range(3):
+            step = (self.upper[axis] - self.lower[axis]) / self.cells[axis]
+            i = math.floor((point[axis] - self.lower[axis]) / step)
+            if not 0 <= i < self.cells[axis]:
+                raise CaseFileError(f"point {point.tolist()} lies outside the fluid box "
+                                    f"{list(self.lower)} .. {list(self.upper)}")
+            index.append(i)
+        return tuple(index)

@@ -1,0 +1,348 @@
+"""FluidSolver: incompressible air and water on a staggered Cartesian grid, one fluid with a sharp
+interface (volume of fluid), as flat arrays.
+
+One step of length dt (all explicit but the pressure):
+
+1. water fraction: geometric (PLIC) split advection of Weymouth & Yue (2010), mass-conserving and
+   bounded (``riprap/fluid/kernels/plic.py``); it also gives the water volume through every face;
+2. momentum: moved with the mass fluxes of step 1 and divided by a density moved with the same
+   fluxes, plus explicit viscous stresses and gravity (``riprap/fluid/kernels/momentum.py``);
+3. pressure: div((1/rho) grad p) = div(u*) / dt on the cells, 1/rho on the faces from the
+   densities of step 2, walls closed, the open top at p = 0 (``riprap/fluid/pressure.py``,
+   multigrid-preconditioned conjugate gradients);
+4. correction: u = u* - dt (1/rho) grad p on every face, so that div u = 0 to the solver tolerance.
+
+Gravity enters the momentum of the faces (step 2) and is balanced by the pressure gradient of step
+3: water at rest under a flat surface stays at rest to the solver tolerance.
+
+Time step: the largest that keeps the Courant number max|u| dt / h below ``courant_number``
+(Weymouth & Yue need <= 0.5 for boundedness), explicit viscous diffusion stable (dt <= h^2 /
+(8 nu) in 3D, nu the largest kinematic viscosity), and a body starting from rest under gravity
+within the same Courant number; it grows by at most ``_STEP_GROWTH`` per step.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from riprap.errors import CaseFileError, InstabilityError
+from riprap.fluid.grid import SIDES, FluidGrid
+from riprap.fluid.kernels import momentum
+from riprap.fluid.phases import AIR_20C, WATER_20C, Phase
+
+__all__ = ["FluidSolver", "StepReport"]
+
+_STEP_GROWTH = 1.2
+_BOUNDARY_CODE = {"no_slip": momentum.NO_SLIP, "free_slip": momentum.FREE_SLIP, "open": momentum.OPEN}
+
+
+@dataclass
+class StepReport:
+    """What one step did."""
+
+    time: float
+    time_step: float
+    courant_number: float
+    pressure_iterations: int
+    pressure_residual: float
+    water_volume_error: float     # (V - V0) / V0
+
+
+def _box_overlap_fractions(grid: FluidGrid, lower, upper) -> np.ndarray:
+    """Fraction of each cell inside the axis-aligned box lower..upper (exact)."""
+    fractions = []
+    for axis in range(3):
+        faces = grid.faces(axis)
+        low = np.clip(lower[axis], faces[:-1], faces[1:])
+        high = np.clip(upper[axis], faces[:-1], faces[1:])
+        fractions.append(np.maximum(high - low, 0.0) / np.diff(faces))
+    return fractions[0][:, None, None] * fractions[1][None, :, None] * fractions[2][None, None, :]
+
+
+class FluidSolver:
+    """Air and water on ``grid`` (:class:`riprap.fluid.grid.FluidGrid`).
+
+    Parameters
+    ----------
+    grid : FluidGrid
+    water, air : Phase
+        Densities and viscosities (defaults: fresh water and air at 20 degrees C).
+    gravity : (3,) float
+        m/s^2.
+    courant_number : float
+        Largest max|u| dt / h (<= 0.5).
+    pressure_tolerance : float
+        Relative residual at which the pressure solve stops.
+    max_time_step : float
+        Upper bound on dt (s).
+    """
+
+    def __init__(self, grid: FluidGrid, *, water: Phase = WATER_20C, air: Phase = AIR_20C,
+                 gravity=(0.0, 0.0, -9.81), courant_number: float = 0.3,
+                 pressure_tolerance: float = 1e-8, max_time_step: float = 0.01,
+                 surface_tension: float = 0.0):
+        from riprap.fluid.pressure import PressureSolver
+
+        if not 0.0 < courant_number <= 0.5:
+            raise CaseFileError(f"fluid: courant_number = {courant_number!r} must be in (0, 0.5] "
+                                "(the volume-of-fluid sweeps are bounded only up to 0.5)")
+        if not (math.isfinite(surface_tension) and surface_tension >= 0):
+            raise CaseFileError(f"fluid: surface_tension = {surface_tension!r} must be >= 0 N/m "
+                                "(0.0728 for clean water and air at 20 degrees C)")
+        if not (math.isfinite(max_time_step) and max_time_step > 0):
+            raise CaseFileError(f"fluid: max_time_step = {max_time_step!r} must be > 0 s")
+        self.grid = grid
+        self.water = water
+        self.air = air
+        self.gravity = np.asarray(gravity, dtype=float).reshape(3)
+        self.courant_number = float(courant_number)
+        self.max_time_step = float(max_time_step)
+        self.surface_tension = float(surface_tension)
+        nx, ny, nz = grid.cells
+        self.h = grid.cell_size
+        self.fraction = np.zeros((nx, ny, nz))
+        self.u = np.zeros((nx + 1, ny, nz))
+        self.v = np.zeros((nx, ny + 1, nz))
+        self.w = np.zeros((nx, ny, nz + 1))
+        self.pressure = np.zeros((nx, ny, nz))
+        self.solid = np.zeros((nx, ny, nz), dtype=bool)
+        self.time = 0.0
+        self.step_count = 0
+        self.time_step = 0.0
+        self.initial_water_volume = None
+        self.boundary_code = np.array([_BOUNDARY_CODE[grid.boundaries[side]] for side in SIDES],
+                                      dtype=np.int64)
+        self.pressure_solver = PressureSolver((nx, ny, nz), self.h, tolerance=pressure_tolerance)
+        self.last_report = None
+
+    # ------------------------------------------------------------------ set-up
+    def add_water_box(self, lower, upper) -> None:
+        """Fill the box lower..upper (m) with water (cells partly inside get their exact share)."""
+        lower = np.asarray(lower, dtype=float)
+        upper = np.asarray(upper, dtype=float)
+        g = self.grid
+        if np.any(upper <= lower):
+            raise CaseFileError(f"fluid water box {lower.tolist()} .. {upper.tolist()}: upper must "
+                                "exceed lower in every direction")
+        if np.any(upper <= np.asarray(g.lower)) or np.any(lower >= np.asarray(g.upper)):
+            raise CaseFileError(f"fluid water box {lower.tolist()} .. {upper.tolist()} lies outside "
+                                f"the fluid box {list(g.lower)} .. {list(g.upper)}")
+        if g.two_dimensional:
+            lower[1], upper[1] = g.lower[1], g.upper[1]
+        self.fraction = np.minimum(1.0, self.fraction + _box_overlap_fractions(g, lower, upper))
+        self.initial_water_volume = None
+
+    def set_still_water_level(self, level: float) -> None:
+        """Water everywhere below ``level`` (m)."""
+        g = self.grid
+        if not g.lower[2] < level <= g.upper[2]:
+            raise CaseFileError(f"fluid still water level {level!r} m is outside the box's height "
+                                f"{g.lower[2]} .. {g.upper[2]} m")
+        self.add_water_box(g.lower, (g.upper[0], g.upper[1], level))
+
+    def add_obstacle_box(self, lower, upper) -> None:
+        """A fixed solid: every cell whose centre lies inside lower..upper (m)."""
+        g = self.grid
+        inside = [(g.centres(a) >= lower[a]) & (g.centres(a) <= upper[a]) for a in range(3)]
+        if g.two_dimensional:
+            inside[1] = np.ones(1, dtype=bool)
+        mask = inside[0][:, None, None] & inside[1][None, :, None] & inside[2][None, None, :]
+        if not mask.any():
+            raise CaseFileError(f"fluid obstacle {list(lower)} .. {list(upper)} holds no cell "
+                                f"centre (cells are {self.h:g} m)")
+        self.solid |= mask
+        self.fraction[mask] = 0.0
+
+    # ------------------------------------------------------------------ properties
+    def water_volume(self) -> float:
+        return float(self.fraction.sum()) * self.h ** 3
+
+    def cell_density(self, fraction=None) -> np.ndarray:
+        f = self.fraction if fraction is None else fraction
+        return f * self.water.density + (1.0 - f) * self.air.density
+
+    def cell_viscosity(self, fraction=None) -> np.ndarray:
+        f = self.fraction if fraction is None else fraction
+        return f * self.water.dynamic_viscosity + (1.0 - f) * self.air.dynamic_viscosity
+
+    def max_speed(self) -> float:
+        return max(momentum.max_abs(self.u), momentum.max_abs(self.v), momentum.max_abs(self.w))
+
+    def cell_velocity(self) -> np.ndarray:
+        """Velocity at the cell centres (nx, ny, nz, 3), the mean of the two faces on each axis."""
+        return np.stack([0.5 * (self.u[1:] + self.u[:-1]), 0.5 * (self.v[:, 1:] + self.v[:, :-1]),
+                         0.5 * (self.w[:, :, 1:] + self.w[:, :, :-1])], axis=-1)
+
+    def stable_time_step(self) -> float:
+        h = self.h
+        speed = self.max_speed()
+        limits = [self.max_time_step]
+        if speed > 0:
+            limits.append(self.courant_number * h / speed)
+        nu = max(self.water.kinematic_viscosity, self.air.kinematic_viscosity)
+        limits.append(h * h / (8.0 * nu))
+        g = float(np.linalg.norm(self.gravity))
+        if g > 0:
+            limits.append(math.sqrt(2.0 * self.courant_number * h / g))
+        step = min(limits)
+        if self.time_step > 0:
+            step = min(step, _STEP_GROWTH * self.time_step)
+        return step
+
+    # ------------------------------------------------------------------ stepping
+    def _advect_water(self, dt: float):
+        from riprap.fluid.kernels import plic
+
+        return plic.advect(self.fraction, self.u, self.v, self.w, dt, self.h, self.step_count)
+
+    def _face_coefficients(self, densities):
+        """1/rho on every face: transported densities inside, walls 0, the open top 1/rho of the
+        top cell; faces of solid cells 0."""
+        rho = self.cell_density()
+        betas = []
+        for axis, density in enumerate(densities):
+            beta = np.zeros_like(density)
+            interior = [slice(None)] * 3
+            interior[axis] = slice(1, -1)
+            beta[tuple(interior)] = 1.0 / density[tuple(interior)]
+            betas.append(beta)
+        if self.grid.open_top:
+            betas[2][:, :, -1] = 1.0 / rho[:, :, -1]
+        if self.grid.two_dimensional:
+            betas[1][:] = 0.0
+        if self.solid.any():
+            for axis in range(3):
+                low = [slice(None)] * 3
+                high = [slice(None)] * 3
+                low[axis] = slice(0, -1)
+                high[axis] = slice(1, None)
+                betas[axis][tuple(low)][self.solid] = 0.0
+                betas[axis][tuple(high)][self.solid] = 0.0
+        return betas
+
+    def step(self, dt: float | None = None) -> StepReport:
+        """Advance by ``dt`` (default: the stable step)."""
+        if self.initial_water_volume is None:
+            self.initial_water_volume = self.water_volume()
+        dt = self.stable_time_step() if dt is None else float(dt)
+        h = self.h
+        courant = self.max_speed() * dt / h
+        if courant > 0.5 + 1e-12:
+            raise InstabilityError(f"fluid: Courant number {courant:.3f} > 0.5 at t = {self.time:.6g} s "
+                                   f"(dt = {dt:.3e} s, largest speed {self.max_speed():.3g} m/s)")
+        density_start = self.cell_density()
+        viscosity_start = self.cell_viscosity()
+        water_fluxes = self._advect_water(dt)
+        area = h * h
+        masses = [momentum.mass_fluxes(water_fluxes[a], velocity, dt, area, self.water.density,
+                                       self.air.density)
+                  for a, velocity in enumerate((self.u, self.v, self.w))]
+        velocities = (self.u, self.v, self.w)
+        new_velocities, densities = [], []
+        two_d = self.grid.two_dimensional
+        for axis, q in enumerate(velocities):
+            out = np.empty_like(q)
+            density = np.empty_like(q)
+            if axis == 1 and two_d:
+                out[:] = 0.0
+                density[:] = 1.0
+            else:
+                momentum.transport_component(q, axis, masses[0], masses[1], masses[2], velocities[0],
+                                             velocities[1], velocities[2], density_start,
+                                             viscosity_start, self.boundary_code, h, dt,
+                                             float(self.gravity[axis]), two_d, out, density)
+            new_velocities.append(out)
+            densities.append(density)
+        u, v, w = new_velocities
+        if self.grid.open_top:
+            # Zero gradient across the open top; the pressure correction then fixes its flux.
+            w[:, :, -1] = w[:, :, -2]
+        if self.surface_tension > 0:
+            self._add_surface_tension(u, v, w, densities, dt)
+        self._zero_solid_faces(u, v, w)
+        betas = self._face_coefficients(densities)
+        rhs = np.empty_like(self.pressure)
+        momentum.divergence(u, v, w, h, rhs)
+        rhs /= dt
+        pressure, report = self.pressure_solver.solve(betas[0], betas[1], betas[2], rhs,
+                                                      p_initial=self.pressure)
+        self._correct(u, v, w, pressure, betas, dt)
+        self.u, self.v, self.w, self.pressure = u, v, w, pressure
+        self.time += dt
+        self.step_count += 1
+        self.time_step = dt
+        error = (self.water_volume() - self.initial_water_volume) / max(self.initial_water_volume, 1e-300)
+        self.last_report = StepReport(time=self.time, time_step=dt, courant_number=courant,
+                                      pressure_iterations=report.iterations,
+                                      pressure_residual=report.relative_residual,
+                                      water_volume_error=error)
+        self._check_finite()
+        return self.last_report
+
+    def _add_surface_tension(self, u, v, w, densities, dt) -> None:
+        """u* += dt F / rho on the faces, F = sigma kappa grad f (continuum surface force with the
+        same face gradient as the pressure: balanced force)."""
+        from riprap.fluid.kernels.surface_tension import face_forces
+
+        forces = [np.zeros_like(u), np.zeros_like(v), np.zeros_like(w)]
+        face_forces(self.fraction, self.h, self.surface_tension, self.grid.two_dimensional,
+                    forces[0], forces[1], forces[2])
+        for axis, (q, force) in enumerate(zip((u, v, w), forces)):
+            interior = [slice(None)] * 3
+            interior[axis] = slice(1, -1)
+            index = tuple(interior)
+            q[index] += dt * force[index] / densities[axis][index]
+
+    def _zero_solid_faces(self, u, v, w) -> None:
+        if not self.solid.any():
+            return
+        for axis, q in enumerate((u, v, w)):
+            low = [slice(None)] * 3
+            high = [slice(None)] * 3
+            low[axis] = slice(0, -1)
+            high[axis] = slice(1, None)
+            q[tuple(low)][self.solid] = 0.0
+            q[tuple(high)][self.solid] = 0.0
+
+    def _correct(self, u, v, w, pressure, betas, dt) -> None:
+        """u = u* - dt beta grad p on interior faces; the open top against p = 0 at the face."""
+        h = self.h
+        u[1:-1] -= dt * betas[0][1:-1] * (pressure[1:] - pressure[:-1]) / h
+        if not self.grid.two_dimensional:
+            v[:, 1:-1] -= dt * betas[1][:, 1:-1] * (pressure[:, 1:] - pressure[:, :-1]) / h
+        w[:, :, 1:-1] -= dt * betas[2][:, :, 1:-1] * (pressure[:, :, 1:] - pressure[:, :, :-1]) / h
+        if self.grid.open_top:
+            w[:, :, -1] -= dt * betas[2][:, :, -1] * (0.0 - pressure[:, :, -1]) / (0.5 * h)
+
+    def _check_finite(self) -> None:
+        for name, array in (("u", self.u), ("v", self.v), ("w", self.w), ("pressure", self.pressure),
+                            ("water fraction", self.fraction)):
+            bad = ~np.isfinite(array)
+            if bad.any():
+                where = np.argwhere(bad)[0]
+                raise InstabilityError(f"fluid: {name} became non-finite at index {where.tolist()} "
+                                       f"at t = {self.time:.6g} s (step {self.step_count}, dt = "
+                                       f"{self.time_step:.3e} s)")
+
+    # ------------------------------------------------------------------ state
+    def state_arrays(self) -> dict:
+        return {"fraction": self.fraction.copy(), "u": self.u.copy(), "v": self.v.copy(),
+                "w": self.w.copy(), "pressure": self.pressure.copy(), "solid": self.solid.copy(),
+                "clock": np.array([self.time, float(self.step_count), self.time_step,
+                                   self.initial_water_volume or 0.0])}
+
+    def load_state_arrays(self, arrays: dict) -> None:
+        for name in ("fraction", "u", "v", "w", "pressure", "solid"):
+            if arrays[name].shape != getattr(self, name).shape:
+                raise CaseFileError(f"fluid checkpoint: {name} has shape {arrays[name].shape}, the "
+                                    f"grid needs {getattr(self, name).shape}")
+        self.fraction = arrays["fraction"].copy()
+        self.u, self.v, self.w = arrays["u"].copy(), arrays["v"].copy(), arrays["w"].copy()
+        self.pressure = arrays["pressure"].copy()
+        self.solid = arrays["solid"].astype(bool).copy()
+        self.time = float(arrays["clock"][0])
+        self.step_count = int(arrays["clock"][1])
+        self.time_step = float(arrays["clock"][2])
+        self.initial_water_volume = float(arrays["clock"][3]) or None
