@@ -22,6 +22,8 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
     from riprap.case.load import load_case
 
     case = load_case(path)
+    if case.is_fluid:
+        return _run_fluid_case(case, path, out, restart, quiet)
     if case.is_placement and case.body_count == 0:
         raise CaseFileError(f"{path} describes an armour placement and has no bodies of its own: "
                             f"run it with 'riprap place {path}'")
@@ -35,6 +37,28 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
           f"steps of {summary.time_step:.3e} s in {summary.wall_time:.1f} s "
           f"({summary.body_steps_per_second:,.0f} body-steps/s); {summary.contacts} contacts, "
           f"max speed {summary.max_speed:.3g} m/s")
+    for key, value in summary.outputs.items():
+        print(f"riprap: {key}: {value}")
+    return 0
+
+
+def _run_fluid_case(case, path: Path, out: str | None, restart: str | None, quiet: bool) -> int:
+    from riprap.case.build_fluid import build_fluid_run
+
+    if case.body_count > 0:
+        raise CaseFileError(f"{path}: has [fluid] and bodies; solids in the fluid (two-way "
+                            "coupling) are not available yet: run them as separate cases")
+    run = build_fluid_run(case, output_directory=out, progress=not quiet)
+    grid = run.solver.grid
+    print(f"riprap: fluid case {path}: {grid.cells[0]} x {grid.cells[1]} x {grid.cells[2]} cells of "
+          f"{grid.cell_size:.4g} m ({'2D' if grid.two_dimensional else '3D'}), water "
+          f"{run.solver.water_volume():.4g} m^3")
+    summary = run.run(restart_from=restart)
+    print(f"riprap: {summary.end_reason} at t = {summary.simulated_time:.4f} s after {summary.steps} "
+          f"steps ({summary.time_step_min:.2e}..{summary.time_step_max:.2e} s) in "
+          f"{summary.wall_time:.1f} s ({summary.cell_updates_per_second:,.0f} cell-updates/s); "
+          f"water volume error {summary.water_volume_error:.1e}, pressure iterations "
+          f"{summary.pressure_iterations_mean:.1f} (max {summary.pressure_iterations_max})")
     for key, value in summary.outputs.items():
         print(f"riprap: {key}: {value}")
     return 0

@@ -197,6 +197,37 @@ class PlacementSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class FluidSpec:
+    """``[fluid]``: see ``docs/case-file.md``."""
+
+    lower: Vector
+    upper: Vector
+    cells: tuple[int, int, int]
+    x_low: str = _default("fluid", "x_low")
+    x_high: str = _default("fluid", "x_high")
+    y_low: str = _default("fluid", "y_low")
+    y_high: str = _default("fluid", "y_high")
+    z_low: str = _default("fluid", "z_low")
+    z_high: str = _default("fluid", "z_high")
+    water_density: float = _default("fluid", "water_density")
+    water_viscosity: float = _default("fluid", "water_viscosity")
+    air_density: float = _default("fluid", "air_density")
+    air_viscosity: float = _default("fluid", "air_viscosity")
+    surface_tension: float = _default("fluid", "surface_tension")
+    courant_number: float = _default("fluid", "courant_number")
+    max_time_step: float = _default("fluid", "max_time_step")
+    pressure_tolerance: float = _default("fluid", "pressure_tolerance")
+
+
+@dataclass(frozen=True, kw_only=True)
+class RegionSpec:
+    """One ``[[water_regions]]`` or ``[[obstacles]]`` entry; ``parameters`` holds its type's keys."""
+
+    type: str
+    parameters: dict
+
+
+@dataclass(frozen=True, kw_only=True)
 class OutputSettings:
     """``[output]``."""
 
@@ -233,6 +264,14 @@ class Case:
     underlayer: UnderlayerSpec | None = None
     armour: ArmourSpec | None = None
     placement: PlacementSpec | None = None
+    fluid: FluidSpec | None = None
+    water_regions: tuple[RegionSpec, ...] = ()
+    obstacles: tuple[RegionSpec, ...] = ()
+
+    @property
+    def is_fluid(self) -> bool:
+        """Whether the case has a ``[fluid]`` table (a two-phase flow run)."""
+        return self.fluid is not None
 
     @property
     def is_placement(self) -> bool:
@@ -805,8 +844,13 @@ class _Validator:
         return self._entry(top, {name: data[name] for name in top_keys if name in data}, ())
 
     def _array(self, part: Table, data: dict) -> list:
-        # riprap place makes its own shapes and bodies: a placement case needs none.
-        minimum = 0 if part.name == "shapes" and "placement" in data else part.minimum_count
+        # riprap place makes its own shapes and bodies: a placement case needs none; a fluid case
+        # without bodies needs neither shapes nor materials.
+        minimum = part.minimum_count
+        if part.name == "shapes" and "placement" in data:
+            minimum = 0
+        if part.name in ("shapes", "materials") and "fluid" in data:
+            minimum = 0
         raw = data.get(part.name, _NOT_GIVEN)
         entries: list = []
         if raw is _NOT_GIVEN:
@@ -896,8 +940,8 @@ class _Validator:
                     )
 
     def _check_body_count(self, tables: dict) -> None:
-        if tables.get("placement") is not None:
-            return               # riprap place makes the bodies
+        if tables.get("placement") is not None or tables.get("fluid") is not None:
+            return               # riprap place makes the bodies; a fluid case needs none
         total = len(tables["bodies"])
         for values in tables["body_grids"]:
             counts = None if values is None else values.get("counts", _INVALID)
@@ -938,6 +982,11 @@ class _Validator:
             underlayer=_optional(UnderlayerSpec, tables["underlayer"]),
             armour=_optional(ArmourSpec, tables["armour"]),
             placement=_optional(PlacementSpec, tables["placement"]),
+            fluid=_optional(FluidSpec, tables["fluid"]),
+            water_regions=tuple(_with_parameters(RegionSpec, "water_regions", values)
+                                for values in tables["water_regions"]),
+            obstacles=tuple(_with_parameters(RegionSpec, "obstacles", values)
+                            for values in tables["obstacles"]),
         )
 
 

@@ -72,11 +72,13 @@ class FluidGrid:
         h = sizes[0]
         directions = [0, 2] if cells[1] == 1 else [0, 1, 2]
         if any(abs(sizes[d] - h) > _CUBE_TOLERANCE * h for d in directions):
-            suggestion = np.round((upper - lower) / h).astype(int)
+            suggestion = np.maximum(np.round((upper - lower) / h).astype(int), 1)
+            fitted = lower + suggestion * h
             raise CaseFileError(
                 f"fluid grid: cells must be cubes, but the box {(upper - lower).tolist()} m in "
-                f"{cells.tolist()} cells gives cells of {sizes.tolist()} m; with cells of {h:g} m "
-                f"use cells = {suggestion.tolist()} (and make the lengths whole multiples of it)")
+                f"{cells.tolist()} cells gives cells of {sizes.tolist()} m; for cells of {h:.6g} m "
+                f"use cells = {suggestion.tolist()} and upper = "
+                f"[{', '.join(f'{v:.6g}' for v in fitted)}]")
         boundaries = _default_boundaries()
         for side, kind in dict(self.boundaries).items():
             if side not in SIDES:
