@@ -148,7 +148,7 @@ class FluidRun:
                     raise InstabilityError(f"{error}; the last good state (t = {s.time:.6g} s) is "
                                            f"in {path}") from None
                 last_good = s.state_arrays()
-                pressure_seconds += getattr(s.pressure_solver, "last_solve_seconds", 0.0)
+                pressure_seconds += s.last_pressure_seconds
                 steps += 1
                 smallest, largest = min(smallest, dt), max(largest, dt)
                 courant_max = max(courant_max, report.courant_number)

@@ -23,6 +23,7 @@ within the same Courant number; it grows by at most ``_STEP_GROWTH`` per step.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -116,6 +117,7 @@ class FluidSolver:
                                       dtype=np.int64)
         self.pressure_solver = PressureSolver((nx, ny, nz), self.h, tolerance=pressure_tolerance)
         self.last_report = None
+        self.last_pressure_seconds = 0.0
 
     # ------------------------------------------------------------------ set-up
     def add_water_box(self, lower, upper) -> None:
@@ -266,8 +268,10 @@ class FluidSolver:
         rhs = np.empty_like(self.pressure)
         momentum.divergence(u, v, w, h, rhs)
         rhs /= dt
+        started = time.perf_counter()
         pressure, report = self.pressure_solver.solve(betas[0], betas[1], betas[2], rhs,
                                                       p_initial=self.pressure)
+        self.last_pressure_seconds = time.perf_counter() - started
         self._correct(u, v, w, pressure, betas, dt)
         self.u, self.v, self.w, self.pressure = u, v, w, pressure
         self.time += dt
