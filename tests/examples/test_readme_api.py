@@ -1,12 +1,17 @@
-"""The Python example of the README runs as written (shortened to 5 ms of simulated time)."""
+"""The Python examples of the README run as written (the solid one shortened to 5 ms of simulated
+time)."""
 import re
 from pathlib import Path
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 
 
+def _blocks():
+    return re.findall(r"```python\n(.*?)```", README.read_text(), re.S)
+
+
 def test_readme_python_example_runs(tmp_path, monkeypatch):
-    block = re.search(r"```python\n(.*?)```", README.read_text(), re.S).group(1)
+    block = next(b for b in _blocks() if "rr.Simulation(" in b)
     assert "end_time=1.0" in block and 'output_directory="out"' in block
     code = block.replace("end_time=1.0", "end_time=0.005").replace(
         'output_directory="out"', 'output_directory=OUT, progress=False')
@@ -15,3 +20,13 @@ def test_readme_python_example_runs(tmp_path, monkeypatch):
     summary = namespace["summary"]
     assert summary.bodies == 2 and summary.steps > 0
     assert (tmp_path / "out" / "bodies.pvd").exists()
+
+
+def test_readme_fluid_example_runs(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    block = next(b for b in _blocks() if "FluidSolver(" in b)
+    namespace = {}
+    exec(compile(block, str(README), "exec"), namespace)
+    report = namespace["report"]
+    assert report.time_step > 0 and abs(report.water_volume_error) < 1e-10
+    assert namespace["fluid"].solid.any()
