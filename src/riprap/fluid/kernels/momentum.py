@@ -45,26 +45,11 @@ def _van_leer_face(q_upwind_upwind, q_upwind, q_downwind):
     return q_upwind + 0.5 * limiter * jump
 
 
-@kernel
-def _at(array, index, axis, offset, other_axis, other_offset):
-    """array[index + offset e_axis + other_offset e_other_axis] (no bounds check)."""
-    i, j, k = index
-    if axis == 0:
-        i += offset
-    elif axis == 1:
-        j += offset
-    else:
-        k += offset
-    if other_axis == 0:
-        i += other_offset
-    elif other_axis == 1:
-        j += other_offset
-    else:
-        k += other_offset
-    return array[i, j, k]
+def _strides(array) -> np.ndarray:
+    """Element strides of a C-ordered 3D array."""
+    return np.array([array.shape[1] * array.shape[2], array.shape[2], 1], dtype=np.int64)
 
 
-@parallel_kernel
 def transport_component(q, axis, mass_x, mass_y, mass_z, velocity_x, velocity_y, velocity_z,
                         cell_density, cell_viscosity, boundary_kind, h, dt, gravity_component,
                         two_dimensional, q_out, density_out):
@@ -75,28 +60,75 @@ def transport_component(q, axis, mass_x, mass_y, mass_z, velocity_x, velocity_y,
     of them). ``cell_density``, ``cell_viscosity``: cell values at the start. Writes the new
     velocity (before the pressure correction) to ``q_out`` and the control volume's new density to
     ``density_out`` for every interior node; boundary nodes along ``axis`` are copied unchanged.
+    All arrays C-contiguous float64.
     """
-    nx, ny, nz = cell_density.shape
-    cells = (nx, ny, nz)
+    masses = (mass_x, mass_y, mass_z)
+    velocities = (velocity_x, velocity_y, velocity_z)
+    face_strides = np.stack([_strides(m) for m in masses])
+    _transport_flat(q.reshape(-1), np.array(q.shape, dtype=np.int64), _strides(q), int(axis),
+                    mass_x.reshape(-1), mass_y.reshape(-1), mass_z.reshape(-1),
+                    velocities[0].reshape(-1), velocities[1].reshape(-1), velocities[2].reshape(-1),
+                    face_strides, cell_density.reshape(-1), cell_viscosity.reshape(-1),
+                    np.array(cell_density.shape, dtype=np.int64), _strides(cell_density),
+                    np.asarray(boundary_kind, dtype=np.int64), float(h), float(dt),
+                    float(gravity_component), bool(two_dimensional), q_out.reshape(-1),
+                    density_out.reshape(-1))
+
+
+@parallel_kernel
+def _transport_flat(q, shape, q_stride, axis, mass_x, mass_y, mass_z, velocity_x, velocity_y,
+                    velocity_z, face_stride, cell_density, cell_viscosity, cells, cell_stride,
+                    boundary_kind, h, dt, gravity_component, two_dimensional, q_out, density_out):
+    """Flat-index form of :func:`transport_component`: every neighbour is a fixed offset (the
+    strides of its array along x, y, z), so the inner loop does no tuple indexing."""
     volume = h * h * h
-    shape = q.shape
+    a_q = q_stride[axis]
+    a_c = cell_stride[axis]
+    n_along = cells[axis]
     for outer in prange(shape[0]):
-        i = np.int64(outer)          # prange counts in uint64; a node tuple needs one int type
+        i = np.int64(outer)          # prange counts in uint64; mixed with int64 it would be float
         for j in range(shape[1]):
             for k in range(shape[2]):
-                node = (i, np.int64(j), np.int64(k))
-                s = node[axis]
-                q_out[i, j, k] = q[i, j, k]
-                density_out[i, j, k] = 0.0
-                if s == 0 or s == cells[axis]:
+                node = i * q_stride[0] + j * q_stride[1] + k
+                s = i if axis == 0 else (j if axis == 1 else k)
+                q_out[node] = q[node]
+                density_out[node] = 0.0
+                if s == 0 or s == n_along:
                     continue
-                density_old = 0.5 * (_at(cell_density, node, axis, -1, axis, 0)
-                                     + _at(cell_density, node, axis, 0, axis, 0))
+                # The cells after (c1) and before (c0) the node along the axis.
+                c1 = i * cell_stride[0] + j * cell_stride[1] + k * cell_stride[2]
+                c0 = c1 - a_c
+                density_old = 0.5 * (cell_density[c0] + cell_density[c1])
+                q_here = q[node]
                 mass_change = 0.0
                 momentum_change = 0.0
                 viscous = 0.0
+                # Faces at the centres of cells s-1 (lower) and s (upper) along the axis.
+                if axis == 0:
+                    mass_a = mass_x
+                elif axis == 1:
+                    mass_a = mass_y
+                else:
+                    mass_a = mass_z
+                for side in range(2):
+                    sign = 1.0 if side == 1 else -1.0
+                    lower = node + (side - 1) * a_q          # the two nodes beside the face
+                    upper = lower + a_q
+                    flux = 0.5 * (mass_a[lower] + mass_a[upper])
+                    if flux >= 0.0:
+                        upwind, downwind = lower, upper
+                        far = lower - a_q if s + side - 2 >= 0 else lower
+                    else:
+                        upwind, downwind = upper, lower
+                        far = upper + a_q if s + side + 1 <= n_along else upper
+                    q_face = _van_leer_face(q[far], q[upwind], q[downwind])
+                    cell = c0 if side == 0 else c1
+                    stress = 2.0 * cell_viscosity[cell] * (q[upper] - q[lower]) / h
+                    mass_change -= sign * flux
+                    momentum_change -= sign * flux * q_face
+                    viscous += sign * stress / h
                 for d in range(3):
-                    if d == 1 and two_dimensional:
+                    if d == axis or (d == 1 and two_dimensional):
                         continue
                     if d == 0:
                         mass_d = mass_x
@@ -107,97 +139,62 @@ def transport_component(q, axis, mass_x, mass_y, mass_z, velocity_x, velocity_y,
                     else:
                         mass_d = mass_z
                         velocity_d = velocity_z
-                    if d == axis:
-                        # Faces of the control volume at the centres of cells s-1 (lower) and s.
-                        for side in range(2):
-                            c = s - 1 + side                    # cell index along the axis
-                            flux = 0.5 * (_at(mass_d, node, axis, c - s, axis, 0)
-                                          + _at(mass_d, node, axis, c - s + 1, axis, 0))
-                            lower_node = c - s                  # offsets of the two nodes
-                            upper_node = c - s + 1
+                    t = i if d == 0 else (j if d == 1 else k)
+                    n_d = cells[d]
+                    d_q = q_stride[d]
+                    d_c = cell_stride[d]
+                    d_f = face_stride[d, d]
+                    a_f = face_stride[d, axis]
+                    # The d-face of cell s (along the axis) below the node.
+                    face_base = i * face_stride[d, 0] + j * face_stride[d, 1] + k * face_stride[d, 2]
+                    for side in range(2):
+                        sign = 1.0 if side == 1 else -1.0
+                        face = t + side
+                        f1 = face_base + side * d_f
+                        flux = 0.5 * (mass_d[f1 - a_f] + mass_d[f1])
+                        if face == 0 or face == n_d:
+                            kind = boundary_kind[2 * d + (1 if face == n_d else 0)]
+                            q_face = q_here
+                            if kind == NO_SLIP:
+                                mu_edge = 0.5 * (cell_viscosity[c0] + cell_viscosity[c1])
+                                stress = mu_edge * sign * (0.0 - q_here) / (0.5 * h)
+                            else:
+                                stress = 0.0
+                        else:
+                            neighbour = node + (d_q if side == 1 else -d_q)
+                            q_there = q[neighbour]
                             if flux >= 0.0:
-                                upwind = lower_node
-                                downwind = upper_node
-                                far = lower_node - 1 if s + lower_node - 1 >= 0 else lower_node
-                            else:
-                                upwind = upper_node
-                                downwind = lower_node
-                                far = (upper_node + 1 if s + upper_node + 1 <= cells[axis]
-                                       else upper_node)
-                            q_face = _van_leer_face(_at(q, node, axis, far, axis, 0),
-                                                    _at(q, node, axis, upwind, axis, 0),
-                                                    _at(q, node, axis, downwind, axis, 0))
-                            stress = (2.0 * _at(cell_viscosity, node, axis, side - 1, axis, 0)
-                                      * (_at(q, node, axis, upper_node, axis, 0)
-                                         - _at(q, node, axis, lower_node, axis, 0)) / h)
-                            sign = 1.0 if side == 1 else -1.0
-                            mass_change -= sign * flux
-                            momentum_change -= sign * flux * q_face
-                            viscous += sign * stress / h
-                    else:
-                        t = node[d]                             # cell index along d
-                        for side in range(2):
-                            sign = 1.0 if side == 1 else -1.0
-                            face = t + side                     # face index along d
-                            # Mass through this face of the control volume: the mean of the two
-                            # cell faces beside it (cells s-1 and s along the axis).
-                            flux = 0.5 * (_at(mass_d, node, d, side, axis, -1)
-                                          + _at(mass_d, node, d, side, axis, 0))
-                            boundary = face == 0 or face == cells[d]
-                            if boundary:
-                                kind = boundary_kind[2 * d + (1 if face == cells[d] else 0)]
-                                q_face = q[i, j, k]
-                                if kind == NO_SLIP:
-                                    gradient = sign * (0.0 - q[i, j, k]) / (0.5 * h)
-                                    mu_edge = 0.5 * (_at(cell_viscosity, node, axis, -1, d, 0)
-                                                     + _at(cell_viscosity, node, axis, 0, d, 0))
-                                    stress = mu_edge * gradient
+                                if side == 1:
+                                    q_up, q_down = q_here, q_there
+                                    q_far = q[node - d_q] if t - 1 >= 0 else q_here
                                 else:
-                                    stress = 0.0
+                                    q_up, q_down = q_there, q_here
+                                    q_far = q[node - 2 * d_q] if t - 2 >= 0 else q_there
                             else:
-                                neighbour = 1 if side == 1 else -1
-                                q_here = q[i, j, k]
-                                q_there = _at(q, node, d, neighbour, d, 0)
-                                if flux >= 0.0:
-                                    if side == 1:
-                                        q_up, q_down = q_here, q_there
-                                        far_ok = t - 1 >= 0
-                                        q_far = _at(q, node, d, -1, d, 0) if far_ok else q_here
-                                    else:
-                                        q_up, q_down = q_there, q_here
-                                        far_ok = t - 2 >= 0
-                                        q_far = _at(q, node, d, -2, d, 0) if far_ok else q_there
+                                if side == 1:
+                                    q_up, q_down = q_there, q_here
+                                    q_far = q[node + 2 * d_q] if t + 2 < n_d else q_there
                                 else:
-                                    if side == 1:
-                                        q_up, q_down = q_there, q_here
-                                        far_ok = t + 2 < cells[d]
-                                        q_far = _at(q, node, d, 2, d, 0) if far_ok else q_there
-                                    else:
-                                        q_up, q_down = q_here, q_there
-                                        far_ok = t + 1 < cells[d]
-                                        q_far = _at(q, node, d, 1, d, 0) if far_ok else q_here
-                                q_face = _van_leer_face(q_far, q_up, q_down)
-                                # Shear stress on the edge between the two nodes: viscosity the
-                                # mean of the four cells around the edge.
-                                lower_cell = t if side == 1 else t - 1
-                                mu_edge = 0.25 * (_at(cell_viscosity, node, axis, -1, d, lower_cell - t)
-                                                  + _at(cell_viscosity, node, axis, 0, d, lower_cell - t)
-                                                  + _at(cell_viscosity, node, axis, -1, d, lower_cell - t + 1)
-                                                  + _at(cell_viscosity, node, axis, 0, d, lower_cell - t + 1))
-                                dq = sign * (q_there - q_here) / h
-                                # d(velocity_d)/d(axis) on the edge: the two velocity_d faces
-                                # beside it (cells s-1 and s along the axis, face `face` along d).
-                                cross = (_at(velocity_d, node, d, side, axis, 0)
-                                         - _at(velocity_d, node, d, side, axis, -1)) / h
-                                stress = mu_edge * (dq + cross)
-                            mass_change -= sign * flux
-                            momentum_change -= sign * flux * q_face
-                            viscous += sign * stress / h
+                                    q_up, q_down = q_here, q_there
+                                    q_far = q[node + d_q] if t + 1 < n_d else q_here
+                            q_face = _van_leer_face(q_far, q_up, q_down)
+                            # Shear on the edge between the two nodes: viscosity the mean of the
+                            # four cells around it.
+                            shift = 0 if side == 1 else -d_c
+                            mu_edge = 0.25 * (cell_viscosity[c0 + shift] + cell_viscosity[c1 + shift]
+                                              + cell_viscosity[c0 + shift + d_c]
+                                              + cell_viscosity[c1 + shift + d_c])
+                            dq = sign * (q_there - q_here) / h
+                            cross = (velocity_d[f1] - velocity_d[f1 - a_f]) / h
+                            stress = mu_edge * (dq + cross)
+                        mass_change -= sign * flux
+                        momentum_change -= sign * flux * q_face
+                        viscous += sign * stress / h
                 density_new = density_old + mass_change / volume
-                momentum = (density_old * q[i, j, k] + momentum_change / volume
+                momentum = (density_old * q_here + momentum_change / volume
                             + dt * (viscous + density_new * gravity_component))
-                q_out[i, j, k] = momentum / density_new
-                density_out[i, j, k] = density_new
+                q_out[node] = momentum / density_new
+                density_out[node] = density_new
 
 
 @parallel_kernel
