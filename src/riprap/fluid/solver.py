@@ -144,6 +144,15 @@ class FluidSolver:
                                 f"{g.lower[2]} .. {g.upper[2]} m")
         self.add_water_box(g.lower, (g.upper[0], g.upper[1], level))
 
+    def add_obstacle_mask(self, mask) -> None:
+        """A fixed solid made of the cells where ``mask`` (nx, ny, nz) is true."""
+        mask = np.asarray(mask, dtype=bool)
+        if mask.shape != self.fraction.shape:
+            raise CaseFileError(f"fluid obstacle mask has shape {mask.shape}, the grid "
+                                f"{self.fraction.shape}")
+        self.solid |= mask
+        self.fraction[mask] = 0.0
+
     def add_obstacle_box(self, lower, upper) -> None:
         """A fixed solid: every cell whose centre lies inside lower..upper (m)."""
         g = self.grid
@@ -326,9 +335,14 @@ class FluidSolver:
             bad = ~np.isfinite(array)
             if bad.any():
                 where = np.argwhere(bad)[0]
-                raise InstabilityError(f"fluid: {name} became non-finite at index {where.tolist()} "
-                                       f"at t = {self.time:.6g} s (step {self.step_count}, dt = "
-                                       f"{self.time_step:.3e} s)")
+                # Face arrays have one more entry along their axis: this is near enough a place.
+                position = [self.grid.lower[a] + (min(where[a], self.grid.cells[a] - 1) + 0.5) * self.h
+                            for a in range(3)]
+                raise InstabilityError(
+                    f"fluid: {name} became non-finite at index {where.tolist()} (near x, y, z = "
+                    f"{', '.join(f'{v:.4g}' for v in position)} m) at t = {self.time:.6g} s (step "
+                    f"{self.step_count}, dt = {self.time_step:.3e} s); reduce courant_number or "
+                    "max_time_step, or refine the grid")
 
     # ------------------------------------------------------------------ state
     def state_arrays(self) -> dict:
