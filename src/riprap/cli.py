@@ -160,7 +160,9 @@ def main(argv: list[str] | None = None) -> int:
             from riprap.case.load import load_case
 
             case = load_case(args.case)
-            what = "an armour placement" if case.is_placement else f"{case.body_count} bodies"
+            what = ("an armour placement" if case.is_placement else
+                    f"air and water on {'x'.join(map(str, case.fluid.cells))} cells" if case.is_fluid
+                    else f"{case.body_count} bodies")
             print(f"{args.case}: valid ({what})")
             return 0
         if args.command == "info":
