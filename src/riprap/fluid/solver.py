@@ -92,6 +92,12 @@ class FluidSolver:
         if not (math.isfinite(surface_tension) and surface_tension >= 0):
             raise CaseFileError(f"fluid: surface_tension = {surface_tension!r} must be >= 0 N/m "
                                 "(0.0728 for clean water and air at 20 degrees C)")
+        if surface_tension > 0:
+            import importlib.util
+
+            if importlib.util.find_spec("riprap.fluid.kernels.surface_tension") is None:
+                raise CaseFileError("fluid: surface_tension > 0 needs the surface-tension kernel, "
+                                    "which this riprap does not have yet; set surface_tension = 0")
         if not (math.isfinite(max_time_step) and max_time_step > 0):
             raise CaseFileError(f"fluid: max_time_step = {max_time_step!r} must be > 0 s")
         self.grid = grid
