@@ -13,6 +13,10 @@ from riprap import analysis, errors, placement
 from riprap.analysis import analyse, compare_layers
 from riprap.case.build import build_simulation
 from riprap.case.load import load_case, parse_case
+from riprap.fluid.grid import FluidGrid
+from riprap.fluid.phases import AIR_20C, SEA_WATER_20C, WATER_20C, Phase
+from riprap.fluid.run import FluidRun
+from riprap.fluid.solver import FluidSolver
 from riprap.geometry import shapes
 from riprap.geometry.armour_units import ArmourUnit, armour_unit
 from riprap.geometry.rock_grading import RockGrading, rock_library
@@ -25,7 +29,8 @@ from riprap.solid.shape import RigidShape
 from riprap.solid.solver import ContactRecords, SolidSolver
 
 __all__ = [
-    "ArmourUnit", "ContactRecords", "analyse", "analysis", "compare_layers", "Material", "RigidShape", "RockGrading", "RunSummary",
+    "AIR_20C", "ArmourUnit", "ContactRecords", "FluidGrid", "FluidRun", "FluidSolver", "Phase",
+    "SEA_WATER_20C", "WATER_20C", "analyse", "analysis", "compare_layers", "Material", "RigidShape", "RockGrading", "RunSummary",
     "Simulation", "SolidSolver", "TetMesh", "armour_unit", "build_simulation", "errors",
     "load_case", "mass_properties", "parse_case", "placement", "rock_library", "shapes", "walls",
 ]
