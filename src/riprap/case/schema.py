@@ -512,7 +512,7 @@ KEYS: tuple[Key, ...] = (
     Key("fluid", "air_viscosity", "number", "Pa s", "Dynamic viscosity of air at 20 C.",
         default=1.825e-5, valid_range=_POSITIVE),
     Key("fluid", "surface_tension", "number", "N/m",
-        "Air-water surface tension (0.0728 at 20 C); 0 leaves it out.", default=0.0,
+        "Air-water surface tension, clean water at 20 C; 0 leaves it out.", default=0.0728,
         valid_range=_NON_NEGATIVE),
     Key("fluid", "courant_number", "number", "-",
         "Largest max|u| dt / h; the interface advection is bounded up to 0.5.", default=0.3,

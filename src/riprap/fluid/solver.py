@@ -7,18 +7,22 @@ One step of length dt (all explicit but the pressure):
    bounded (``riprap/fluid/kernels/plic.py``); it also gives the water volume through every face;
 2. momentum: moved with the mass fluxes of step 1 and divided by a density moved with the same
    fluxes, plus explicit viscous stresses and gravity (``riprap/fluid/kernels/momentum.py``);
-3. pressure: div((1/rho) grad p) = div(u*) / dt on the cells, 1/rho on the faces from the
+3. surface tension (``surface_tension`` > 0): u* += dt sigma kappa grad f / rho on the faces, kappa
+   from height functions (``riprap/fluid/kernels/surface_tension.py``), grad f discretised as the
+   pressure gradient so that the pressure jump balances it exactly (balanced force);
+4. pressure: div((1/rho) grad p) = div(u*) / dt on the cells, 1/rho on the faces from the
    densities of step 2, walls closed, the open top at p = 0 (``riprap/fluid/pressure.py``,
    multigrid-preconditioned conjugate gradients);
-4. correction: u = u* - dt (1/rho) grad p on every face, so that div u = 0 to the solver tolerance.
+5. correction: u = u* - dt (1/rho) grad p on every face, so that div u = 0 to the solver tolerance.
 
 Gravity enters the momentum of the faces (step 2) and is balanced by the pressure gradient of step
-3: water at rest under a flat surface stays at rest to the solver tolerance.
+4: water at rest under a flat surface stays at rest to the solver tolerance.
 
 Time step: the largest that keeps the Courant number max|u| dt / h below ``courant_number``
 (Weymouth & Yue need <= 0.5 for boundedness), explicit viscous diffusion stable (dt <= h^2 /
-(8 nu) in 3D, nu the largest kinematic viscosity), and a body starting from rest under gravity
-within the same Courant number; it grows by at most ``_STEP_GROWTH`` per step.
+(8 nu) in 3D, nu the largest kinematic viscosity), the shortest capillary wave resolved (dt <=
+sqrt((rho_w + rho_a) h^3 / (4 pi sigma)), Brackbill et al. 1992), and a body starting from rest
+under gravity within the same Courant number; it grows by at most ``_STEP_GROWTH`` per step.
 """
 from __future__ import annotations
 
@@ -78,12 +82,15 @@ class FluidSolver:
         Relative residual at which the pressure solve stops.
     max_time_step : float
         Upper bound on dt (s).
+    surface_tension : float
+        Air-water surface tension sigma (N/m; default 0.0728, clean water at 20 degrees C; 0
+        leaves it out).
     """
 
     def __init__(self, grid: FluidGrid, *, water: Phase = WATER_20C, air: Phase = AIR_20C,
                  gravity=(0.0, 0.0, -9.81), courant_number: float = 0.3,
                  pressure_tolerance: float = 1e-8, max_time_step: float = 0.01,
-                 surface_tension: float = 0.0):
+                 surface_tension: float = 0.0728):
         from riprap.fluid.pressure import PressureSolver
 
         if not 0.0 < courant_number <= 0.5:
@@ -92,12 +99,6 @@ class FluidSolver:
         if not (math.isfinite(surface_tension) and surface_tension >= 0):
             raise CaseFileError(f"fluid: surface_tension = {surface_tension!r} must be >= 0 N/m "
                                 "(0.0728 for clean water and air at 20 degrees C)")
-        if surface_tension > 0:
-            import importlib.util
-
-            if importlib.util.find_spec("riprap.fluid.kernels.surface_tension") is None:
-                raise CaseFileError("fluid: surface_tension > 0 needs the surface-tension kernel, "
-                                    "which this riprap does not have yet; set surface_tension = 0")
         if not (math.isfinite(max_time_step) and max_time_step > 0):
             raise CaseFileError(f"fluid: max_time_step = {max_time_step!r} must be > 0 s")
         self.grid = grid
@@ -200,6 +201,10 @@ class FluidSolver:
             limits.append(self.courant_number * h / speed)
         nu = max(self.water.kinematic_viscosity, self.air.kinematic_viscosity)
         limits.append(h * h / (8.0 * nu))
+        if self.surface_tension > 0:
+            # capillary waves of the shortest length the grid carries (Brackbill et al. 1992)
+            limits.append(math.sqrt((self.water.density + self.air.density) * h ** 3
+                                    / (4.0 * math.pi * self.surface_tension)))
         g = float(np.linalg.norm(self.gravity))
         if g > 0:
             limits.append(math.sqrt(2.0 * self.courant_number * h / g))

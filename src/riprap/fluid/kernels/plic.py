@@ -216,7 +216,7 @@ def rectangle_volume(n1, n2, n3, alpha, x0, y0, z0, dx, dy, dz):
 # --------------------------------------------------------------------------------------------
 
 @kernel
-def _clamp(index, size):
+def clamp_index(index, size):
     """Nearest valid index (zero-gradient continuation outside the domain)."""
     if index < 0:
         return 0
@@ -257,13 +257,13 @@ def interface_normal(f, i, j, k):
     z_columns_dx = 0.0
     z_columns_dy = 0.0
     for a in range(-1, 2):
-        ia = _clamp(i + a, nx)
+        ia = clamp_index(i + a, nx)
         wa = 2.0 - abs(a)
         for b in range(-1, 2):
-            jb = _clamp(j + b, ny)
+            jb = clamp_index(j + b, ny)
             wb = 2.0 - abs(b)
             for c in range(-1, 2):
-                value = f[ia, jb, _clamp(k + c, nz)]
+                value = f[ia, jb, clamp_index(k + c, nz)]
                 wc = 2.0 - abs(c)
                 youngs_x += wb * wc * a * value
                 youngs_y += wa * wc * b * value
@@ -328,10 +328,10 @@ def _interface_normal_2d(f, i, k):
     x_columns_dz = 0.0
     z_columns_dx = 0.0
     for a in range(-1, 2):
-        ia = _clamp(i + a, nx)
+        ia = clamp_index(i + a, nx)
         wa = 2.0 - abs(a)
         for c in range(-1, 2):
-            value = f[ia, 0, _clamp(k + c, nz)]
+            value = f[ia, 0, clamp_index(k + c, nz)]
             wc = 2.0 - abs(c)
             youngs_x += wc * a * value
             youngs_z += wa * c * value
