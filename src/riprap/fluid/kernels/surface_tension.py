@@ -8,20 +8,22 @@ up to the error of the curvature estimate instead of stirring "parasitic current
 
 Curvature: from height functions (Cummins, Francois & Kothe 2005, Comput. Struct. 83: 425;
 Popinet 2009, J. Comput. Phys. 228: 5838). In a cell near the interface, take the axis d along
-which the interface normal is largest; sum the water fraction over 7-cell columns along d through
-the cell and its neighbours across d: each sum is the height of the interface above the column's
-foot (in cells). Second-order differences of those heights give kappa = div n (n the unit normal
-from water to air; a water drop has kappa > 0):
+which the interface normal is largest; through the cell and its neighbours across d, run columns
+along d out to the first full cell on the water side and the first empty cell on the air side (at
+most 5 cells each way): the water in a column is the height of the interface in it. Second-order
+differences of the heights give kappa = div n (n the unit normal from water to air; a water drop
+has kappa > 0):
 
     kappa = -(H_aa (1 + H_b^2) + H_bb (1 + H_a^2) - 2 H_ab H_a H_b) / (1 + H_a^2 + H_b^2)^(3/2)
 
 whichever side of the columns the water lies (both the heights and their second derivatives
-change sign together). A column is used only if it is closed: water at its water end, air at its
-other end. Where a column is not closed (thin films and tips, under-resolved drops) the cell takes
-the mean height-function curvature of the interface cells around it, and failing that the
-divergence of normals from the fraction's corner gradients (Youngs). |kappa| is capped at 1 / h: a
-grid cannot carry a surface curved on a smaller scale, and larger estimates come from
-under-resolved tips where they only make noise.
+change sign together). Where the columns along d do not close, those along the next axis the
+normal leans towards are tried. Where none close (thin films and tips, corners of drops a few cells
+across), in this order: the mean of the height-function curvatures of the cut cells around; the
+cell's own columns closed loosely (ends within 1e-2 of full or empty); the mean of those second
+values around; the divergence of Youngs' normals. |kappa| is capped at 1 / h: a grid cannot carry
+a surface curved on a smaller scale, and larger estimates come from under-resolved tips where
+they only make noise.
 
 Outside the domain the fraction continues with zero gradient, which is a contact angle of 90
 degrees on walls.
@@ -33,7 +35,14 @@ from riprap.fluid.kernels.plic import clamp_index, interface_normal
 
 __all__ = ["cell_curvature", "face_forces", "NO_CURVATURE", "HEIGHT_FUNCTION", "FALLBACK"]
 
-_HALF_COLUMN = 3                     # 7-cell columns
+_HALF_COLUMN = 5                     # columns of up to 11 cells
+# A cell this close to 0 or 1 ends a column; loosely only where neither strict columns nor strict
+# neighbours give a curvature (drops a few cells across have no strictly full corner columns).
+_PURE_STRICT = 1e-6
+_PURE_LOOSE = 1e-2
+# columns along an axis the normal leans towards by less than this (1-norm share) are not tried:
+# the surface would be too steep across them for three columns to see it
+_MIN_COLUMN_COMPONENT = 0.2
 _MIXED = 1e-9                        # 0 < f < 1 beyond this: a cell the interface cuts
 # cell status in the curvature pass
 NO_CURVATURE = 0                     # not next to the interface
@@ -48,31 +57,58 @@ def _value(f, i, j, k):
 
 
 @kernel
-def _column(f, i, j, k, axis, water_low):
-    """Height (in cells) of water in the 7-cell column along ``axis`` centred on (i, j, k), and
-    whether the column is closed (water at its water end, air at the other)."""
-    total = 0.0
-    for m in range(-_HALF_COLUMN, _HALF_COLUMN + 1):
-        if axis == 0:
-            total += _value(f, i + m, j, k)
-        elif axis == 1:
-            total += _value(f, i, j + m, k)
-        else:
-            total += _value(f, i, j, k + m)
+def _along(f, i, j, k, axis, m):
+    """The fraction m cells from (i, j, k) along ``axis`` (zero gradient past the domain)."""
     if axis == 0:
-        low = _value(f, i - _HALF_COLUMN, j, k)
-        high = _value(f, i + _HALF_COLUMN, j, k)
-    elif axis == 1:
-        low = _value(f, i, j - _HALF_COLUMN, k)
-        high = _value(f, i, j + _HALF_COLUMN, k)
-    else:
-        low = _value(f, i, j, k - _HALF_COLUMN)
-        high = _value(f, i, j, k + _HALF_COLUMN)
-    if water_low:
-        closed = low > 0.5 and high < 0.5
-    else:
-        closed = high > 0.5 and low < 0.5
-    return total, closed
+        return _value(f, i + m, j, k)
+    if axis == 1:
+        return _value(f, i, j + m, k)
+    return _value(f, i, j, k + m)
+
+
+@kernel
+def _column(f, i, j, k, axis, water_low, pure):
+    """Position of the interface along ``axis`` in the column through (i, j, k), in cells from the
+    centre of (i, j, k) towards the air, and whether the column is closed.
+
+    The column runs from the cell out to the first full cell on the water side and the first empty
+    cell on the air side, at most ``_HALF_COLUMN`` cells each way (Popinet 2009): a fixed stencil
+    would cut off the interface in the corner columns of a steep normal. Not closed where either
+    end is not reached."""
+    towards_air = 1 if water_low else -1
+    water_end = 0
+    wet = False
+    while True:
+        value = _along(f, i, j, k, axis, -towards_air * water_end)
+        if value >= 1.0 - pure:
+            break
+        if value > pure:
+            wet = True
+        elif wet:
+            return 0.0, False              # back into air: the column crosses the surface twice
+        water_end += 1
+        if water_end > _HALF_COLUMN:
+            return 0.0, False
+    air_end = 0
+    dry = False
+    while True:
+        value = _along(f, i, j, k, axis, towards_air * air_end)
+        if value <= pure:
+            break
+        if value < 1.0 - pure:
+            dry = True
+        elif dry:
+            return 0.0, False              # back into water
+        air_end += 1
+        if air_end > _HALF_COLUMN:
+            return 0.0, False
+    if water_end == 0 and air_end == 0:
+        return 0.0, False                  # cannot be both full and empty
+    total = 0.0
+    for m in range(-water_end, air_end + 1):
+        total += _along(f, i, j, k, axis, towards_air * m)
+    # the water-end cell's far face is water_end + 1/2 cells below the centre
+    return total - water_end - 0.5, True
 
 
 @kernel
@@ -85,23 +121,9 @@ def _offset(i, j, k, axis, step):
 
 
 @kernel
-def _height_function_curvature(f, i, j, k, h, two_dimensional):
-    """(kappa, closed) in cell (i, j, k) from height functions; closed False where any column
-    of the stencil is not closed or no normal can be found."""
-    n1, n2, n3 = interface_normal(f, i, j, k)
-    if n1 == 0.0 and n2 == 0.0 and n3 == 0.0:
-        return 0.0, False
-    a1 = abs(n1)
-    a2 = abs(n2)
-    a3 = abs(n3)
-    if a1 >= a2 and a1 >= a3:
-        axis, leading = 0, n1
-    elif a2 >= a3:
-        axis, leading = 1, n2
-    else:
-        axis, leading = 2, n3
-    water_low = leading > 0.0            # the normal points from water to air
-    # the tangential axes (in 2D only the other of x and z)
+def _curvature_along(f, i, j, k, h, two_dimensional, axis, water_low, pure):
+    """(kappa, closed) from the heights of the columns along ``axis`` through (i, j, k) and its
+    neighbours across ``axis``."""
     if axis == 0:
         t1, t2 = 2, 1
     elif axis == 1:
@@ -120,7 +142,7 @@ def _height_function_curvature(f, i, j, k, h, two_dimensional):
                 ib, jb, kb = _offset(ia, ja, ka, t2, b)
             else:
                 ib, jb, kb = ia, ja, ka
-            height, closed = _column(f, ib, jb, kb, axis, water_low)
+            height, closed = _column(f, ib, jb, kb, axis, water_low, pure)
             if not closed:
                 return 0.0, False
             heights[a + 1, b + 1] = height
@@ -133,6 +155,27 @@ def _height_function_curvature(f, i, j, k, h, two_dimensional):
     hab = (heights[2, 2] - heights[2, 0] - heights[0, 2] + heights[0, 0]) / (4.0 * h)
     numerator = haa * (1.0 + hb * hb) + hbb * (1.0 + ha * ha) - 2.0 * hab * ha * hb
     return -numerator / (1.0 + ha * ha + hb * hb) ** 1.5, True
+
+
+@kernel
+def _height_function_curvature(f, i, j, k, h, two_dimensional, pure):
+    """(kappa, closed) in cell (i, j, k) from height functions: columns along the axis the normal
+    is closest to, or, where those do not close (steep corners of small drops), along the next
+    axis the normal leans towards (Popinet 2009). closed False where none closes."""
+    n1, n2, n3 = interface_normal(f, i, j, k)
+    components = np.array([n1, n2, n3])
+    if two_dimensional:
+        components[1] = 0.0
+    order = np.argsort(-np.abs(components))
+    for rank in range(3):
+        axis = order[rank]
+        if abs(components[axis]) < _MIN_COLUMN_COMPONENT:
+            break
+        curvature, closed = _curvature_along(f, i, j, k, h, two_dimensional, axis,
+                                             components[axis] > 0.0, pure)
+        if closed:
+            return curvature, True
+    return 0.0, False
 
 
 @kernel
@@ -193,32 +236,75 @@ def cell_curvature(f, h, two_dimensional, kappa, status):
                                     near = True
                 if not near:
                     continue
-                curvature, closed = _height_function_curvature(f, i, j, k, h, two_dimensional)
+                curvature, closed = _height_function_curvature(f, i, j, k, h, two_dimensional,
+                                                               _PURE_STRICT)
                 if closed:
                     kappa[i, j, k] = min(cap, max(-cap, curvature))
                     status[i, j, k] = HEIGHT_FUNCTION
                 else:
                     status[i, j, k] = FALLBACK
-    # Cells whose columns were not closed: the mean of the height-function values around them.
+    # Cells whose strict columns did not close: the mean of the strict values of the cut cells
+    # around them, else their own loosely closed columns (written to a side array: neighbours read
+    # only pass-1 values, so the threads do not race).
+    loose = np.zeros_like(kappa)
+    level = np.zeros(f.shape, dtype=np.int8)         # 1 neighbour mean, 2 loose columns, 3 neither
+    # (level 0: not a fallback cell)
     for outer in prange(nx):
-        i = np.int64(outer)          # prange counts in uint64; mixed with int64 it gives floats
+        i = np.int64(outer)
         for j in range(ny):
             for k in range(nz):
                 if status[i, j, k] != FALLBACK:
                     continue
-                total = 0.0
-                count = 0
-                for a in range(max(i - 1, 0), min(i + 2, nx)):
-                    for b in range(max(j - 1, 0), min(j + 2, ny)):
-                        for c in range(max(k - 1, 0), min(k + 2, nz)):
-                            if status[a, b, c] == HEIGHT_FUNCTION and _MIXED < f[a, b, c] < 1.0 - _MIXED:
-                                total += kappa[a, b, c]
-                                count += 1
+                total, count = _neighbour_mean(f, kappa, status, loose, level, i, j, k, False)
+                if count > 0:
+                    loose[i, j, k] = total / count
+                    level[i, j, k] = 1
+                    continue
+                curvature, closed = _height_function_curvature(f, i, j, k, h, two_dimensional,
+                                                               _PURE_LOOSE)
+                if closed:
+                    loose[i, j, k] = min(cap, max(-cap, curvature))
+                    level[i, j, k] = 2
+                else:
+                    level[i, j, k] = 3
+    # The rest: the mean of any column-based value around them, failing that Youngs' normals.
+    for outer in prange(nx):
+        i = np.int64(outer)
+        for j in range(ny):
+            for k in range(nz):
+                if status[i, j, k] != FALLBACK:
+                    continue
+                if level[i, j, k] < 3:
+                    kappa[i, j, k] = loose[i, j, k]
+                    continue
+                total, count = _neighbour_mean(f, kappa, status, loose, level, i, j, k, True)
                 if count > 0:
                     kappa[i, j, k] = total / count
                 else:
                     curvature = _normal_divergence_curvature(f, i, j, k, h, two_dimensional)
                     kappa[i, j, k] = min(cap, max(-cap, curvature))
+
+
+@kernel
+def _neighbour_mean(f, kappa, status, loose, level, i, j, k, with_loose):
+    """Sum and count of the column-based curvatures of the cut cells in the 3x3x3 block around
+    (i, j, k): strict ones, and with ``with_loose`` also the second-pass ones (neighbour means and
+    loosely closed columns)."""
+    nx, ny, nz = f.shape
+    total = 0.0
+    count = 0
+    for a in range(max(i - 1, 0), min(i + 2, nx)):
+        for b in range(max(j - 1, 0), min(j + 2, ny)):
+            for c in range(max(k - 1, 0), min(k + 2, nz)):
+                if not _MIXED < f[a, b, c] < 1.0 - _MIXED:
+                    continue
+                if status[a, b, c] == HEIGHT_FUNCTION:
+                    total += kappa[a, b, c]
+                    count += 1
+                elif with_loose and status[a, b, c] == FALLBACK and level[a, b, c] < 3:
+                    total += loose[a, b, c]
+                    count += 1
+    return total, count
 
 
 @kernel
