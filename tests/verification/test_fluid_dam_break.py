@@ -23,7 +23,8 @@ Tolerances:
   to 2.45), a/50: within ``HEIGHT_TOLERANCE`` = 0.03 (measured: 0.019 at most);
 - 3D: a tank 1.25 a wide with no-slip side walls (the peers' 3D case), a/12 and a/16: converged
   within 0.1 a (measured 0.05 a) and within 0.35 a of the experiment (measured +0.28 a at most;
-  at T = 3 against Fig. 3: riprap a/16 3.97 with sigma 0.07, interFoam a/16 at maxCo 1 3.91).
+  at T = 3 against Fig. 3: riprap a/16 3.97 with sigma 0.07, interFoam a/16 3.97 at maxCo 0.3,
+  3.91 at maxCo 1).
 """
 import numpy as np
 import pytest
