@@ -121,7 +121,7 @@ def _offset(i, j, k, axis, step):
 
 
 @kernel
-def _curvature_along(f, i, j, k, h, two_dimensional, axis, water_low, pure):
+def _curvature_along(f, i, j, k, h, two_dimensional, axis, water_low, pure, heights):
     """(kappa, closed) from the heights of the columns along ``axis`` through (i, j, k) and its
     neighbours across ``axis``."""
     if axis == 0:
@@ -132,7 +132,6 @@ def _curvature_along(f, i, j, k, h, two_dimensional, axis, water_low, pure):
         t1, t2 = 0, 1
     if two_dimensional:
         t2 = -1
-    heights = np.zeros((3, 3))
     for a in range(-1, 2):
         ia, ja, ka = _offset(i, j, k, t1, a)
         for b in range(-1, 2):
@@ -158,21 +157,33 @@ def _curvature_along(f, i, j, k, h, two_dimensional, axis, water_low, pure):
 
 
 @kernel
-def _height_function_curvature(f, i, j, k, h, two_dimensional, pure):
+def _height_function_curvature(f, i, j, k, h, two_dimensional, pure, heights):
     """(kappa, closed) in cell (i, j, k) from height functions: columns along the axis the normal
     is closest to, or, where those do not close (steep corners of small drops), along the next
-    axis the normal leans towards (Popinet 2009). closed False where none closes."""
+    axis the normal leans towards (Popinet 2009). closed False where none closes. ``heights``
+    (3, 3) is work space."""
     n1, n2, n3 = interface_normal(f, i, j, k)
-    components = np.array([n1, n2, n3])
     if two_dimensional:
-        components[1] = 0.0
-    order = np.argsort(-np.abs(components))
+        n2 = 0.0
     for rank in range(3):
-        axis = order[rank]
-        if abs(components[axis]) < _MIN_COLUMN_COMPONENT:
+        # the axis with the rank-th largest |n| (ties: lower axis first)
+        axis = 0
+        component = n1
+        for candidate in range(3):
+            value = n1 if candidate == 0 else (n2 if candidate == 1 else n3)
+            larger = 0
+            for other in range(3):
+                other_value = n1 if other == 0 else (n2 if other == 1 else n3)
+                if abs(other_value) > abs(value) or (abs(other_value) == abs(value)
+                                                     and other < candidate):
+                    larger += 1
+            if larger == rank:
+                axis = candidate
+                component = value
+        if abs(component) < _MIN_COLUMN_COMPONENT:
             break
         curvature, closed = _curvature_along(f, i, j, k, h, two_dimensional, axis,
-                                             components[axis] > 0.0, pure)
+                                             component > 0.0, pure, heights)
         if closed:
             return curvature, True
     return 0.0, False
@@ -219,6 +230,7 @@ def cell_curvature(f, h, two_dimensional, kappa, status):
     cap = 1.0 / h
     for outer in prange(nx):
         i = np.int64(outer)          # prange counts in uint64; mixed with int64 it gives floats
+        heights = np.empty((3, 3))
         for j in range(ny):
             for k in range(nz):
                 kappa[i, j, k] = 0.0
@@ -237,7 +249,7 @@ def cell_curvature(f, h, two_dimensional, kappa, status):
                 if not near:
                     continue
                 curvature, closed = _height_function_curvature(f, i, j, k, h, two_dimensional,
-                                                               _PURE_STRICT)
+                                                               _PURE_STRICT, heights)
                 if closed:
                     kappa[i, j, k] = min(cap, max(-cap, curvature))
                     status[i, j, k] = HEIGHT_FUNCTION
@@ -251,6 +263,7 @@ def cell_curvature(f, h, two_dimensional, kappa, status):
     # (level 0: not a fallback cell)
     for outer in prange(nx):
         i = np.int64(outer)
+        heights = np.empty((3, 3))
         for j in range(ny):
             for k in range(nz):
                 if status[i, j, k] != FALLBACK:
@@ -261,7 +274,7 @@ def cell_curvature(f, h, two_dimensional, kappa, status):
                     level[i, j, k] = 1
                     continue
                 curvature, closed = _height_function_curvature(f, i, j, k, h, two_dimensional,
-                                                               _PURE_LOOSE)
+                                                               _PURE_LOOSE, heights)
                 if closed:
                     loose[i, j, k] = min(cap, max(-cap, curvature))
                     level[i, j, k] = 2
