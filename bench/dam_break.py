@@ -30,11 +30,12 @@ A = 0.05715
 GRIDS = {"small": (25, 32), "large": (50, 64)}      # cells per a, cells across
 
 
-def column(cells_per_a: int, across: int, surface_tension: float) -> FluidSolver:
+def column(cells_per_a: int, across: int, surface_tension: float,
+           courant_number: float = 0.3) -> FluidSolver:
     h = A / cells_per_a
     nx, nz = 5 * cells_per_a, int(np.ceil(2.52 * cells_per_a))
     grid = FluidGrid(lower=(0, 0, 0), upper=(nx * h, across * h, nz * h), cells=(nx, across, nz))
-    solver = FluidSolver(grid, surface_tension=surface_tension)
+    solver = FluidSolver(grid, surface_tension=surface_tension, courant_number=courant_number)
     solver.add_water_box((0, 0, 0), (A, across * h, 2 * A))
     return solver
 

@@ -22,10 +22,8 @@ import time
 import numba
 import numpy as np
 
-from riprap.fluid.grid import FluidGrid
-from riprap.fluid.solver import FluidSolver
+from dam_break import A, column          # the same column as the speed bench
 
-A = 0.05715
 G = 9.81
 TIMES = np.round(np.arange(0.0, 3.61, 0.2), 2)
 # Martin & Moyce (1952) Fig. 3, n^2 = 2, a = 2.25 in, interpolated at TIMES (peers' table 3a).
@@ -43,13 +41,10 @@ def main() -> None:
     parser.add_argument("--surface-tension", type=float, default=0.07, help="N/m")
     parser.add_argument("--courant-number", type=float, default=0.3)
     args = parser.parse_args()
-    h = A / args.cells_per_a
-    nx, nz = 5 * args.cells_per_a, int(np.ceil(2.52 * args.cells_per_a))
-    grid = FluidGrid(lower=(0, 0, 0), upper=(nx * h, args.across * h, nz * h),
-                     cells=(nx, args.across, nz))
-    solver = FluidSolver(grid, surface_tension=args.surface_tension,
-                         courant_number=args.courant_number)
-    solver.add_water_box((0, 0, 0), (A, args.across * h, 2 * A))
+    solver = column(args.cells_per_a, args.across, args.surface_tension,
+                    courant_number=args.courant_number)
+    h = solver.h
+    nx, _, nz = solver.grid.cells
     print(f"{nx} x {args.across} x {nz} cells of a/{args.cells_per_a}, surface tension "
           f"{args.surface_tension} N/m, Courant number {args.courant_number}, "
           f"{numba.get_num_threads()} thread(s)")

@@ -165,21 +165,19 @@ def _height_function_curvature(f, i, j, k, h, two_dimensional, pure, heights):
     n1, n2, n3 = interface_normal(f, i, j, k)
     if two_dimensional:
         n2 = 0.0
+    # axes in order of falling |n| (ties: lower axis first), by three compare-and-swaps
+    first, second, third = 0, 1, 2
+    size = (abs(n1), abs(n2), abs(n3))
+    if size[second] > size[first]:
+        first, second = second, first
+    if size[third] > size[second]:
+        second, third = third, second
+    if size[second] > size[first]:
+        first, second = second, first
+    components = (n1, n2, n3)
     for rank in range(3):
-        # the axis with the rank-th largest |n| (ties: lower axis first)
-        axis = 0
-        component = n1
-        for candidate in range(3):
-            value = n1 if candidate == 0 else (n2 if candidate == 1 else n3)
-            larger = 0
-            for other in range(3):
-                other_value = n1 if other == 0 else (n2 if other == 1 else n3)
-                if abs(other_value) > abs(value) or (abs(other_value) == abs(value)
-                                                     and other < candidate):
-                    larger += 1
-            if larger == rank:
-                axis = candidate
-                component = value
+        axis = first if rank == 0 else (second if rank == 1 else third)
+        component = components[axis]
         if abs(component) < _MIN_COLUMN_COMPONENT:
             break
         curvature, closed = _curvature_along(f, i, j, k, h, two_dimensional, axis,
