@@ -144,6 +144,8 @@ class Simulation:
         self._frame_index = 0
         self._checkpoint_index = 1
         self._restarted = False
+        # Pairs allowed to overlap at the start, up to a depth (m): a pack's resting contacts.
+        self.accepted_overlaps: dict[tuple[int, int], float] = {}
 
     # ------------------------------------------------------------------ building
     def add_material(self, material: Material) -> None:
@@ -191,7 +193,25 @@ class Simulation:
         self.build_without_checks()
         if not self._restarted:
             smallest = min(s.min_subtet_height for s in solver.shapes)
-            solver.check_no_initial_overlap(_INITIAL_OVERLAP_FRACTION * smallest)
+            solver.check_no_initial_overlap(_INITIAL_OVERLAP_FRACTION * smallest,
+                                            accepted=self.accepted_overlaps)
+
+    def contact_history(self):
+        """The current contacts as a :class:`riprap.io.contact_history.ContactHistory` (spring
+        state and overlap depths), to start another run from this state."""
+        from riprap.io.contact_history import ContactHistory
+
+        body_i, body_j, springs = self.solver.contact_history()
+        depths = {(i, j): depth for i, j, depth in self.solver.overlaps(0.0)}
+        return ContactHistory(body_i, body_j, springs,
+                              [depths.get((int(i), int(j)), 0.0) for i, j in zip(body_i, body_j)])
+
+    def set_contact_history(self, history) -> None:
+        """Start from the contacts of a placed pack (a
+        :class:`riprap.io.contact_history.ContactHistory`): their friction carries over and their
+        overlaps, up to the depths recorded, are accepted at the start."""
+        self.solver.set_initial_contact_history(history.body_i, history.body_j, history.springs)
+        self.accepted_overlaps = history.accepted_depths()
 
     def build_without_checks(self) -> None:
         """Build the solver's arrays, choose the time step and evaluate the initial forces, without
@@ -453,14 +473,21 @@ class Simulation:
                                        "body_i": c.body_i, "body_j": c.body_j})
         self._frame_index += 1
 
-    def write_picture(self, path) -> Path:
-        from riprap.io.picture import render_bodies_png
+    def write_picture(self, path, *, show_fixed: bool = False, planes=None, view=(25, -60),
+                      title: str | None = None) -> Path:
+        """Shaded PNG of the bodies now (:func:`riprap.io.picture.render_bodies_png`).
+
+        Free bodies are drawn in distinct colours. Fixed bodies are left out, or drawn in grey
+        with ``show_fixed`` (e.g. the underlayer rocks under a placed layer); when every body is
+        fixed, all are drawn in colour. ``planes``: quadrilaterals (4, 3), m, drawn translucent
+        (e.g. the slope face); ``view``: camera elevation and azimuth, degrees. The default title
+        counts free and fixed bodies separately and says which are not drawn."""
+        from riprap.io.picture import bodies_to_draw, render_bodies_png
 
         s = self.solver
         points, triangles, owners = self.surface_arrays()
-        free = ~s.fixed[owners]
-        if not free.any():       # everything held (a finished underlayer): show it all
-            free[:] = True
+        drawn, grey, description = bodies_to_draw(s.fixed, show_fixed=show_fixed)
+        shown = drawn[owners]
         box = None
         if self.container_box is not None:
             # Show the container only up to a little above the bodies, not its full height.
@@ -468,8 +495,10 @@ class Simulation:
             top = points[:, 2].max() if len(points) else hi[2]
             hi[2] = min(hi[2], top + 0.15 * (top - lo[2]))
             box = (tuple(lo), tuple(hi))
-        return render_bodies_png(path, triangles_world=points[triangles][free], body_ids=owners[free],
-                                 title=f"{s.n_bodies} bodies at t = {s.time:.3f} s", walls_box=box)
+        return render_bodies_png(path, triangles_world=points[triangles][shown], body_ids=owners[shown],
+                                 grey_bodies=np.flatnonzero(grey), planes=planes, view=view,
+                                 title=title or f"{description} at t = {s.time:.3f} s",
+                                 walls_box=box)
 
     # ------------------------------------------------------------------ checkpoints
     def _write_checkpoint(self, checkpoint_io, state: dict, name: str) -> Path:

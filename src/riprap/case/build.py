@@ -85,6 +85,18 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
     rng = np.random.default_rng(settings.seed)
     for grid in case.body_grids:
         add_body_grid(sim, grid, rng)
+    add_case_walls(sim, case)
+    if settings.contact_history:
+        from riprap.io.contact_history import read_contact_history
+
+        sim.set_contact_history(read_contact_history(
+            settings.contact_history, n_bodies=sim.solver.n_bodies,
+            n_walls=len(sim.solver.walls)))
+    return sim
+
+
+def add_case_walls(sim: Simulation, case) -> None:
+    """The ``[[walls]]`` of ``case``."""
     for wall in case.walls:
         if wall.type == "plane":
             sim.add_walls(wall_builders.plane(point=wall.parameters["point"],
@@ -95,7 +107,6 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
             sim.add_walls(wall_builders.box(min=lo, max=hi, material=wall.material,
                                             open_top=wall.parameters["open_top"]),
                           container_box=(tuple(lo), tuple(hi)))
-    return sim
 
 
 def add_body_grid(sim: Simulation, grid, rng: np.random.Generator) -> None:

@@ -170,7 +170,8 @@ def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
                                   "time_step": case.simulation.time_step,
                                   "time_step_safety": case.simulation.time_step_safety,
                                   "gravity": list(case.simulation.gravity)},
-                      comment=f"armour layer placed by riprap place from {case.source}")
+                      comment=f"armour layer placed by riprap place from {case.source}",
+                      contact_history=sim.contact_history())
     outputs = {"pack": str(pack), "paraview": str(out / "deposition" / "bodies.pvd"),
                "layer": str(write_layer_file(out, layer)),
                "contacts": str(write_contact_table(out / CONTACTS_FILE_NAME, solver.contacts))}

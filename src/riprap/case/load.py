@@ -60,6 +60,7 @@ class SimulationSettings:
     local_damping: float = _default("simulation", "local_damping")
     rest_speed: float = _default("simulation", "rest_speed")
     seed: int = _default("simulation", "seed")
+    contact_history: Path | str = _default("simulation", "contact_history")
 
 
 @dataclass(frozen=True, kw_only=True)

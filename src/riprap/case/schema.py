@@ -278,6 +278,10 @@ KEYS: tuple[Key, ...] = (
     Key("simulation", "seed", "integer", "-",
         "Seed of the random orientations, shape choices and jitter of body grids.",
         default=0, valid_range=_NON_NEGATIVE),
+    Key("simulation", "contact_history", "path", "-",
+        "Contacts the bodies start in (written by `riprap place` beside `pack.toml`): their "
+        "friction carries over and the overlaps listed there are accepted at the start; "
+        "absent: none.", default="", extensions=(".csv",)),
     # [[materials]]
     Key("materials", "name", "string", "-", "Name that bodies and walls use to refer to it.",
         unique=True),

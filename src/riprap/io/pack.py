@@ -259,7 +259,7 @@ def _write_atomically(path: Path, text: str) -> None:
 def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
                materials: Sequence, bodies: Sequence[PackBody], walls: Sequence = (),
                simulation: Mapping | None = None, output: Mapping | None = None,
-               comment: str = "") -> Path:
+               comment: str = "", contact_history=None) -> Path:
     """Save bodies, their shapes and materials, and plane walls as a pack folder.
 
     Parameters
@@ -285,6 +285,10 @@ def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
         ``[output]`` keys; default :data:`DEFAULT_PACK_OUTPUT`.
     comment : str
         Extra lines for the header comment (what the pack is, which design it places).
+    contact_history : riprap.io.contact_history.ContactHistory, optional
+        The contacts the bodies rest in (spring state and overlap depths); written as
+        ``contact_history.csv`` and named by ``[simulation] contact_history``, so that a run from
+        the pack starts from them (:mod:`riprap.io.contact_history`).
 
     Returns
     -------
@@ -311,6 +315,11 @@ def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
 
     folder = Path(directory)
     (folder / SHAPES_FOLDER).mkdir(parents=True, exist_ok=True)
+    if contact_history is not None:
+        from riprap.io.contact_history import CONTACT_HISTORY_FILE_NAME, write_contact_history
+
+        write_contact_history(folder / CONTACT_HISTORY_FILE_NAME, contact_history)
+        simulation_values["contact_history"] = CONTACT_HISTORY_FILE_NAME
     stems = _file_stems(shapes)
     lines = _header(comment, len(bodies), len(shapes))
     lines += ["", f"format_version = {schema.FORMAT_VERSION}", "", "[simulation]"]

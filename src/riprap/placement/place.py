@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from riprap.case.schema import default_of
 from riprap.errors import CaseFileError, OverlapError
 from riprap.placement import layer_metrics
 from riprap.placement.lowering import Surface, VerticalLowering
@@ -181,7 +182,8 @@ def _stick_to_face(sim: Simulation) -> bool:
     return bool(solver.fixed.all())
 
 
-def unit_orientations(count: int, *, mode: str, slope, seed: int = 0, max_tilt_deg: float = 180.0,
+def unit_orientations(count: int, *, mode: str, slope, seed: int = 0,
+                      max_tilt_deg: float = default_of("placement", "max_tilt_deg"),
                       user=None) -> np.ndarray:
     """Quaternions (w, x, y, z) rotating the unit as built into the world.
 
@@ -214,7 +216,7 @@ def unit_orientations(count: int, *, mode: str, slope, seed: int = 0, max_tilt_d
 def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations, materials,
                 velocities=None, grid_lines=None, lift_overlapping: bool = False,
                 initial_velocity=(0.0, 0.0, 0.0), deposition: str = "all_at_once", rows=None,
-                release: str = "free_fall", **run) -> PlacementResult:
+                release: str = default_of("placement", "release"), **run) -> PlacementResult:
     """Deposit the units on the fixed underlayer and run until they rest.
 
     ``unit``: an :class:`riprap.geometry.armour_units.ArmourUnit` (mesh, height, nominal_diameter,

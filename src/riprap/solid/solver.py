@@ -23,6 +23,11 @@ _BROAD_PHASE_MARGIN = 0.02
 # Default contact skin as a fraction of the boundary sub-tet height: a rebuild of a pair's piece
 # list costs about two evaluations, so the skin only has to cover a few steps of fast motion.
 _SKIN_OVER_SUBTET_HEIGHT = 0.1
+# A pack's recorded overlap depths are recomputed from poses written to the last bit, so a pair
+# found deeper than recorded by more than this fraction was moved, not read back.
+_ACCEPTED_DEPTH_SLACK = 1e-3
+# Centroids closer than this fraction of the smaller bounding radius: the bodies coincide.
+_COINCIDENT_FRACTION = 0.05
 
 
 @dataclass
@@ -72,6 +77,8 @@ class SolidSolver:
         self._step_origin = 0
         self.time_step = None
         self._ready = False
+        # (body_i, body_j, springs) of the contacts the bodies start in (a pack's history).
+        self.initial_contact_history = None
 
     # ------------------------------------------------------------------ building
     def add_shape(self, shape: RigidShape) -> int:
@@ -178,6 +185,8 @@ class SolidSolver:
         self.wall_materials = np.array([self.material_index(w.material) for w in self.walls], dtype=np.int64)
         self.history_keys = np.zeros(0, dtype=np.int64)
         self.history_springs = np.zeros((0, interactions.HISTORY_WIDTH))
+        if self.initial_contact_history is not None:
+            self._load_initial_history(*self.initial_contact_history)
         self._margin = _BROAD_PHASE_MARGIN * float(self.bounding_radius.max())
         if self.contact_skin is None:
             self._skin = _SKIN_OVER_SUBTET_HEIGHT * min(
@@ -185,6 +194,37 @@ class SolidSolver:
         else:
             self._skin = float(self.contact_skin)
         self._piece_cache = interactions.empty_piece_cache()
+
+    def set_initial_contact_history(self, body_i, body_j, springs) -> None:
+        """Start from these contacts' spring state (elastic tangential force, twisting torque and
+        the stiffnesses they were built with; ``body_j = -1 - w`` for wall ``w``), as a placed
+        pack carries it, instead of from none."""
+        self.initial_contact_history = (np.asarray(body_i, dtype=np.int64).reshape(-1),
+                                        np.asarray(body_j, dtype=np.int64).reshape(-1),
+                                        np.asarray(springs, dtype=np.float64).reshape(-1, 6))
+        self._ready = False
+
+    def _load_initial_history(self, body_i, body_j, springs) -> None:
+        n, n_walls = len(self.positions), len(self.walls)
+        if len(body_i) and (body_i.min() < 0 or body_i.max() >= n or body_j.max() >= n
+                            or body_j.min() < -n_walls):
+            raise CaseFileError(f"the contact history names bodies or walls that the case does not "
+                                f"have ({n} bodies, {n_walls} walls)")
+        stride = n + n_walls
+        keys = np.where(body_j >= 0, body_i * stride + body_j, body_i * stride + (stride + body_j))
+        order = np.argsort(keys)
+        self.history_keys = np.ascontiguousarray(keys[order])
+        self.history_springs = np.ascontiguousarray(springs[order])
+
+    def contact_history(self):
+        """The current contacts' spring state: (body_i, body_j, springs (n, 6)) in the layout of
+        :meth:`set_initial_contact_history`."""
+        self.finalize()
+        stride = len(self.positions) + len(self.walls)
+        body_i = self.history_keys // stride
+        rest = self.history_keys % stride
+        body_j = np.where(rest < len(self.positions), rest, rest - stride)
+        return body_i.astype(np.int64), body_j.astype(np.int64), self.history_springs.copy()
 
     # ------------------------------------------------------------------ physics
     def stable_time_step(self, safety: float = 0.2) -> float:
@@ -333,9 +373,16 @@ class SolidSolver:
                 found.append((int(c.body_i[k]), int(c.body_j[k]), float(depth)))
         return found
 
-    def check_no_initial_overlap(self, tolerance: float) -> None:
-        """Raise OverlapError listing every pair that overlaps deeper than ``tolerance`` (m)."""
-        found = self.overlaps(tolerance)
+    def check_no_initial_overlap(self, tolerance: float, accepted: dict | None = None) -> None:
+        """Raise OverlapError listing every pair that overlaps deeper than ``tolerance`` (m).
+
+        ``accepted`` maps pairs ``(body_i, body_j)`` to an overlap depth they may have (a placed
+        pack's resting contacts); such a pair is refused only when it overlaps deeper than that
+        (plus ``tolerance``), i.e. when a body was moved into it."""
+        accepted = accepted or {}
+        found = [(i, j, depth) for i, j, depth in self.overlaps(tolerance)
+                 if depth > accepted.get((i, j), 0.0) * (1.0 + _ACCEPTED_DEPTH_SLACK) + tolerance]
+        self._check_coincident_bodies()
         if found:
             lines = []
             for i, j, depth in found[:20]:
@@ -346,6 +393,27 @@ class SolidSolver:
                 f"{len(found)} overlapping pair(s) at the start (tolerance {tolerance:.1e} m):\n"
                 + "\n".join(lines) + more
                 + "\nMove the bodies apart (larger grid spacing or a higher start) and run again.")
+
+    def _check_coincident_bodies(self) -> None:
+        """Two bodies whose centroids (nearly) coincide occupy the same place; their potential
+        forces cancel by symmetry when their shapes are the same, so the overlap test above
+        cannot see them."""
+        from scipy.spatial import cKDTree
+
+        radius = self.bounding_radius[self.shape_index]
+        pairs = cKDTree(self.positions).query_pairs(_COINCIDENT_FRACTION * float(radius.max()),
+                                                    output_type="ndarray")
+        if len(pairs) == 0:
+            return
+        gaps = np.linalg.norm(self.positions[pairs[:, 0]] - self.positions[pairs[:, 1]], axis=1)
+        close = gaps < _COINCIDENT_FRACTION * np.minimum(radius[pairs[:, 0]], radius[pairs[:, 1]])
+        pairs = pairs[close]
+        if len(pairs):
+            listed = ", ".join(f"bodies {int(i)} and {int(j)}" for i, j in sorted(map(tuple, pairs[:10])))
+            more = f" and {len(pairs) - 10} more pairs" if len(pairs) > 10 else ""
+            raise OverlapError(f"{len(pairs)} pair(s) of bodies occupy the same place (centroids "
+                               f"closer than {_COINCIDENT_FRACTION:g} of their bounding radius): "
+                               f"{listed}{more}. Each body needs its own position.")
 
     def check_finite(self) -> None:
         """Raise InstabilityError naming the first body whose state is not finite."""
