@@ -11,7 +11,6 @@ Output folder:
 """
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -175,11 +174,26 @@ def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
     outputs = {"pack": str(pack), "paraview": str(out / "deposition" / "bodies.pvd"),
                "layer": str(write_layer_file(out, layer)),
                "contacts": str(write_contact_table(out / CONTACTS_FILE_NAME, solver.contacts))}
-    picture = out / "deposition" / "final_state.png"
-    if picture.is_file():
-        shutil.copyfile(picture, out / "final_layer.png")
-        outputs["picture"] = str(out / "final_layer.png")
+    if case.output.picture:
+        outputs["picture"] = str(_write_layer_picture(out / "final_layer.png", sim, slope,
+                                                      n_units=len(result.unit_bodies)))
     return outputs
+
+
+# Seen from above the sea side of the slope, looking at the face, like the 3D views of
+# ``riprap analyse`` (riprap/io/analysis_figures.py).
+_LAYER_VIEW = (30, -125)
+
+
+def _write_layer_picture(path: Path, sim, slope, *, n_units: int) -> Path:
+    """The placed layer: units in colour, the fixed underlayer rocks in grey, the slope face as
+    a translucent plane, with units and rocks counted separately in the title."""
+    face = slope.to_world([0.0, slope.length, slope.length, 0.0],
+                          [0.0, 0.0, slope.width, slope.width], [0.0, 0.0, 0.0, 0.0])
+    n_rocks = sim.solver.n_bodies - n_units
+    title = (f"{n_units} armour units and {n_rocks} underlayer rocks (grey) on the "
+             f"1:{slope.cotangent:g} slope face, t = {sim.solver.time:.3f} s")
+    return sim.write_picture(path, show_fixed=True, planes=[face], view=_LAYER_VIEW, title=title)
 
 
 __all__ = ["run_placement"]

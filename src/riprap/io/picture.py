@@ -3,7 +3,9 @@
 Faces are shaded with a Lambert (diffuse) law from a key light above and to the left of the
 viewer and a weak fill light, so that the 3D shape of each body reads on paper. Each body gets a
 distinct colour from a qualitative colour map, or a colour from a sequential map for one value
-per body (e.g. maximum contact force), with a colour bar.
+per body (e.g. maximum contact force), with a colour bar. Bodies that are context rather than
+subject (the fixed rocks of an underlayer) can be drawn in a muted grey, and flat surfaces (a
+slope face) as translucent planes.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import numpy as np
 from riprap.errors import CaseFileError
 from riprap.io.checkpoint import _atomic_target
 
-__all__ = ["render_bodies_png"]
+__all__ = ["render_bodies_png", "bodies_to_draw"]
 
 # Lighting: a key light above and to the left of the viewer, a weaker fill light from the
 # lower right so that faces turned away from the key light still show their shape, and an
@@ -34,6 +36,14 @@ _DOTS_PER_INCH = 150
 _BODY_COLOUR_MAP = "tab20"
 _BODY_COLOUR_STRIDE = 7
 _VALUE_COLOUR_MAP = "viridis"
+# Context bodies (e.g. fixed underlayer rocks): a mid grey, shaded like the rest, darker than the
+# panes (0.96) and lighter than the text, and outside the body palette (its greys are removed).
+_MUTED_GREY = (0.62, 0.62, 0.60)
+# Planes (e.g. the slope face): a pale sand colour, see-through, so that bodies that the painter's
+# algorithm draws before a plane tile still show through it. Planes are cut into about this many
+# tiles along their longer side so that the tiles sort in depth among the bodies.
+_PLANE_RGBA = (0.80, 0.72, 0.55, 0.35)
+_PLANE_TILES = 32
 # Tick intervals on the longest side of the box: one per this many pixels of picture width,
 # within the bounds, so that tick labels do not overlap in small pictures.
 _PIXELS_PER_TICK = 200
@@ -86,6 +96,10 @@ def render_bodies_png(
     body_ids: np.ndarray,
     values: np.ndarray | None = None,
     value_label: str = "",
+    value_range: tuple[float, float] | None = None,
+    colour_map: str = _VALUE_COLOUR_MAP,
+    grey_bodies: Sequence[int] | np.ndarray | None = None,
+    planes: Sequence[np.ndarray] | None = None,
     title: str = "",
     walls_box: tuple[Sequence[float], Sequence[float]] | None = None,
     view: tuple[float, float] = (25, -60),
@@ -107,6 +121,20 @@ def render_bodies_png(
         instead of one distinct colour per body. ``n_bodies`` must exceed ``body_ids.max()``.
     value_label : str
         Colour-bar label for ``values``, with its unit, e.g. ``"maximum contact force (N)"``.
+    value_range : (float, float), optional
+        Values at the two ends of the colour scale; default the smallest and largest finite value
+        of the bodies drawn. Values outside are drawn in the end colours, and the colour bar gets
+        a pointed end on that side. Give the same range (and ``colour_map``) as a 2D figure of
+        the same quantity so that equal colours mean equal values.
+    colour_map : str
+        Matplotlib colour map for ``values``.
+    grey_bodies : array_like of int, optional
+        Body indices drawn in a muted grey (context, e.g. fixed underlayer rocks): left out of the
+        distinct colours and of the colour scale.
+    planes : list of numpy.ndarray, shape (4, 3), optional
+        Planar quadrilaterals, corners in order around the edge (m), drawn as translucent
+        surfaces among the bodies, e.g. the slope face the bodies rest on. They count towards the
+        extent of the axes.
     title : str
         Title written above the picture.
     walls_box : (array_like of 3, array_like of 3), optional
@@ -129,8 +157,9 @@ def render_bodies_png(
     Notes
     -----
     Hidden surfaces are resolved by matplotlib's painter's algorithm (faces sorted by mean depth),
-    which is right for separate convex-ish bodies and can misorder long interpenetrating faces.
-    About 100 000 triangles take some seconds.
+    which is right for separate convex-ish bodies and can misorder long interpenetrating faces;
+    planes are therefore cut into tiles (``_PLANE_TILES`` along the longer side) and drawn
+    translucent. About 100 000 triangles take some seconds.
     """
     import matplotlib
 
@@ -161,6 +190,9 @@ def render_bodies_png(
             f"non-negative integers of shape ({len(triangles)},), one per triangle."
         )
 
+    grey = np.zeros(len(triangles), dtype=bool)
+    if grey_bodies is not None:
+        grey = np.isin(body_ids, np.asarray(grey_bodies, dtype=np.int64).reshape(-1))
     if values is not None:
         values = np.asarray(values, dtype=np.float64).reshape(-1)
         if len(values) <= body_ids.max():
@@ -168,22 +200,33 @@ def render_bodies_png(
                 f"{where}: values has {len(values)} entries but body index {body_ids.max()} is "
                 "used; give one value per body, indexed by body index."
             )
-        finite = values[np.unique(body_ids)]
-        finite = finite[np.isfinite(finite)]
-        low, high = (finite.min(), finite.max()) if len(finite) else (0.0, 1.0)
+        shown = values[np.unique(body_ids[~grey])]
+        finite = shown[np.isfinite(shown)]
+        if value_range is not None:
+            low, high = (float(v) for v in value_range)
+        else:
+            low, high = (finite.min(), finite.max()) if len(finite) else (0.0, 1.0)
         if high <= low:
             high = low + 1.0
-        norm = Normalize(vmin=low, vmax=high)
-        value_map = colormaps[_VALUE_COLOUR_MAP]
-        base_colours = value_map(norm(values[body_ids]))[:, :3]
+        beyond_low, beyond_high = bool((shown < low).any()), bool((shown > high).any())
+        colour_bar_extend = {(False, False): "neither", (True, False): "min",
+                             (False, True): "max", (True, True): "both"}[beyond_low, beyond_high]
+        norm = Normalize(vmin=low, vmax=high, clip=True)
+        value_map = colormaps[colour_map]
+        # inf is clipped to the top colour like any value above the range; nan has no colour.
+        base_colours = value_map(norm(np.nan_to_num(values[body_ids], nan=low,
+                                                    posinf=high, neginf=low)))[:, :3]
     else:
         palette = np.asarray(colormaps[_BODY_COLOUR_MAP].colors)[:, :3]
         # Greys would read as unpainted bodies or as the axes panes.
         palette = palette[np.ptp(palette, axis=1) > 0.05]
         base_colours = palette[(body_ids * _BODY_COLOUR_STRIDE) % len(palette)]
+    base_colours = np.where(grey[:, None], np.asarray(_MUTED_GREY)[None, :], base_colours)
 
-    lower = triangles.reshape(-1, 3).min(axis=0)
-    upper = triangles.reshape(-1, 3).max(axis=0)
+    plane_triangles = _tile_planes(planes, where)
+    all_corners = np.concatenate([triangles, plane_triangles]).reshape(-1, 3)
+    lower = all_corners.min(axis=0)
+    upper = all_corners.max(axis=0)
     if walls_box is not None:
         wall_lower = np.asarray(walls_box[0], dtype=np.float64).reshape(3)
         wall_upper = np.asarray(walls_box[1], dtype=np.float64).reshape(3)
@@ -196,7 +239,14 @@ def render_bodies_png(
     lower, upper = centre - 0.5 * extents, centre + 0.5 * extents
 
     intensity = _lambert_intensity(triangles, view)
-    face_colours = np.clip(base_colours * intensity[:, None], 0.0, 1.0)
+    face_colours = np.ones((len(triangles) + len(plane_triangles), 4))
+    face_colours[:len(triangles), :3] = np.clip(base_colours * intensity[:, None], 0.0, 1.0)
+    face_colours[len(triangles):] = _PLANE_RGBA
+    # Edges in the face colour hide the hairline seams that antialiasing leaves between
+    # neighbouring triangles; plane tiles get none, or their overlapping translucent edges would
+    # draw a grid.
+    edge_colours = face_colours.copy()
+    edge_colours[len(triangles):, 3] = 0.0
 
     width_px, height_px = size_px
     figure = plt.figure(figsize=(width_px / _DOTS_PER_INCH, height_px / _DOTS_PER_INCH),
@@ -215,7 +265,10 @@ def render_bodies_png(
         axes.view_init(elev=view[0], azim=view[1])
         axes.set_xlabel("x (m)")
         axes.set_ylabel("y (m)")
-        axes.set_zlabel("z (m)")
+        # mplot3d turns the z label along the projected axis, which for views from the -x side
+        # (azimuth beyond -90 degrees) prints it upside down; keep it upright, reading upwards.
+        axes.zaxis.set_rotate_label(False)
+        axes.set_zlabel("z (m)", rotation=90)
         most_ticks = int(np.clip(round(width_px / _PIXELS_PER_TICK), *_TICK_COUNT_BOUNDS))
         for axis, extent in zip((axes.xaxis, axes.yaxis, axes.zaxis), extents):
             axis.pane.set_facecolor((0.96, 0.96, 0.96, 1.0))
@@ -226,12 +279,11 @@ def render_bodies_png(
         # the same, and each trial draw stays cheap however many triangles there are.
         _fit_axes_to_region(figure, axes, region)
 
+        # Planes and bodies in one collection, so that their faces are sorted together.
         surfaces = Poly3DCollection(
-            triangles,
+            np.concatenate([triangles, plane_triangles]),
             facecolors=face_colours,
-            # Edges in the face colour hide the hairline seams that antialiasing leaves between
-            # neighbouring triangles.
-            edgecolors=face_colours,
+            edgecolors=edge_colours,
             linewidths=0.2,
             zsort="average",
         )
@@ -250,7 +302,8 @@ def render_bodies_png(
         if has_colour_bar:
             colour_bar_axes = figure.add_axes([0.88, 0.2, 0.022, 0.6])
             colour_bar = figure.colorbar(
-                ScalarMappable(norm=norm, cmap=value_map), cax=colour_bar_axes
+                ScalarMappable(norm=norm, cmap=value_map), cax=colour_bar_axes,
+                extend=colour_bar_extend,
             )
             colour_bar.set_label(value_label)
         with _atomic_target(path) as temporary:
@@ -258,6 +311,73 @@ def render_bodies_png(
     finally:
         plt.close(figure)
     return path
+
+
+def _tile_planes(planes, where: str) -> np.ndarray:
+    """Triangles (n, 3, 3) of the planar quadrilaterals ``planes`` cut into a grid of tiles."""
+    if planes is None or len(planes) == 0:
+        return np.zeros((0, 3, 3))
+    tiles = []
+    for k, plane in enumerate(planes):
+        corners = np.asarray(plane, dtype=np.float64)
+        if corners.shape != (4, 3) or not np.all(np.isfinite(corners)):
+            raise CaseFileError(f"{where}: plane {k} has shape {corners.shape}, expected 4 finite "
+                                "corners (4, 3) in order around its edge.")
+        sides = (np.linalg.norm(corners[1] - corners[0]), np.linalg.norm(corners[3] - corners[0]))
+        longest = max(sides) if max(sides) > 0 else 1.0
+        counts = [max(1, int(round(_PLANE_TILES * side / longest))) for side in sides]
+        u = np.linspace(0.0, 1.0, counts[0] + 1)
+        v = np.linspace(0.0, 1.0, counts[1] + 1)
+        # Bilinear map of the unit square onto the quadrilateral, grid points (len(u), len(v), 3).
+        uu, vv = u[:, None, None], v[None, :, None]
+        grid = ((1 - uu) * (1 - vv) * corners[0] + uu * (1 - vv) * corners[1]
+                + uu * vv * corners[2] + (1 - uu) * vv * corners[3])
+        a, b = grid[:-1, :-1].reshape(-1, 3), grid[1:, :-1].reshape(-1, 3)
+        c, d = grid[1:, 1:].reshape(-1, 3), grid[:-1, 1:].reshape(-1, 3)
+        tiles.append(np.stack([a, b, c], axis=1))
+        tiles.append(np.stack([a, c, d], axis=1))
+    return np.concatenate(tiles)
+
+
+def bodies_to_draw(fixed, *, show_fixed: bool) -> tuple[np.ndarray, np.ndarray, str]:
+    """Which bodies a picture of a run draws, which of those in grey, and how to name them.
+
+    Parameters
+    ----------
+    fixed : array_like of bool, shape (n_bodies,)
+        Whether each body is held fixed.
+    show_fixed : bool
+        Draw the fixed bodies in grey (as context) instead of leaving them out. When every body
+        is fixed (a finished underlayer) all are drawn in colour either way.
+
+    Returns
+    -------
+    drawn, grey : numpy.ndarray of bool, shape (n_bodies,)
+    description : str
+        The bodies as a title counts them, free and fixed separately, e.g. ``"25 free bodies,
+        135 fixed bodies (grey)"``.
+
+    Examples
+    --------
+    >>> drawn, grey, text = bodies_to_draw([True, False, False], show_fixed=False)
+    >>> drawn.tolist(), grey.tolist(), text
+    ([False, True, True], [False, False, False], '2 free bodies (1 fixed body not drawn)')
+    """
+    fixed = np.asarray(fixed, dtype=bool).reshape(-1)
+    n_fixed = int(fixed.sum())
+    n_free = len(fixed) - n_fixed
+
+    def count(number, what=""):
+        return " ".join(filter(None, (str(number), what, "body" if number == 1 else "bodies")))
+
+    everything = np.ones(len(fixed), dtype=bool)
+    if n_fixed == 0:
+        return everything, ~everything, count(n_free)
+    if n_free == 0:
+        return everything, ~everything, count(n_fixed, "fixed")
+    if show_fixed:
+        return everything, fixed.copy(), f"{count(n_free, 'free')}, {count(n_fixed, 'fixed')} (grey)"
+    return ~fixed, ~everything, f"{count(n_free, 'free')} ({count(n_fixed, 'fixed')} not drawn)"
 
 
 def _fit_axes_to_region(figure, axes, region: tuple[float, float, float, float]) -> None:
