@@ -213,3 +213,28 @@ def test_command_line_analyse(pack, tmp_path, capsys):
     assert "report:" in capsys.readouterr().out
     assert main(["analyse", str(tmp_path / "missing")]) == 2
     assert "no such pack or run folder" in capsys.readouterr().err
+
+
+def test_the_3d_and_face_views_of_a_field_share_one_colour_scale(pack, tmp_path, monkeypatch):
+    from matplotlib.collections import PolyCollection
+
+    from riprap.io import analysis_figures, picture
+
+    analysis = analyse(pack)
+    drawn, saved = {}, {}
+    monkeypatch.setattr(picture, "render_bodies_png", lambda path, **given: drawn.update(given))
+
+    def keep_scale(figure, path, formats=("png", "svg")):
+        footprints = [c for c in figure.axes[0].collections if isinstance(c, PolyCollection)]
+        saved.update(colour_map=footprints[0].get_cmap().name, range=footprints[0].get_clim())
+        matplotlib.pyplot.close(figure)
+        return []
+
+    monkeypatch.setattr(analysis_figures, "_save", keep_scale)
+    for column, (_, colour_map) in analysis_figures.PER_UNIT_FIELDS.items():
+        analysis_figures.layer_view_png(tmp_path / "layer.png", analysis, column)
+        analysis_figures.slope_view_figure(tmp_path / "slope.png", analysis, column)
+        assert drawn["colour_map"] == saved["colour_map"] == colour_map, column
+        assert tuple(drawn["value_range"]) == pytest.approx(saved["range"], abs=1e-12), column
+    # The unit touches nothing (factor of safety 0): the scale is still 0 to the display cap.
+    assert saved["range"] == pytest.approx((0.0, analysis_figures.FACTOR_OF_SAFETY_DISPLAY_CAP))

@@ -3,13 +3,16 @@
 - ``stereonet``: lower-hemisphere equal-area (Schmidt) net of the units' nose axes, points and
   density contours (exponential Kamb, mplstereonet; multiples of the density of uniformly random
   axes), with the fabric eigenvalues in the title;
-- ``layer_<field>``: the units in 3D coloured by a per-unit value (PNG only: a layer has too many
-  faces for a useful SVG);
+- ``layer_<field>``: the units in 3D coloured by a per-unit value, the underlayer rocks in grey
+  (PNG only: a layer has too many faces for a useful SVG);
 - ``slope_<field>``: the layer seen square onto the face (s up the slope, y across), each unit as
   the outline of its footprint on the face, coloured by a per-unit value, with the underlayer's
   extent drawn in grey;
 - ``histograms``: coordination numbers, contact forces (unit-unit and unit-underlayer) and
   factors of safety.
+
+A 3D view and the face view of the same field share its colour map and range
+(:func:`colour_scale`); factors of safety are drawn up to :data:`FACTOR_OF_SAFETY_DISPLAY_CAP`.
 """
 from __future__ import annotations
 
@@ -19,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["stereonet_figure", "layer_view_png", "slope_view_figure", "histogram_figure",
-           "comparison_stereonets", "comparison_histograms", "PER_UNIT_FIELDS"]
+           "comparison_stereonets", "comparison_histograms", "colour_scale", "PER_UNIT_FIELDS",
+           "FACTOR_OF_SAFETY_DISPLAY_CAP"]
 
 #: Per-unit fields drawn on the layer, with their colour-bar labels and colour maps.
 PER_UNIT_FIELDS = {
@@ -27,8 +31,12 @@ PER_UNIT_FIELDS = {
     "coordination_number": ("coordination number (bodies and walls touched)", "plasma"),
     "factor_of_safety": ("factor of safety (smaller of sliding and rocking)", "RdYlGn"),
 }
-# Factors of safety above this are drawn with the top colour (inf when nothing drives a unit).
-_FOS_DISPLAY_CAP = 5.0
+#: Factors of safety above this are shown as "> cap" in the report's tables, with the top colour
+#: in the pictures and in the histogram's last bin. Beyond a few the number says only that the
+#: mode does not govern: a rocking factor is inf when nothing tips a unit forward and runs to
+#: hundreds when the overturning moment is small, and 5 leaves room to tell 1, 1.5 and 2 apart
+#: on the colour scale.
+FACTOR_OF_SAFETY_DISPLAY_CAP = 5.0
 _DOTS_PER_INCH = 150
 
 
@@ -55,8 +63,31 @@ def _save(figure, path: Path, formats=("png", "svg")) -> list[Path]:
 def _display_values(column: str, values) -> np.ndarray:
     values = np.asarray(values, dtype=float)
     if column.startswith("factor_of_safety"):
-        return np.minimum(values, _FOS_DISPLAY_CAP)
+        return np.minimum(values, FACTOR_OF_SAFETY_DISPLAY_CAP)
     return values
+
+
+def colour_scale(column: str, values) -> tuple[str, float, float]:
+    """Colour map, lowest and highest value of the colour scale of a per-unit ``column``.
+
+    Factors of safety: 0 to :data:`FACTOR_OF_SAFETY_DISPLAY_CAP`; other fields: their finite
+    range over ``values`` (one unit wide if all are equal). Every figure of one field uses this,
+    so a colour means the same value in the 3D view and the face view."""
+    _, colour_map = PER_UNIT_FIELDS.get(column, (column, "viridis"))
+    if column.startswith("factor_of_safety"):
+        return colour_map, 0.0, FACTOR_OF_SAFETY_DISPLAY_CAP
+    values = np.asarray(values, dtype=float)
+    finite = values[np.isfinite(values)]
+    low, high = (float(finite.min()), float(finite.max())) if len(finite) else (0.0, 1.0)
+    return colour_map, low, high if high > low else low + 1.0
+
+
+def _extend(values, low: float, high: float) -> str:
+    """Colour-bar ends to point: where some values lie beyond the scale."""
+    values = np.asarray(values, dtype=float)
+    below, above = bool((values < low).any()), bool((values > high).any())
+    return {(False, False): "neither", (True, False): "min", (False, True): "max",
+            (True, True): "both"}[below, above]
 
 
 def _draw_stereonet(axes, trend, plunge, title, title_pad=26):
@@ -85,10 +116,11 @@ def stereonet_figure(path, trend, plunge, *, title: str, slope_dip_direction_deg
     import mplstereonet  # noqa: F401  (registers the "stereonet" projection)
 
     plt = _pyplot()
-    figure = plt.figure(figsize=(6.6, 7.0))
+    figure = plt.figure(figsize=(6.6, 6.2))
     axes = figure.add_subplot(111, projection="stereonet")
-    contours = _draw_stereonet(axes, np.asarray(trend), np.asarray(plunge), "", title_pad=0)
-    figure.suptitle(title, fontsize=10)
+    # The title on the net's own axes, just clear of the "N" label: a figure title sits at the
+    # top of the figure, a band of blank paper above the (square) net.
+    contours = _draw_stereonet(axes, np.asarray(trend), np.asarray(plunge), title, title_pad=18)
     if slope_dip_direction_deg is not None:
         axes.pole(slope_dip_direction_deg[0] - 90.0, slope_dip_direction_deg[1], marker="^",
                   color="crimson", markersize=8, label="pole of the slope face")
@@ -105,16 +137,21 @@ def layer_view_png(path, analysis, column: str) -> Path:
 
     state = analysis.state
     bodies = state.layer.unit_bodies
+    rocks = np.setdiff1d(np.arange(state.n_bodies), bodies)
     triangles, owners = [], []
-    for body in bodies:
+    for body in np.concatenate([bodies, rocks]):
         faces = state.boundary_faces(body)
         triangles.append(state.world_nodes(body)[faces])
         owners.append(np.full(len(faces), body, dtype=np.int64))
     label, _ = PER_UNIT_FIELDS.get(column, (column, "viridis"))
-    values = _display_values(column, analysis.body_values(column))
+    colour_map, low, high = colour_scale(column, analysis.units[column])
+    title = f"{len(bodies)} units: {label}"
+    if len(rocks):
+        title += f", on {len(rocks)} underlayer rocks (grey)"
     return render_bodies_png(path, triangles_world=triangles, body_ids=np.concatenate(owners),
-                             values=values, value_label=label,
-                             title=f"{len(bodies)} units: {label}", view=(30, -125))
+                             values=analysis.body_values(column), value_label=label,
+                             value_range=(low, high), colour_map=colour_map, grey_bodies=rocks,
+                             title=title, view=(30, -125))
 
 
 def _footprints(state, bodies):
@@ -137,9 +174,10 @@ def slope_view_figure(path, analysis, column: str) -> list[Path]:
     plt = _pyplot()
     state = analysis.state
     layer = state.layer
-    label, colour_map = PER_UNIT_FIELDS.get(column, (column, "viridis"))
+    label, _ = PER_UNIT_FIELDS.get(column, (column, "viridis"))
     outlines = _footprints(state, layer.unit_bodies)
-    values = _display_values(column, analysis.units[column])
+    values = np.asarray(analysis.units[column], dtype=float)
+    colour_map, low, high = colour_scale(column, values)
     extent_s = max(o[:, 1].max() for o in outlines) if outlines else layer.slope.length
     figure, axes = plt.subplots(figsize=(7.5, 2.0 + 6.0 * min(extent_s / layer.slope.width, 2.0)))
     rocks = np.setdiff1d(np.arange(state.n_bodies), layer.unit_bodies)
@@ -147,10 +185,10 @@ def slope_view_figure(path, analysis, column: str) -> list[Path]:
         rock_sy = layer.slope.to_slope(state.positions[rocks])
         axes.scatter(rock_sy[:, 1], rock_sy[:, 0], s=2, color="0.75", zorder=0,
                      label="underlayer rock centroids")
-    collection = PolyCollection(outlines, array=values, cmap=colour_map, edgecolors="black",
-                                linewidths=0.4)
-    if column.startswith("factor_of_safety"):
-        collection.set_clim(0.0, _FOS_DISPLAY_CAP)
+    # inf (nothing drives the unit) takes the top colour like any value above the scale.
+    collection = PolyCollection(outlines, array=np.clip(values, low, high), cmap=colour_map,
+                                edgecolors="black", linewidths=0.4)
+    collection.set_clim(low, high)
     axes.add_collection(collection)
     if len(outlines) <= 60:
         for k, outline in enumerate(outlines):
@@ -165,7 +203,7 @@ def slope_view_figure(path, analysis, column: str) -> list[Path]:
     axes.set_ylabel("s up the slope from the toe (m)")
     axes.set_title(f"{len(outlines)} units on the 1:{layer.slope.cotangent:g} face, seen square on",
                    fontsize=10)
-    bar = figure.colorbar(collection, ax=axes, shrink=0.8)
+    bar = figure.colorbar(collection, ax=axes, shrink=0.8, extend=_extend(values, low, high))
     bar.set_label(label, fontsize=8)
     if len(rocks):
         axes.legend(loc="upper right", fontsize=7, markerscale=3)
@@ -198,10 +236,10 @@ def _histogram_axes(axes, analysis, label=None, colour=None):
     axes[1].set_xlabel("contact force (N)")
     axes[1].set_ylabel("contacts")
     fos = _display_values("factor_of_safety", units["factor_of_safety"])
-    axes[2].hist(fos, bins=np.linspace(0.0, _FOS_DISPLAY_CAP, 26), color=colour,
+    axes[2].hist(fos, bins=np.linspace(0.0, FACTOR_OF_SAFETY_DISPLAY_CAP, 26), color=colour,
                  alpha=0.6 if label else 0.9, edgecolor="black", linewidth=0.4, label=label)
     axes[2].axvline(1.0, color="crimson", linewidth=1.0)
-    axes[2].set_xlabel(f"factor of safety (>= {_FOS_DISPLAY_CAP:g} in the last bin)")
+    axes[2].set_xlabel(f"factor of safety (>= {FACTOR_OF_SAFETY_DISPLAY_CAP:g} in the last bin)")
     axes[2].set_ylabel("units")
 
 

@@ -10,7 +10,9 @@ In the output folder (every column and unit in ``docs/outputs.md``):
   rocking ones) for ParaView; ``underlayer.vtu`` the rocks;
 - ``stereonet.png``/``.svg``, ``layer_<field>.png``, ``slope_<field>.png``/``.svg``,
   ``histograms.png``/``.svg``;
-- ``report.html``: the summary table and the pictures on one page.
+- ``report.html``: the summary table, the layer measured against design (:data:`DESIGN_TOLERANCES`),
+  the pictures, the units with the smallest factors of safety and what those factors mean, on one
+  page.
 
 :func:`write_comparison` puts several analysed layers side by side (``comparison.html``).
 """
@@ -24,9 +26,22 @@ import numpy as np
 
 from riprap.io.summary import write_json
 
-__all__ = ["write_analysis", "write_comparison", "write_units_csv", "SUMMARY_ROWS"]
+__all__ = ["write_analysis", "write_comparison", "write_units_csv", "design_verdict",
+           "SUMMARY_ROWS", "DESIGN_TOLERANCES"]
 
-#: Rows of the report's summary table: (key of LayerAnalysis.layer, label, format).
+
+def _factor_of_safety_text(value) -> str:
+    """A factor of safety for a table: 3 decimals, "> cap" above the display cap (and for inf)."""
+    from riprap.io.analysis_figures import FACTOR_OF_SAFETY_DISPLAY_CAP as cap
+
+    value = float(value)
+    if math.isnan(value):
+        return "-"
+    return f"> {cap:g}" if value > cap else f"{value:.3f}"
+
+
+#: Rows of the report's summary table: (key of LayerAnalysis.layer, label, format string or
+#: function of the value). A label starting with spaces is a detail of the row above, indented.
 SUMMARY_ROWS = (
     ("units", "units", "{:d}"),
     ("underlayer_bodies", "underlayer bodies (rocks)", "{:d}"),
@@ -41,10 +56,84 @@ SUMMARY_ROWS = (
     ("coordination_number_max", "largest coordination number", "{:d}"),
     ("max_contact_force_N", "largest contact force on a unit (N)", "{:.4g}"),
     ("unit_weight_N", "weight of a unit (N)", "{:.4g}"),
-    ("factor_of_safety_min", "smallest factor of safety", "{:.3f}"),
-    ("factor_of_safety_median", "median factor of safety", "{:.3f}"),
+    ("factor_of_safety_min", "smallest factor of safety", _factor_of_safety_text),
+    ("factor_of_safety_median", "median factor of safety", _factor_of_safety_text),
     ("mean_distance_from_design_m", "mean distance from the design position (m)", "{:.3f}"),
 )
+
+
+#: Tolerances of the verdict against design: (key of LayerAnalysis.layer, label, tolerance, kind);
+#: the design value is the layer's ``design_<key>``, ``kind`` says whether the tolerance is a
+#: fraction of the design value ("relative") or in the quantity's own unit ("absolute").
+#:
+#: No published acceptance tolerance for a placed layer was found in the sources read
+#: (docs/armour-units.md; shared/validation/armour_design.md sections 5-6, where the CLI
+#: packing-density specifications are marked not found), so these are riprap's working values, to
+#: be replaced by a project's specification:
+#:
+#: - packing density coefficient, +-5 %: one unit more or less in a measured panel of about 20
+#:   units (the small example counts 21) moves phi by about 5 %, so a model panel of that size
+#:   cannot be judged more finely;
+#: - layer thickness, +-10 %: the thickness is read from each unit's highest point, which moves by
+#:   a good part of D_n with the unit's random orientation, above an underlayer top averaged over
+#:   rocks about half a D_n in size; 10 % of k_t D_n is 0.15 D_n for a Core-Loc;
+#: - porosity, +-0.05 absolute: porosity follows from the other two (n_v = 1 - phi D_n / t for one
+#:   layer), and +-5 % on phi with +-10 % on t move it by up to (1 - n_v) x 15 %, about 0.06 for
+#:   a single-layer unit; absolute, because it is a fraction near one half.
+DESIGN_TOLERANCES = (
+    ("packing_density_coefficient", "packing density coefficient phi", 0.05, "relative"),
+    ("layer_thickness_m", "layer thickness (m)", 0.10, "relative"),
+    ("porosity", "layer porosity", 0.05, "absolute"),
+)
+
+
+def design_verdict(layer: dict) -> list[dict]:
+    """The layer measured against design, one entry per row of :data:`DESIGN_TOLERANCES`.
+
+    Each entry: ``key``, ``label``, ``design``, ``measured``, ``difference`` (measured - design),
+    ``tolerance`` (in the quantity's unit), ``tolerance_text`` (as stated) and ``inside`` (True,
+    False, or None when the design or measured value is missing).
+
+    Examples
+    --------
+    >>> rows = design_verdict({"layer_thickness_m": 1.2, "design_layer_thickness_m": 1.0})
+    >>> [(row["key"], row["inside"]) for row in rows]
+    [('packing_density_coefficient', None), ('layer_thickness_m', False), ('porosity', None)]
+    """
+    rows = []
+    for key, label, tolerance, kind in DESIGN_TOLERANCES:
+        design = float(layer.get(f"design_{key}", math.nan))
+        measured = float(layer.get(key, math.nan))
+        absolute = tolerance * abs(design) if kind == "relative" else tolerance
+        known = math.isfinite(design) and math.isfinite(measured)
+        rows.append({"key": key, "label": label, "design": design, "measured": measured,
+                     "difference": measured - design, "tolerance": absolute,
+                     "tolerance_text": (f"±{100 * tolerance:g} %" if kind == "relative"
+                                        else f"±{tolerance:g}"),
+                     "inside": bool(abs(measured - design) <= absolute) if known else None})
+    return rows
+
+
+def _verdict_table(layer: dict) -> str:
+    head = "".join(f"<th>{name}</th>" for name in (
+        "", "design", "measured", "difference", "tolerance", "verdict"))
+    rows = []
+    for row in design_verdict(layer):
+        if row["inside"] is None:
+            cells = ["-"] * 4 + [row["tolerance_text"], "no value to compare"]
+            verdict_class = ""
+        else:
+            relative = (f" ({100 * row['difference'] / row['design']:+.1f} %)"
+                        if row["design"] else "")
+            cells = [f"{row['design']:.3f}", f"{row['measured']:.3f}",
+                     f"{row['difference']:+.3f}{relative}",
+                     f"{row['tolerance_text']} (±{row['tolerance']:.3f})",
+                     "inside" if row["inside"] else "outside"]
+            verdict_class = " class='inside'" if row["inside"] else " class='outside'"
+        tds = "".join(f"<td>{html.escape(text)}</td>" for text in cells[:-1])
+        rows.append(f"<tr><th class='name'>{html.escape(row['label'])}</th>{tds}"
+                    f"<td{verdict_class}>{html.escape(cells[-1])}</td></tr>")
+    return f"<table class='verdict'><tr>{head}</tr>{''.join(rows)}</table>"
 
 
 def _csv_number(value) -> str:
@@ -114,12 +203,15 @@ def _summary_table(layers: list[dict], labels: list[str]) -> str:
         for layer in layers:
             value = layer.get(key)
             try:
-                text = fmt.format(value) if value is not None and not (
-                    isinstance(value, float) and math.isnan(value)) else "-"
+                text = (fmt(value) if callable(fmt) else fmt.format(value)) if value is not None \
+                    and not (isinstance(value, float) and math.isnan(value)) else "-"
             except (ValueError, TypeError):
                 text = str(value)
             cells.append(f"<td>{html.escape(text)}</td>")
-        rows.append(f"<tr><th class='name'>{html.escape(label)}</th>{''.join(cells)}</tr>")
+        # HTML collapses leading spaces: a detail row is indented by its class instead.
+        name_class = "name detail" if label.startswith(" ") else "name"
+        rows.append(f"<tr><th class='{name_class}'>{html.escape(label.strip())}</th>"
+                    f"{''.join(cells)}</tr>")
     return f"<table><tr><th></th>{head}</tr>{''.join(rows)}</table>"
 
 
@@ -128,7 +220,8 @@ body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 72em; co
 h1 { font-size: 1.5em; } h2 { font-size: 1.15em; margin-top: 1.6em; border-bottom: 1px solid #ccc; }
 table { border-collapse: collapse; font-size: 0.9em; }
 td, th { padding: 0.2em 0.8em; border-bottom: 1px solid #eee; text-align: right; }
-th.name { text-align: left; font-weight: normal; }
+th.name { text-align: left; font-weight: normal; } th.detail { padding-left: 2.2em; }
+td.inside { color: #1a7f37; font-weight: bold; } td.outside { color: #b42318; font-weight: bold; }
 .figures { display: flex; flex-wrap: wrap; gap: 1em; } .figures img { max-width: 34em; }
 img.wide { max-width: 100%; } .note { color: #555; font-size: 0.85em; }
 """
@@ -141,13 +234,78 @@ def _page(title: str, body: str) -> str:
 
 def _lowest_fos_table(units: dict, count: int = 10) -> str:
     order = np.argsort(units["factor_of_safety"], kind="stable")[:count]
-    columns = (("unit_id", "{:d}"), ("row", "{:d}"), ("coordination_number", "{:d}"),
-               ("max_contact_force_N", "{:.4g}"), ("factor_of_safety_sliding", "{:.3f}"),
-               ("factor_of_safety_rocking", "{:.3f}"), ("height_above_underlayer_m", "{:.3f}"))
+    fos = _factor_of_safety_text
+    columns = (("unit_id", "{:d}".format), ("row", "{:d}".format),
+               ("coordination_number", "{:d}".format), ("max_contact_force_N", "{:.4g}".format),
+               ("factor_of_safety_sliding", fos), ("factor_of_safety_rocking", fos),
+               ("height_above_underlayer_m", "{:.3f}".format))
     head = "".join(f"<th>{name}</th>" for name, _ in columns)
-    rows = "".join("<tr>" + "".join(f"<td>{fmt.format(units[name][k].item())}</td>"
+    rows = "".join("<tr>" + "".join(f"<td>{html.escape(fmt(units[name][k].item()))}</td>"
                                     for name, fmt in columns) + "</tr>" for k in order)
     return f"<table><tr>{head}</tr>{rows}</table>"
+
+
+def _units_below_one(layer: dict, units: dict) -> str:
+    """One line per unit with a factor of safety below 1: which mode, and what it rests on."""
+    items = []
+    for k in layer["units_below_factor_of_safety_1"]:
+        sliding = float(units["factor_of_safety_sliding"][k])
+        rocking = float(units["factor_of_safety_rocking"][k])
+        mode = "rocking" if rocking <= sliding else "sliding"
+        other = "sliding" if mode == "rocking" else "rocking"
+        on_units, on_rest = int(units["unit_contacts"][k]), int(units["underlayer_contacts"][k])
+        height = float(units["height_above_underlayer_m"][k])
+        items.append(
+            f"<li>unit {k} (row {int(units['row'][k])}): {mode} "
+            f"{_factor_of_safety_text(min(sliding, rocking))}, {other} "
+            f"{_factor_of_safety_text(max(sliding, rocking))}; touches "
+            f"{_count(on_units, 'unit', 'units')} and "
+            f"{_count(on_rest, 'rock or wall', 'rocks or walls')}; centroid {height:.2f} m "
+            f"({height / layer['nominal_diameter_m']:.2f} D<sub>n</sub>) above the underlayer top"
+            f"{' (it rests on other units only)' if on_rest == 0 and on_units else ''}.</li>")
+    return f"<p>Units with a factor of safety below 1:</p><ul>{''.join(items)}</ul>" if items else ""
+
+
+def _count(number: int, one: str, many: str) -> str:
+    return f"{number or 'no'} {one if number == 1 else many}"
+
+
+def _factor_of_safety_notes(layer: dict, units: dict) -> str:
+    """What the factors of safety of a unit at rest mean, why one can be below 1, and the cap."""
+    from riprap.io.analysis_figures import FACTOR_OF_SAFETY_DISPLAY_CAP as cap
+
+    return (
+        "<h2 id='reading-factors-of-safety'>Reading the factors of safety</h2>"
+        f"{_units_below_one(layer, units)}"
+        "<p>Every unit of a settled layer is at rest: with all its contacts, the forces and "
+        "moments on it balance. A factor of safety here is a limit-equilibrium check of one unit "
+        "over the contacts it has now, with the forces the layer settled to "
+        "(<code>contacts.csv</code>); it does not say that the unit moves.</p>"
+        "<p><b>Sliding</b> (riprap/analysis/unit_contacts.py): the sum of &mu;|N| over the sum "
+        "of |T| over all the unit's contacts. The solver caps each contact's friction force at "
+        "&mu;|N|, so for a state riprap computed it is at least 1, and 1 only when every contact "
+        "slides; above 1 it says how far the tangential springs are from their Coulomb limit. "
+        "Friction forces that oppose each other (a unit pinched between neighbours) all count as "
+        "driving, which errs on the safe side.</p>"
+        "<p><b>Rocking</b> (riprap/analysis/rocking.py, Goodman &amp; Bray's toppling criterion): "
+        "the unit is taken to tip forward about one pivot, its support point furthest down the "
+        "slope. The loads are its weight and the pushes of the units further up the slope. Every "
+        "other contact (rocks, the face, units down the slope or beside it) is assumed to let go "
+        "as soon as the unit tips, and no contact that would form or grow as it starts to turn "
+        "is counted. In the layer those contacts carry load: a unit whose legs are hooked behind "
+        "its neighbours is held back by their reactions, which push above or up the slope of the "
+        "pivot, and by the friction at its other supports; and since each contact is recorded as "
+        "one force at one point, the moment of a broad contact's pressure is lost too. A rocking "
+        "factor below 1 therefore means that the unit's own weight would not stop it toppling "
+        "about that pivot: it rests because its neighbours hold it (interlocking), and it would "
+        "go if they moved, for example if a wave lifted the units below it. It marks a unit to "
+        "look at, not one that is moving.</p>"
+        f"<p class='note'>Factors of safety above {cap:g} are shown as \"&gt; {cap:g}\" in the "
+        "tables and drawn with the top colour (the colour bar is then pointed): beyond a few, the "
+        "number says only that the mode does not govern. A rocking factor is inf when nothing "
+        "tips the unit forward, and runs to hundreds when the overturning moment is small. "
+        "<code>units.csv</code> and <code>layer.vtu</code> keep the computed values (inf as "
+        "1e30 in ParaView).</p>")
 
 
 def write_analysis(out, analysis) -> dict:
@@ -188,8 +346,9 @@ def _write_report(out: Path, analysis) -> Path:
     layer, units = analysis.layer, analysis.units
     histogram = ", ".join(f"{k}: {v}" for k, v in layer["coordination_number_histogram"].items())
     low = layer["units_below_factor_of_safety_1"]
+    # Only the first letter raised: str.capitalize would also lower the unit, "(N)" to "(n)".
     fields = "".join(
-        f"<h2>{html.escape(label.capitalize())}</h2><div class='figures'>"
+        f"<h2>{html.escape(label[:1].upper() + label[1:])}</h2><div class='figures'>"
         f"<img src='layer_{column}.png' alt='layer, {html.escape(label)}'>"
         f"<img src='slope_{column}.svg' alt='face view, {html.escape(label)}'></div>"
         for column, (label, _) in PER_UNIT_FIELDS.items())
@@ -201,14 +360,22 @@ def _write_report(out: Path, analysis) -> Path:
         "<a href='contacts.csv'>contacts.csv</a>, <a href='layer_summary.json'>layer_summary.json</a>; "
         "ParaView: <code>layer.vtu</code>, <code>underlayer.vtu</code>.</p>"
         f"<h2>Summary</h2>{_summary_table([layer], ['this layer'])}"
+        f"<h2>Measured against design</h2>{_verdict_table(layer)}"
+        "<p class='note'>Design values: the unit's design table (<code>layer.json</code>, "
+        "docs/armour-units.md, which says which values are published and which are riprap's "
+        "assumptions). Tolerances: riprap's working values, no published acceptance tolerance "
+        "having been found (<code>DESIGN_TOLERANCES</code> in riprap/io/analysis_report.py gives "
+        "the reason for each); use the project's specification where there is one.</p>"
         f"<p>Coordination numbers (value: units): {html.escape(histogram)}. "
         f"Units with a factor of safety below 1: {len(low)}"
-        f"{' (' + ', '.join(map(str, low[:20])) + (' ...' if len(low) > 20 else '') + ')' if low else ''}.</p>"
+        f"{' (' + ', '.join(map(str, low[:20])) + (' ...' if len(low) > 20 else '') + ')' if low else ''}"
+        f"{'; see <a href=#reading-factors-of-safety>what that means for a unit at rest</a>' if low else ''}.</p>"
         "<h2>Orientation of the nose axes</h2><div class='figures'>"
         "<img src='stereonet.svg' alt='stereonet of the nose axes'></div>"
         f"{fields}"
         "<h2>Distributions</h2><img class='wide' src='histograms.svg' alt='histograms'>"
         f"<h2>Units with the smallest factor of safety</h2>{_lowest_fos_table(units)}"
+        f"{_factor_of_safety_notes(layer, units)}"
         "<p class='note'>Definitions. Coordination number: bodies and walls a unit touches. Largest "
         "contact force: magnitude of the normal plus friction force of the unit's most loaded "
         "contact. Factor of safety against sliding: sum of mu |N| over sum of |T| of the unit's "
