@@ -1,12 +1,18 @@
-"""Command-line interface: parses arguments and calls the Python API, nothing else.
+"""riprap: numerical breakwater modelling. Armour units and rocks as rigid bodies with potential
+contact, armour layers placed on a slope and analysed, air and water flow.
 
-    riprap demo [--out DIR]            drop rocks and tetrapods into a box (embedded case)
-    riprap run CASE.toml [--out DIR] [--restart CHECKPOINT]
-    riprap place CASE.toml [--out DIR]   build an armour layer on a slope (pack, pictures, summary)
-    riprap analyse PACK_OR_RUN [MORE ...] --out DIR   per-unit contact forces, coordination
-                                       numbers, stereonet, factors of safety, report.html
-    riprap check CASE.toml             validate a case file and report every problem
-    riprap info                        versions and threads
+Commands (each has --help):
+  riprap demo                      rocks and tetrapods dropped into a box (a minute the first time)
+  riprap place CASE.toml --out DIR build an armour layer on a slope: pack, pictures, summary
+  riprap run CASE.toml --out DIR   run a case: bodies, a placed pack (DIR/pack.toml) or a fluid case
+  riprap analyse PACK_OR_RUN       contact forces, coordination numbers, stereonet, factors of
+                                   safety, packing density and a report.html (also: analyze)
+  riprap check CASE.toml           every check that run or place makes, without running
+  riprap info                      versions of riprap, Python and the libraries; threads
+
+Case files are TOML; every key is in docs/case-file.md. Examples: examples/. Bad input gives one
+line starting 'riprap: error:' and exit status 2; set RIPRAP_TRACEBACK=1 to see where an error came
+from.
 """
 from __future__ import annotations
 
@@ -22,11 +28,12 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
     from riprap.case.load import load_case
 
     case = load_case(path)
+    _say_if_smoke()
     if case.is_fluid:
         return _run_fluid_case(case, path, out, restart, quiet)
-    if case.is_placement and case.body_count == 0:
-        raise CaseFileError(f"{path} describes an armour placement and has no bodies of its own: "
-                            f"run it with 'riprap place {path}'")
+    if case.is_placement:
+        raise CaseFileError(f"{path} describes an armour placement: build the layer with "
+                            f"'riprap place {path} --out DIR', then run DIR/pack.toml")
     print(f"riprap: case {path}: {case.body_count} bodies, {len(case.shapes)} shapes, "
           f"{len(case.walls)} wall entries")
     print("riprap: contact pairs combine materials by the smaller friction coefficient, the smaller "
@@ -45,9 +52,6 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
 def _run_fluid_case(case, path: Path, out: str | None, restart: str | None, quiet: bool) -> int:
     from riprap.case.build_fluid import build_fluid_run
 
-    if case.body_count > 0:
-        raise CaseFileError(f"{path}: has [fluid] and bodies; solids in the fluid (two-way "
-                            "coupling) are not available yet: run them as separate cases")
     run = build_fluid_run(case, output_directory=out, progress=not quiet)
     grid = run.solver.grid
     print(f"riprap: fluid case {path}: {grid.cells[0]} x {grid.cells[1]} x {grid.cells[2]} cells of "
@@ -64,14 +68,30 @@ def _run_fluid_case(case, path: Path, out: str | None, restart: str | None, quie
     return 0
 
 
+def _say_if_smoke() -> None:
+    from riprap.case.build import SMOKE_END_TIME, smoke_mode
+
+    if smoke_mode():
+        print(f"riprap: SMOKE MODE (RIPRAP_SMOKE=1): every run is cut to {SMOKE_END_TIME} s of "
+              "simulated time; its figures are not results", file=sys.stderr)
+
+
 def _place_case(path: Path, out: str | None, quiet: bool) -> int:
     from riprap.case.build_placement import run_placement
     from riprap.case.load import load_case
 
     case = load_case(path)
+    _say_if_smoke()
     print(f"riprap: placement case {path}: {case.armour.unit if case.armour else '?'} units on a "
           f"1:{case.slope.cotangent if case.slope else '?'} slope")
     summary = run_placement(case, output_directory=out, progress=not quiet)
+    if summary.get("smoke"):
+        print(f"riprap: SMOKE MODE: {summary['units_placed']} units placed on "
+              f"{summary['underlayer_rocks']} rocks; {summary['smoke_note']}, so none are "
+              "reported here (summary.json has \"smoke\": true)")
+        for key, value in summary["outputs"].items():
+            print(f"riprap: {key}: {value}")
+        return 0
     print(f"riprap: {summary['units_placed']} units placed, {summary['units_at_rest']} at rest, "
           f"{len(summary['units_rolled_off'])} rolled off; packing density coefficient "
           f"{summary['packing_density_coefficient']:.3f} (design "
@@ -115,66 +135,136 @@ def _analyse(paths: list[Path], out: str | None, frame: int, labels: list[str] |
     return 0
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="riprap", description=__doc__.split("\n\n")[0])
-    sub = parser.add_subparsers(dest="command", required=True)
+def _check(path: Path, out: str | None) -> int:
+    from riprap.case.load import load_case
+    from riprap.case.preflight import check_case
+
+    report = check_case(load_case(path), output_directory=out)
+    print(f"{path}: valid ({report.description})")
+    print(f"  checked: {'; '.join(report.checked)}")
+    for item in report.not_checked:
+        print(f"  not checked (only a run can tell): {item}")
+    return 0
+
+
+def _info() -> int:
+    import platform
+
+    import gmsh
+    import matplotlib
+    import meshio
+    import numba
+    import numpy
+    import scipy
+
+    import riprap
+
+    print(f"riprap {riprap.__version__} ({Path(riprap.__file__).parent})")
+    print(f"Python {platform.python_version()} ({sys.executable}), {platform.platform()}")
+    print(f"numpy {numpy.__version__}, numba {numba.__version__} ({numba.get_num_threads()} threads), "
+          f"scipy {scipy.__version__}, gmsh {gmsh.__version__}, meshio {meshio.__version__}, "
+          f"matplotlib {matplotlib.__version__}")
+    return 0
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="riprap", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     demo = sub.add_parser("demo", help="drop rocks and tetrapods into a box until they rest")
-    demo.add_argument("--out", default="riprap-demo", help="output directory (default riprap-demo)")
+    demo.add_argument("--out", default="riprap-demo", help="output folder (default riprap-demo)")
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
-    run = sub.add_parser("run", help="run a case file")
-    run.add_argument("case", type=Path)
-    run.add_argument("--out", default=None, help="output directory (default: [output] directory)")
-    run.add_argument("--restart", default=None, help="continue from this checkpoint (.npz)")
+    run = sub.add_parser("run", help="run a case file (bodies, a placed pack, or air and water)")
+    run.add_argument("case", type=Path, help="the case file (.toml), e.g. out/layer/pack.toml")
+    run.add_argument("--out", default=None, help="output folder (default: [output] directory)")
+    run.add_argument("--restart", default=None,
+                     help="continue from this checkpoint (.npz) with the case's settings")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     place = sub.add_parser("place", help="build an armour layer on a slope (POSITIT)")
-    place.add_argument("case", type=Path)
-    place.add_argument("--out", default=None, help="output directory (default: [output] directory)")
+    place.add_argument("case", type=Path, help="a placement case file (.toml)")
+    place.add_argument("--out", default=None, help="output folder (default: [output] directory)")
     place.add_argument("--quiet", action="store_true", help="no progress bar")
     analyse = sub.add_parser(
-        "analyse", help="analyse an armour layer (a pack folder or a run started from one); "
-                        "two or more are compared side by side")
+        "analyse", aliases=["analyze"],
+        help="analyse an armour layer (a pack folder or a run started from one); two or more are "
+             "compared side by side")
     analyse.add_argument("paths", type=Path, nargs="+", metavar="PACK_OR_RUN")
     analyse.add_argument("--out", default=None,
-                         help="output directory (default: PACK/analysis for one pack)")
+                         help="output folder (default: PACK/analysis for one pack)")
     analyse.add_argument("--frame", type=int, default=-1,
                          help="frame of a run to analyse (0 the first, -1 the last; default -1)")
     analyse.add_argument("--labels", nargs="+", default=None,
                          help="names of the compared layers (default: their folder names)")
-    check = sub.add_parser("check", help="validate a case file")
+    check = sub.add_parser("check", help="every check run or place makes, without running")
     check.add_argument("case", type=Path)
-    sub.add_parser("info", help="versions and threads")
-    args = parser.parse_args(argv)
+    check.add_argument("--out", default=None,
+                       help="output folder to check (default: [output] directory)")
+    sub.add_parser("info", help="versions of riprap, Python and its libraries; threads")
+    return parser
+
+
+def _dispatch(args) -> int:
+    if args.command == "demo":
+        from importlib.resources import as_file, files
+
+        with as_file(files("riprap.data") / "demo.toml") as path:
+            return _run_case(Path(path), args.out, None, args.quiet)
+    if args.command == "run":
+        return _run_case(args.case, args.out, args.restart, args.quiet)
+    if args.command == "place":
+        return _place_case(args.case, args.out, args.quiet)
+    if args.command in ("analyse", "analyze"):
+        return _analyse(args.paths, args.out, args.frame, args.labels)
+    if args.command == "check":
+        return _check(args.case, args.out)
+    return _info()
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """riprap's own warnings as one line each; numpy's RuntimeWarnings are not shown (riprap checks
+    that the state stays finite and names the body and time when it does not)."""
+    from riprap.work_estimate import RiprapWarning
+
+    if issubclass(category, RiprapWarning):
+        print(f"riprap: warning: {message}", file=sys.stderr)
+    elif not issubclass(category, RuntimeWarning):
+        print(f"riprap: warning ({category.__name__}): {message}", file=sys.stderr)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status (0 done, 2 could not, 130 interrupted)."""
+    import os
+    import warnings
+
+    args = _parser().parse_args(argv)
+    if os.environ.get("RIPRAP_TRACEBACK", "") == "1":
+        return _dispatch(args)
+    previous = warnings.showwarning
+    warnings.showwarning = _show_warning
     try:
-        if args.command == "demo":
-            from importlib.resources import as_file, files
-
-            with as_file(files("riprap.data") / "demo.toml") as path:
-                return _run_case(Path(path), args.out, None, args.quiet)
-        if args.command == "run":
-            return _run_case(args.case, args.out, args.restart, args.quiet)
-        if args.command == "place":
-            return _place_case(args.case, args.out, args.quiet)
-        if args.command == "analyse":
-            return _analyse(args.paths, args.out, args.frame, args.labels)
-        if args.command == "check":
-            from riprap.case.load import load_case
-
-            case = load_case(args.case)
-            what = ("an armour placement" if case.is_placement else
-                    f"air and water on {'x'.join(map(str, case.fluid.cells))} cells" if case.is_fluid
-                    else f"{case.body_count} bodies")
-            print(f"{args.case}: valid ({what})")
-            return 0
-        if args.command == "info":
-            import numba
-            import numpy
-
-            import riprap
-
-            print(f"riprap {riprap.__version__}, numpy {numpy.__version__}, numba {numba.__version__}, "
-                  f"threads {numba.get_num_threads()}")
-            return 0
+        return _dispatch(args)
     except RiprapError as error:
         print(f"riprap: error: {error}", file=sys.stderr)
-        return 2
-    return 1
+    except OSError as error:
+        from riprap.io.output_folder import describe_os_error
+
+        print(f"riprap: error: {describe_os_error(error)}", file=sys.stderr)
+    except MemoryError:
+        print("riprap: error: out of memory; use fewer bodies, tetrahedra or cells "
+              "(riprap check estimates the size of a case)", file=sys.stderr)
+    except KeyboardInterrupt:
+        print("riprap: interrupted; frames and checkpoints written so far are complete",
+              file=sys.stderr)
+        return 130
+    except SystemExit as error:
+        # A library (meshio) calling sys.exit must not end riprap without a word.
+        if error.code in (0, None):
+            return 0
+        print(f"riprap: error: a library stopped with: {error.code}", file=sys.stderr)
+    except Exception as error:  # noqa: BLE001 - the last line of defence for the user
+        print(f"riprap: error: {type(error).__name__}: {error} (riprap did not expect this: it may "
+              "be an input riprap does not check yet, or a bug; RIPRAP_TRACEBACK=1 shows where, "
+              "please report it)", file=sys.stderr)
+    finally:
+        warnings.showwarning = previous
+    return 2

@@ -7,6 +7,7 @@ fails (non-finite state) writes a checkpoint of the last good state and says whi
 from __future__ import annotations
 
 import math
+import os
 import time as wallclock
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -14,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, RiprapError
+from riprap.work_estimate import check_rigid_run
 from riprap.geometry.tetmesh import TetMesh
 from riprap.solid.kernels import interactions
 from riprap.solid.materials import Material
@@ -41,6 +43,9 @@ _STEP_CUT = 0.5
 _MAX_STEP_OVER_ESTIMATE = 30.0
 _MIN_STEP_OVER_ESTIMATE = 1e-3
 _MAX_MOTION_PER_STEP = 0.1
+# Gravity above this (m/s^2) is named as the likely cause of a blow-up (a centrifuge model runs
+# at tens of g; more is a typo).
+_ABSURD_GRAVITY = 1000.0
 _ADAPT_CHUNK_STEPS = 50
 # Wall-clock seconds between progress updates (and rest checks).
 _PROGRESS_PERIOD = 0.25
@@ -67,6 +72,7 @@ class RunSummary:
     time_step_cuts: int = 0
     outputs: dict = field(default_factory=dict)
     case_file: str = ""          # the case file run (absolute), "" when built in Python
+    smoke: bool = False          # RIPRAP_SMOKE=1 cut the run short: its figures are not results
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -191,6 +197,8 @@ class Simulation:
         if solver._ready:
             return
         self.build_without_checks()
+        check_rigid_run(end_time=self.end_time, time_step=solver.time_step,
+                        moving_bodies=int((~solver.fixed).sum()), start_time=solver.time)
         if not self._restarted:
             smallest = min(s.min_subtet_height for s in solver.shapes)
             solver.check_no_initial_overlap(_INITIAL_OVERLAP_FRACTION * smallest,
@@ -233,13 +241,14 @@ class Simulation:
         """
         from riprap.io import checkpoint as checkpoint_io
         from riprap.io import vtk
+        from riprap.io.output_folder import prepare_output_folder
 
+        out = self.output_directory
+        prepare_output_folder(out)
         if restart_from is not None:
             self.restart(restart_from)
         self.prepare()
         solver = self.solver
-        out = self.output_directory
-        out.mkdir(parents=True, exist_ok=True)
         series = contact_series = None
         if self.paraview:
             series = vtk.ParaViewSeries(out, "bodies", append=self._restarted)
@@ -278,8 +287,8 @@ class Simulation:
                         continue
                     path = self._write_checkpoint(checkpoint_io, good, "failure_checkpoint.npz")
                     raise InstabilityError(f"{error}\nThe last good state (t = {good['clock'][0]:.6g} s) "
-                                           f"was written to {path}; restart from it with a smaller "
-                                           "time step.") from None
+                                           f"was written to {path}. {self._blow_up_advice(good)}"
+                                           ) from None
                 elapsed = wallclock.perf_counter() - tick
                 if self.adaptive_time_step:
                     # Time step decisions at fixed step counts, not wall-clock ones, so that a
@@ -329,7 +338,8 @@ class Simulation:
                              frames=self._frame_index,
                              stability_ratio_max=getattr(self, "_max_stability_ratio", 0.0),
                              time_step_min=smallest_step, time_step_max=largest_step,
-                             time_step_cuts=cuts, outputs=outputs, case_file=self.case_file)
+                             time_step_cuts=cuts, outputs=outputs, case_file=self.case_file,
+                             smoke=os.environ.get("RIPRAP_SMOKE", "") == "1")
         from riprap.io.summary import write_json
         write_json(out / "summary.json", summary.as_dict())
         return summary
@@ -352,8 +362,33 @@ class Simulation:
         if speeds.max(initial=0.0) > _RUNAWAY_SPEED:
             body = int(np.argmax(speeds))
             raise InstabilityError(
-                f"body {body} moves at {speeds[body]:.3g} m/s at t = {self.solver.time:.6g} s: the "
-                "time step is too large for the contact stiffness; lower time_step or contact_penalty")
+                f"body {body} moves at {speeds[body]:.3g} m/s at t = {self.solver.time:.6g} s, "
+                f"faster than any armour unit or rock should ({_RUNAWAY_SPEED:g} m/s)")
+
+    def _blow_up_advice(self, good: dict) -> str:
+        """What to change after a blow-up, judged from the last good state: the time step only
+        where it is the cause, not where gravity or a start velocity is absurd."""
+        s = self.solver
+        smallest = min(shape.min_subtet_height for shape in s.shapes)
+        gravity = float(np.linalg.norm(s.gravity))
+        speeds = np.linalg.norm(np.asarray(good["velocities"]), axis=1)
+        speed = float(speeds[~s.fixed].max(initial=0.0))
+        causes = []
+        if gravity > _ABSURD_GRAVITY:
+            causes.append(f"gravity is {gravity:.3g} m/s^2 (the earth's is 9.81): check "
+                          "[simulation] gravity")
+        if speed * s.time_step > _MAX_MOTION_PER_STEP * smallest:
+            causes.append(f"a body moved {speed * s.time_step:.3g} m per step at {speed:.3g} m/s, "
+                          f"more than a tenth of the thinnest boundary layer of tetrahedra "
+                          f"({smallest:.3g} m), so contacts start too deep: check the start "
+                          "velocities, or lower time_step")
+        if not causes:
+            what = ("set [simulation] time_step below the step used" if self.requested_time_step
+                    else "lower [simulation] time_step_safety (or set a smaller time_step)")
+            causes.append(f"the time step {s.time_step:.3e} s is too large for the contact "
+                          f"stiffness: {what}, or lower contact_penalty")
+        return ("Likely cause: " + "; ".join(causes) + ". Then restart from the checkpoint with "
+                "--restart: the new time step is used from there.")
 
     def at_rest(self) -> bool:
         """Every free body slower than ``rest_speed`` and, under gravity, with a net force below
@@ -539,6 +574,13 @@ class Simulation:
         s.time_step = float(arrays["clock"][2])
         s._ready = True
         s.load_state_arrays(arrays)
+        if not self.adaptive_time_step:
+            # The case's time step wins over the checkpoint's (the same case gives the same step, so
+            # a restart stays bit for bit): after a blow-up a smaller step is the usual fix.
+            step = (self.requested_time_step if self.requested_time_step > 0
+                    else s.stable_time_step(self.time_step_safety))
+            if step != s.time_step:
+                s.set_time_step(step)
         s._last = (np.zeros((0, interactions.C_SIZE)), np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64))
         s._contacts = None
         self._frame_index = int(metadata["frame_index"])

@@ -20,7 +20,10 @@ def analyse(path, *, out=None, frame: int = -1) -> LayerAnalysis:
     ``units.csv``, ``report.html``, ``stereonet.png`` and the rest there
     (:mod:`riprap.io.analysis_report`). ``frame``: which frame of a run (-1 the last)."""
     from riprap.io.analysis_input import load_layer_state
+    from riprap.io.output_folder import prepare_output_folder
 
+    if out is not None:
+        prepare_output_folder(out)
     analysis = analyse_layer(load_layer_state(path, frame=frame))
     if out is not None:
         from riprap.io.analysis_report import write_analysis
@@ -44,6 +47,7 @@ def compare_layers(paths, *, out, labels=None, frame: int = -1) -> list[LayerAna
     (``comparison.html``, and each one's files in ``out/<label>/``)."""
     from riprap.io.analysis_input import load_layer_state
     from riprap.io.analysis_report import write_comparison
+    from riprap.io.output_folder import prepare_output_folder
 
     paths = list(paths)
     if len(paths) < 2:
@@ -51,6 +55,7 @@ def compare_layers(paths, *, out, labels=None, frame: int = -1) -> list[LayerAna
     labels = _labels(paths, labels)
     if len(labels) != len(paths):
         raise CaseFileError(f"compare_layers: {len(labels)} labels for {len(paths)} packs")
+    prepare_output_folder(out)
     analyses = [analyse_layer(load_layer_state(p, frame=frame)) for p in paths]
     outputs = write_comparison(out, analyses, labels)
     for analysis, label in zip(analyses, labels):

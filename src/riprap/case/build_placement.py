@@ -11,6 +11,7 @@ Output folder:
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -65,15 +66,28 @@ def _settings(case, end_time, output_directory, progress) -> dict:
                 adaptive_time_step=True)
 
 
-def run_placement(case, *, output_directory=None, progress: bool = True) -> dict:
-    """Build the underlayer and the armour layer of ``case``; returns the summary (also written
-    as ``summary.json``)."""
+@dataclass
+class PlacementInputs:
+    """Everything ``riprap place`` builds and checks before it simulates anything."""
+
+    slope: Slope
+    materials: PlacementMaterials
+    unit: object            # riprap.geometry.armour_units.ArmourUnit
+    rocks: list             # the rock library (riprap.geometry.rock_grading)
+    grid: object = None     # riprap.io.grid_file.GridFile, when [placement] grid_file is given
+
+
+#: What ``riprap check`` cannot know of a placement case without running it.
+PLACEMENT_NOT_CHECKED = ("whether the rocks and units come to rest, and where (only the "
+                         "deposition runs tell)",)
+
+
+def prepare_placement(case) -> PlacementInputs:
+    """Build the slope, materials, unit mesh and rock shapes of ``case`` and read its grid file:
+    every check ``riprap place`` makes before the deposition runs (``riprap check`` runs this)."""
     _require_tables(case)
     from riprap.geometry.rock_grading import RockGrading, rock_library
-    from riprap.io.summary import write_json
 
-    out = Path(output_directory or case.output.directory)
-    out.mkdir(parents=True, exist_ok=True)
     sl, ul, pl = case.slope, case.underlayer, case.placement
     slope = Slope(cotangent=sl.cotangent, width=sl.width, length=sl.length, toe_x=sl.toe_x,
                   toe_level=sl.toe_level, toe_stop_distance=sl.toe_stop_distance)
@@ -81,17 +95,33 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
                                    rock=_material(case, ul.material),
                                    face=_material(case, sl.face_material),
                                    side_wall=_material(case, sl.side_wall_material))
-    unit = _armour_unit(case)
-    rocks = rock_library(RockGrading(dn50=ul.dn50, dn85_over_dn15=ul.dn85_over_dn15),
-                         n_shapes=ul.rock_shapes, n_size_classes=ul.size_classes, seed=ul.seed)
-    underlayer = build_underlayer(
-        slope, rocks, materials=materials, s_range=(ul.from_s, ul.to_s or slope.length),
-        layers=ul.layers, seed=ul.seed,
-        **_settings(case, ul.settle_time, out / "underlayer", progress))
+    grid = None
     if pl.grid_file:
         from riprap.io.grid_file import read_grid_file
 
         grid = read_grid_file(case.base_dir / pl.grid_file)
+    unit = _armour_unit(case)
+    rocks = rock_library(RockGrading(dn50=ul.dn50, dn85_over_dn15=ul.dn85_over_dn15),
+                         n_shapes=ul.rock_shapes, n_size_classes=ul.size_classes, seed=ul.seed)
+    return PlacementInputs(slope=slope, materials=materials, unit=unit, rocks=rocks, grid=grid)
+
+
+def run_placement(case, *, output_directory=None, progress: bool = True) -> dict:
+    """Build the underlayer and the armour layer of ``case``; returns the summary (also written
+    as ``summary.json``)."""
+    from riprap.io.output_folder import prepare_output_folder
+    from riprap.io.summary import write_json
+
+    inputs = prepare_placement(case)
+    out = prepare_output_folder(output_directory or case.output.directory)
+    ul, pl = case.underlayer, case.placement
+    slope, materials, unit = inputs.slope, inputs.materials, inputs.unit
+    underlayer = build_underlayer(
+        slope, inputs.rocks, materials=materials, s_range=(ul.from_s, ul.to_s or slope.length),
+        layers=ul.layers, seed=ul.seed,
+        **_settings(case, ul.settle_time, out / "underlayer", progress))
+    if inputs.grid is not None:
+        grid = inputs.grid
         positions, velocities, lines = grid.positions, grid.velocities, grid.lines
         user = grid.orientations
         lift = False
@@ -127,6 +157,11 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
                          deposition=pl.deposition, rows=rows, release=pl.release,
                          **_settings(case, pl.settle_time, out / "deposition", progress))
     summary = dict(result.summary)
+    summary["smoke"] = smoke_mode()
+    if summary["smoke"]:
+        summary["smoke_note"] = (f"RIPRAP_SMOKE=1 cut every deposition run to {SMOKE_END_TIME} s: "
+                                 "the units had no time to settle, so the layer figures describe "
+                                 "a cut run, not a layer")
     layer = _layer_description(unit, slope, underlayer, result, design_positions)
     summary["outputs"] = _write_outputs(case, result, materials, slope, out, layer)
     summary["underlayer_run"] = underlayer.summary

@@ -22,6 +22,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from riprap.case.cross_rules import check_cross_rules
 from riprap.case import schema
 from riprap.case.schema import Key, Table, describe_expected, format_toml_value
 from riprap.errors import CaseFileError
@@ -964,6 +965,7 @@ class _Validator:
         self._check_unique(tables)
         self._check_references(tables)
         self._check_body_count(tables)
+        check_cross_rules(tables, self._problems.add, _INVALID)
         if self._problems:
             return None
         return Case(

@@ -452,8 +452,9 @@ KEYS: tuple[Key, ...] = (
         "Units in the rows between (staggered, e.g. 11 between rows of 12); 0: the same.",
         default=0, valid_range=_NON_NEGATIVE),
     Key("placement", "packing_density_coefficient", "number", "-",
-        "Packing density of the design grid, phi = N Dn^2 / A; 0: the unit's design value.",
-        default=0.0, valid_range=_NON_NEGATIVE),
+        "Packing density of the design grid, phi = N Dn^2 / A; 0: the unit's design value. One "
+        "layer of units covers the face at most once (cubes face to face: 1), hence at most 1.5.",
+        default=0.0, valid_range=Range(minimum=0.0, maximum=1.5)),
     Key("placement", "first_row_s", "number", "m",
         "Position of the first row along the face from the toe; 0: half a unit height.",
         default=0.0, valid_range=_NON_NEGATIVE),

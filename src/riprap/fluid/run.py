@@ -10,6 +10,8 @@ unbroken run.
 """
 from __future__ import annotations
 
+import os
+
 import time as wallclock
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -44,6 +46,7 @@ class FluidRunSummary:
     frames: int
     outputs: dict = field(default_factory=dict)
     case_file: str = ""
+    smoke: bool = False          # RIPRAP_SMOKE=1 cut the run short: its figures are not results
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -114,11 +117,12 @@ class FluidRun:
     # ------------------------------------------------------------------ the loop
     def run(self, *, restart_from=None) -> FluidRunSummary:
         from riprap.io import vtk
+        from riprap.io.output_folder import prepare_output_folder
         from riprap.io.summary import write_json
 
         s = self.solver
         out = self.output_directory
-        out.mkdir(parents=True, exist_ok=True)
+        prepare_output_folder(out)
         if restart_from is not None:
             self.restart(restart_from)
         series = vtk.ParaViewSeries(out, "fluid", append=self._restarted) if self.paraview else None
@@ -177,7 +181,8 @@ class FluidRun:
             pressure_iterations_mean=float(np.mean(iterations)) if iterations else 0.0,
             pressure_iterations_max=int(max(iterations, default=0)),
             pressure_time_share=float(pressure_seconds / max(wall, 1e-9)),
-            frames=self._frame_index, outputs=outputs, case_file=self.case_file)
+            frames=self._frame_index, outputs=outputs, case_file=self.case_file,
+            smoke=os.environ.get("RIPRAP_SMOKE", "") == "1")
         write_json(out / "summary.json", summary.as_dict())
         return summary
 

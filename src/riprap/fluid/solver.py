@@ -36,6 +36,7 @@ from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.kernels import momentum
 from riprap.fluid.phases import AIR_20C, WATER_20C, Phase
+from riprap.work_estimate import check_fluid_grid
 
 __all__ = ["FluidSolver", "StepReport"]
 
@@ -108,6 +109,7 @@ class FluidSolver:
         self.courant_number = float(courant_number)
         self.max_time_step = float(max_time_step)
         self.surface_tension = float(surface_tension)
+        check_fluid_grid(grid.cells)
         nx, ny, nz = grid.cells
         self.h = grid.cell_size
         self.fraction = np.zeros((nx, ny, nz))

@@ -423,8 +423,7 @@ class SolidSolver:
             first = int(np.argmax(bad))
             raise InstabilityError(
                 f"body {first} has a non-finite state at t = {self.time:.6g} s (step {self.step_count}); "
-                f"{int(bad.sum())} bodies affected. The time step {self.time_step:.3e} s is probably too "
-                "large for the contact stiffness: lower time_step (or time_step_safety) or contact_penalty.")
+                f"{int(bad.sum())} bodies affected")
 
     # ------------------------------------------------------------------ state I/O (arrays only)
     STATE_ARRAYS = ("positions", "quaternions", "velocities", "angular_momenta", "forces", "torques",

@@ -1,0 +1,97 @@
+"""Rules that join several keys or tables of a case file.
+
+The schema (:mod:`riprap.case.schema`) judges each key alone; these rules judge keys together, so
+that ``riprap check`` refuses every combination that ``riprap run`` or ``riprap place`` would
+refuse or, worse, silently ignore. Each rule adds a problem at the line of the key that has to
+change, through ``add(path, message, value)`` of the case loader.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+# The validated tables: name -> dict of values (defaults filled, _INVALID where a value was
+# refused), a list of such dicts for arrays, or None for an absent optional table.
+Tables = dict
+
+#: Keys of [placement] that describe a design grid; a grid file replaces all of them.
+DESIGN_GRID_KEYS = ("rows", "units_per_row", "units_per_alternate_row",
+                    "packing_density_coefficient", "first_row_s", "drop_height")
+#: Tables only ``riprap place`` reads.
+PLACEMENT_TABLES = ("slope", "underlayer", "armour", "placement")
+
+
+def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
+    """Add a problem for every broken rule; values equal to ``invalid`` were already reported."""
+    def ok(*values):
+        return all(value is not invalid for value in values)
+
+    simulation = tables.get("simulation")
+    if simulation and ok(simulation["time_step"], simulation["end_time"]):
+        if simulation["time_step"] > simulation["end_time"]:
+            add(("simulation", "time_step"),
+                f"longer than end_time = {simulation['end_time']:g} s: the run would make no "
+                "step; 0 chooses the step automatically", simulation["time_step"])
+
+    given_placement = [name for name in PLACEMENT_TABLES if tables.get(name) is not None]
+    has_bodies = bool(tables.get("bodies")) or bool(tables.get("body_grids"))
+    if given_placement:
+        missing = [f"[{name}]" for name in PLACEMENT_TABLES if tables.get(name) is None]
+        if missing:
+            add((given_placement[0],),
+                f"an armour placement (riprap place) needs [slope], [underlayer], [armour] and "
+                f"[placement]; missing: {', '.join(missing)}")
+        if tables.get("fluid") is not None:
+            add(("fluid",), "a case is either an armour placement ([slope], [underlayer], [armour], "
+                "[placement]; riprap place) or a fluid run ([fluid]; riprap run), not both: place "
+                "the layer first, then run its pack")
+        if has_bodies:
+            where = "bodies" if tables.get("bodies") else "body_grids"
+            add((where,), "riprap place makes its own bodies (rocks and units) and would ignore "
+                "these; remove them, or run them as a separate case")
+        _check_placement(tables, add, ok)
+    elif tables.get("fluid") is not None and has_bodies:
+        where = "bodies" if tables.get("bodies") else "body_grids"
+        add((where,), "bodies in the fluid (two-way coupling) are not available yet: run the "
+            "bodies and the fluid as separate cases")
+
+
+def _check_placement(tables: Tables, add: Callable, ok: Callable) -> None:
+    placement, armour = tables.get("placement"), tables.get("armour")
+    slope, underlayer = tables.get("slope"), tables.get("underlayer")
+    if placement:
+        if placement["grid_file"] not in ("", None) and ok(placement["grid_file"]):
+            for name in DESIGN_GRID_KEYS:
+                default = 0 if name in ("rows", "units_per_row", "units_per_alternate_row") else 0.0
+                if ok(placement[name]) and placement[name] != default:
+                    add(("placement", name), "a grid_file gives the unit positions, so this design-"
+                        "grid key would be ignored; remove it or the grid_file", placement[name])
+        else:
+            for name in ("rows", "units_per_row"):
+                if ok(placement[name]) and placement[name] < 1:
+                    add(("placement", name), "a design grid (no grid_file) needs rows >= 1 and "
+                        "units_per_row >= 1", placement[name])
+            if placement["orientation"] == "user":
+                add(("placement", "orientation"), "'user' orientations come from a grid_file; give "
+                    "one, or choose random or random_within", placement["orientation"])
+        if placement["release"] == "on_contact" and ok(placement["drop_height"]) \
+                and placement["drop_height"] > 0:
+            add(("placement", "drop_height"), "only used with release = \"free_fall\"; units "
+                "released on contact are lowered until they touch", placement["drop_height"])
+    if armour:
+        sizes = [name for name in ("height", "nominal_diameter", "mass")
+                 if ok(armour[name]) and armour[name] > 0]
+        if len(sizes) != 1:
+            add(("armour",), "give exactly one of height, nominal_diameter and mass (> 0); got "
+                + (", ".join(sizes) or "none"))
+    if slope and underlayer and ok(slope["length"], underlayer["from_s"], underlayer["to_s"]):
+        length, low = slope["length"], underlayer["from_s"]
+        high = underlayer["to_s"] or length
+        if low < 0:
+            add(("underlayer", "from_s"), "below the toe (s < 0); the rock band must lie on the "
+                f"face, 0 to length = {length:g} m", low)
+        if underlayer["to_s"] > length:
+            add(("underlayer", "to_s"), f"beyond the crest: the face is {length:g} m long "
+                "(slope.length); 0 means the whole face", underlayer["to_s"])
+        elif low >= high:
+            add(("underlayer", "from_s"), f"not below to_s = {high:g} m: the rock band would be "
+                "empty", low)

@@ -1,0 +1,89 @@
+"""``riprap check``: every check that ``riprap run`` or ``riprap place`` makes before it simulates,
+without simulating: the schema and the rules joining keys (on loading), meshes and mesh files,
+grid files, the contact history of a pack, the fluid grid and its water, the time step and the
+work it implies, overlapping and coincident bodies, and the output folder. What only a run can
+tell is listed as not checked, never passed over in silence.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from riprap.case.load import Case
+from riprap.io.output_folder import OutputFolderError
+
+__all__ = ["CheckReport", "check_case", "check_output_folder"]
+
+
+@dataclass
+class CheckReport:
+    """What ``check_case`` found: a one-line description of the case, what was checked and what
+    cannot be known without running it."""
+
+    description: str
+    checked: list[str] = field(default_factory=list)
+    not_checked: list[str] = field(default_factory=list)
+
+
+def check_output_folder(path) -> str:
+    """Refuse an output folder that cannot be made or written, without making it."""
+    folder = Path(path)
+    if folder.exists() and not folder.is_dir():
+        raise OutputFolderError(f"output folder {folder}: a file of that name exists; choose "
+                                "another --out folder")
+    existing = folder
+    while not existing.exists():
+        if existing.parent == existing:
+            break
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        raise OutputFolderError(f"output folder {folder}: {existing} is a file, not a folder")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise OutputFolderError(f"cannot write the output folder {folder}: {existing} is not "
+                                "writable; choose a folder you may write to (--out)")
+    return f"output folder {folder} can be written"
+
+
+def check_case(case: Case, *, output_directory=None) -> CheckReport:
+    """Run every pre-simulation check of ``case``; raises the error the run would raise."""
+    out = output_directory or case.output.directory
+    if case.is_placement:
+        from riprap.case.build_placement import PLACEMENT_NOT_CHECKED, prepare_placement
+
+        inputs = prepare_placement(case)
+        report = CheckReport(
+            f"an armour placement for riprap place: {case.armour.unit} units on a "
+            f"1:{case.slope.cotangent:g} slope",
+            checked=["tables and keys", f"unit mesh ({len(inputs.unit.mesh.tets)} tetrahedra)",
+                     f"{len(inputs.rocks)} rock shapes"],
+            not_checked=list(PLACEMENT_NOT_CHECKED))
+        if inputs.grid is not None:
+            report.checked.append(f"grid file ({len(inputs.grid.positions)} units)")
+    elif case.is_fluid:
+        from riprap.case.build_fluid import build_fluid_solver
+
+        solver = build_fluid_solver(case)
+        cells = "x".join(map(str, case.fluid.cells))
+        report = CheckReport(
+            f"air and water on {cells} cells",
+            checked=["tables and keys", "fluid grid and memory",
+                     f"water regions ({solver.water_volume():.4g} m^3 of water)"],
+            not_checked=["whether the flow stays stable (the time step adapts to it)"])
+    else:
+        from riprap.case.build import build_simulation
+
+        sim = build_simulation(case, output_directory=out, progress=False)
+        sim.prepare()
+        solver = sim.solver
+        checked = ["tables and keys", f"{len(case.shapes)} shape meshes",
+                   f"time step {solver.time_step:.3e} s and the work of "
+                   f"{sim.end_time / solver.time_step:.3g} steps",
+                   "overlapping and coincident bodies at the start"]
+        if case.simulation.contact_history:
+            checked.append(f"contact history ({len(sim.accepted_overlaps)} resting contacts)")
+        report = CheckReport(f"{solver.n_bodies} bodies", checked=checked,
+                             not_checked=["whether the contacts that form later stay stable at "
+                                          "this time step (a run stops with a checkpoint if not)"])
+    report.checked.append(check_output_folder(out))
+    return report

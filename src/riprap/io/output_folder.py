@@ -1,0 +1,56 @@
+"""The output folder of a run: made (with its parents) and proved writable before any work starts,
+so that a read-only folder, a path under a file, a name too long or a full disk is one clear
+error at the start, not a traceback after an hour of simulation."""
+from __future__ import annotations
+
+import errno
+import os
+from pathlib import Path
+
+from riprap.errors import RiprapError
+
+__all__ = ["OutputFolderError", "prepare_output_folder", "describe_os_error"]
+
+
+class OutputFolderError(RiprapError):
+    """The output folder cannot be made or written."""
+
+
+def describe_os_error(error: OSError) -> str:
+    """An OSError in words an engineer can act on, naming the file."""
+    where = error.filename if error.filename is not None else "?"
+    reason = error.strerror or str(error)
+    hints = {errno.ENOSPC: "free some space or choose another --out folder",
+             errno.EDQUOT: "free some space or choose another --out folder",
+             errno.EACCES: "choose a folder you may write to (--out)",
+             errno.EPERM: "choose a folder you may write to (--out)",
+             errno.EROFS: "the file system is read-only: choose another --out folder",
+             errno.ENAMETOOLONG: "use a shorter folder name",
+             errno.ENOTDIR: "a part of the path is a file, not a folder",
+             errno.EEXIST: "a file of that name is in the way"}
+    hint = hints.get(error.errno)
+    return f"{where}: {reason}" + (f" ({hint})" if hint else "")
+
+
+def prepare_output_folder(path) -> Path:
+    """Make ``path`` (and its parents) and check that a file can be written in it.
+
+    Raises
+    ------
+    OutputFolderError
+        Naming the folder and the reason (not writable, under a file, name too long, disk full).
+    """
+    folder = Path(path)
+    if folder.exists() and not folder.is_dir():
+        raise OutputFolderError(f"output folder {folder}: a file of that name exists; choose "
+                                "another --out folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / f".riprap-write-test-{os.getpid()}"
+        with open(probe, "wb") as stream:
+            stream.write(b"riprap")
+        probe.unlink()
+    except OSError as error:
+        raise OutputFolderError(f"cannot write the output folder {folder}: "
+                                f"{describe_os_error(error)}") from None
+    return folder

@@ -1,0 +1,84 @@
+"""How much work a run asks for, estimated before it starts, so that a size or parameter that
+would make billions of steps or cells is refused with the figure instead of hanging without a word.
+
+The rates are this code's measured speeds on a 2-core machine (``bench/README.md``): rigid runs
+3e4-6e4 body-steps/s, the fluid solver about 2e6 cell-updates/s and about 250 bytes of memory per
+fluid cell (all arrays and the multigrid levels). An estimate above the refusal limit is an error
+(:class:`WorkTooLargeError`); above the warning limit a :class:`RiprapWarning` tells the user what
+they are about to wait for.
+"""
+from __future__ import annotations
+
+import os
+import warnings
+
+from riprap.errors import RiprapError
+
+#: Measured speed of a rigid run (body-steps per second), the low end of bench/README.md.
+RIGID_BODY_STEPS_PER_SECOND = 3.0e4
+#: Memory of one fluid cell (bytes): velocities, fraction, pressure, work arrays, multigrid.
+FLUID_BYTES_PER_CELL = 250.0
+#: A run estimated to take longer than this (s of wall-clock time) is refused: 30 days.
+REFUSE_WALL_SECONDS = 30 * 86400.0
+#: ... and one estimated to take longer than this gets a warning: 12 hours.
+WARN_WALL_SECONDS = 12 * 3600.0
+#: More steps than this is refused whatever the rate: the clock's round-off and the output count
+#: stop meaning anything long before.
+REFUSE_STEPS = 1.0e10
+#: A fluid grid needing more than this fraction of the machine's memory is refused.
+MEMORY_FRACTION = 0.8
+
+
+class WorkTooLargeError(RiprapError):
+    """A run, grid or mesh would need an absurd amount of time or memory."""
+
+
+class RiprapWarning(UserWarning):
+    """Something the user should know before waiting for the result."""
+
+
+def _duration(seconds: float) -> str:
+    for unit, size in (("years", 365.25 * 86400), ("days", 86400.0), ("hours", 3600.0),
+                       ("minutes", 60.0)):
+        if seconds >= size:
+            return f"{seconds / size:.3g} {unit}"
+    return f"{seconds:.3g} s"
+
+
+def check_rigid_run(*, end_time: float, time_step: float, moving_bodies: int,
+                    start_time: float = 0.0) -> None:
+    """Refuse (or warn about) a rigid run of ``(end_time - start_time) / time_step`` steps."""
+    steps = max(end_time - start_time, 0.0) / time_step
+    seconds = steps * max(moving_bodies, 1) / RIGID_BODY_STEPS_PER_SECOND
+    figure = (f"{steps:.3g} steps of {time_step:.3g} s for {end_time - start_time:.3g} s of "
+              f"simulated time with {moving_bodies} moving bodies: about {_duration(seconds)} at "
+              f"{RIGID_BODY_STEPS_PER_SECOND:.0e} body-steps/s")
+    if steps > REFUSE_STEPS or seconds > REFUSE_WALL_SECONDS:
+        raise WorkTooLargeError(
+            f"the run would take {figure}. The time step comes from the smallest, lightest body "
+            "and the contact stiffness: check the sizes (in metres), densities and contact_penalty, "
+            "or shorten end_time")
+    if seconds > WARN_WALL_SECONDS:
+        warnings.warn(f"this run will take {figure}", RiprapWarning, stacklevel=3)
+
+
+def available_memory_bytes() -> float:
+    """Physical memory of this machine (bytes); infinity where it cannot be read."""
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return float("inf")
+
+
+def check_fluid_grid(cells) -> None:
+    """Refuse a fluid grid whose arrays would not fit in memory, before allocating any."""
+    count = 1.0
+    for n in cells:
+        count *= float(n)
+    need = count * FLUID_BYTES_PER_CELL
+    have = available_memory_bytes()
+    if need > MEMORY_FRACTION * have:
+        raise WorkTooLargeError(
+            f"a fluid grid of {' x '.join(str(int(n)) for n in cells)} = {count:.3g} cells needs about "
+            f"{need / 2**30:.3g} GiB of memory ({FLUID_BYTES_PER_CELL:.0f} bytes per cell); this "
+            f"machine has {have / 2**30:.3g} GiB. Use fewer, larger cells")
