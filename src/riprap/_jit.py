@@ -5,6 +5,9 @@ pay the compile time again. ``parallel_kernel`` adds ``parallel=True`` and is us
 in ``bench/`` shows that threads pay. ``fastmath`` stays off: contact forces are compared with a
 reference evaluation to 1e-9 and must not depend on reassociation.
 
+The cache is stamped with one hash of all kernel sources, not numba's per-file time stamps, so
+that a kernel compiled against an older version of another kernel file is never loaded.
+
 Set ``NUMBA_DISABLE_JIT=1`` to run every kernel as plain Python (slow) for tracebacks and debugging.
 """
 import os
@@ -16,6 +19,49 @@ import os
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numba  # noqa: E402
+
+
+def _use_source_stamped_cache() -> None:
+    """Put riprap's own cache locators (numba's three file-backed ones, stamped with one hash of
+    all kernel sources) in front of numba's; functions outside riprap keep numba's behaviour. numba's locator list is not
+    public API: where it has moved, numba's own per-file stamps stay in use."""
+    try:
+        from numba.core import caching
+
+        bases = (caching.UserProvidedCacheLocator, caching.InTreeCacheLocator,
+                 caching.UserWideCacheLocator)
+        existing = list(caching.CacheImpl._locator_classes)
+    except AttributeError:
+        return
+    from riprap.io.source_hash import kernel_source_hash
+
+    package_dir = os.path.dirname(os.path.abspath(__file__))
+    # numba judges a cached function fresh by its own file's time stamp and size only, but a
+    # cached kernel carries compiled copies of the kernels it calls from other files: after one
+    # of those changed, a stale copy would run with today's data layout. One hash of all kernel
+    # sources (and of this file and numba's version) as every riprap entry's stamp makes any
+    # change recompile them all.
+    stamp = kernel_source_hash(package_dir, extra_files=[__file__], salt=numba.__version__)
+
+    def stamped(base):
+        class RiprapLocator(base):
+            @classmethod
+            def from_function(cls, py_func, py_file):
+                if not os.path.abspath(py_file).startswith(package_dir + os.sep):
+                    return None
+                return super().from_function(py_func, py_file)
+
+            def get_source_stamp(self):
+                return stamp
+
+        RiprapLocator.__name__ = f"Riprap{base.__name__}"
+        return RiprapLocator
+
+    if not any(getattr(cls, "__name__", "").startswith("Riprap") for cls in existing):
+        caching.CacheImpl._locator_classes = [stamped(base) for base in bases] + existing
+
+
+_use_source_stamped_cache()
 
 kernel = numba.njit(cache=True, fastmath=False, error_model="numpy")
 parallel_kernel = numba.njit(cache=True, fastmath=False, parallel=True, error_model="numpy")
