@@ -52,7 +52,13 @@ import numpy as np
 
 from riprap.errors import CaseFileError, MeshError
 from riprap.geometry.mass_properties import mass_properties
-from riprap.geometry.meshing import mesh_occ_shape
+from riprap.geometry.meshing import (
+    MAX_BODY_LENGTH,
+    MIN_BODY_LENGTH,
+    check_body_length,
+    check_tetrahedron_estimate,
+    mesh_occ_shape,
+)
 from riprap.geometry.tetmesh import TetMesh
 
 UNIT_KINDS = ("core_loc_like", "accropode_like", "xbloc_like", "tetrapod", "cube", "antifer_cube")
@@ -313,6 +319,8 @@ class ArmourUnit:
 
 
 def _positive(value: float, parameter: str, where: str, unit: str = "m") -> float:
+    if isinstance(value, (bool, np.bool_)):
+        raise CaseFileError(f"{where}: {parameter} must be a number in {unit}, got {value!r}")
     try:
         value = float(value)
     except (TypeError, ValueError) as error:
@@ -624,7 +632,7 @@ def add_unit_solid(occ: object, kind: str, *, height: float) -> None:
         Unit height H in metres.
     """
     kind = _check_kind(kind)
-    height = _positive(height, "height", f"armour unit '{kind}'")
+    height = check_body_length(height, "height", f"armour unit '{kind}'")
     _BUILDERS[kind](occ, height)
 
 
@@ -671,7 +679,7 @@ def occ_mass_properties(kind: str, *, height: float) -> dict[str, object]:
     from riprap.geometry.meshing import _gmsh_session
 
     kind = _check_kind(kind)
-    height = _positive(height, "height", f"armour unit '{kind}'")
+    height = check_body_length(height, "height", f"armour unit '{kind}'")
     with _gmsh_session(f"occ_mass_properties({kind})") as gmsh:
         occ = gmsh.model.occ
         add_unit_solid(occ, kind, height=height)
@@ -722,7 +730,7 @@ def unit_design(kind: str) -> UnitDesign:
 def default_mesh_size(kind: str, *, height: float) -> float:
     """Default element size in m of a unit of this kind and height (a per-kind fraction of H)."""
     kind = _check_kind(kind)
-    height = _positive(height, "height", f"armour unit '{kind}'")
+    height = check_body_length(height, "height", f"armour unit '{kind}'")
     return _DEFAULT_MESH_SIZE_OVER_HEIGHT[kind] * height
 
 
@@ -736,14 +744,22 @@ def _height_from_size(kind: str, height, nominal_diameter, mass, density) -> flo
             f"{', '.join(given) if given else 'none'}"
         )
     if height is not None:
-        return _positive(height, "height", where)
+        return check_body_length(height, "height", where)
     if nominal_diameter is not None:
-        volume = _positive(nominal_diameter, "nominal_diameter", where) ** 3
+        volume = check_body_length(nominal_diameter, "nominal_diameter", where) ** 3
+        given = f"nominal_diameter = {float(nominal_diameter):g} m"
     else:
-        volume = _positive(mass, "mass", where, unit="kg") / _positive(
-            density, "density", where, unit="kg/m^3"
+        mass = _positive(mass, "mass", where, unit="kg")
+        density = _positive(density, "density", where, unit="kg/m^3")
+        volume = mass / density
+        given = f"mass = {mass:g} kg at density = {density:g} kg/m^3"
+    height = (volume / volume_coefficient(kind)) ** (1.0 / 3.0)
+    if not MIN_BODY_LENGTH <= height <= MAX_BODY_LENGTH:
+        raise CaseFileError(
+            f"{where}: {given} gives a unit height of {height:g} m, outside the sizes riprap "
+            f"meshes ({MIN_BODY_LENGTH:g} m to {MAX_BODY_LENGTH:g} m); check the value and its unit"
         )
-    return (volume / volume_coefficient(kind)) ** (1.0 / 3.0)
+    return height
 
 
 def armour_unit(
@@ -784,7 +800,9 @@ def armour_unit(
     ------
     CaseFileError
         For an unknown kind (the message lists the kinds and suggests the closest), none or
-        several of the size arguments, or a non-positive size, density or mesh size.
+        several of the size arguments, a non-positive size, density or mesh size, a height
+        (given or derived) outside ``MIN_BODY_LENGTH`` .. ``MAX_BODY_LENGTH``, or a mesh size
+        that would make more than ``MAX_TETRAHEDRA_PER_SHAPE`` tetrahedra.
 
     Examples
     --------
@@ -798,10 +816,11 @@ def armour_unit(
         mesh_size = default_mesh_size(kind, height=height)
     else:
         mesh_size = _positive(mesh_size, "mesh_size", f"armour_unit('{kind}')")
+    name = f"{kind}(height={height:.6g})"
+    check_tetrahedron_estimate(volume_coefficient(kind) * height**3, mesh_size, name,
+                               error=CaseFileError)
     mesh = mesh_occ_shape(
-        lambda occ: add_unit_solid(occ, kind, height=height),
-        mesh_size=mesh_size,
-        name=f"{kind}(height={height:.6g})",
+        lambda occ: add_unit_solid(occ, kind, height=height), mesh_size=mesh_size, name=name
     )
     volume = mass_properties(mesh).volume
     return ArmourUnit(

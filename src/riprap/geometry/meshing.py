@@ -29,7 +29,7 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 
-from riprap.errors import MeshError, RiprapError
+from riprap.errors import CaseFileError, MeshError, RiprapError
 from riprap.geometry.tetmesh import _OUTWARD_FACES, TetMesh
 
 # Element size = nominal diameter / 3.8 gives ~300-600 tetrahedra for random rocks of elongation
@@ -48,6 +48,20 @@ OPTIMISE_BELOW_QUALITY = 0.1
 # Minimum SICN accepted after optimisation; lower is rejected with MeshError (gmsh's own
 # "very poor quality" warnings start around here).
 MIN_ACCEPTED_QUALITY = 0.05
+
+# Sizes riprap accepts for a body, in m, checked before gmsh is called: gmsh/OpenCASCADE crash
+# (segfault) or hang on absurd sizes (a sphere of radius 1e308), and nothing riprap models (sand
+# grains to caisson-sized units) lies outside this range.
+MIN_BODY_LENGTH = 1e-5
+MAX_BODY_LENGTH = 1e4
+
+# A shape is refused before meshing if its estimated tetrahedron count exceeds this: 2e6
+# tetrahedra take minutes and gigabytes in gmsh, and contact on them would be hopeless.
+MAX_TETRAHEDRA_PER_SHAPE = 2_000_000
+
+# Estimated tetrahedra per (volume / mesh_size^3): 6 is a lower estimate (a regular tetrahedron
+# of edge h has volume h^3 / 8.5; gmsh gives ~11 V / h^3 for a cube, ~5.5 for a sphere).
+TETRAHEDRA_PER_CUBED_MESH_SIZE = 6.0
 
 # Feature angles tried after the requested one when gmsh cannot re-parametrise the patches.
 _FEATURE_ANGLE_RETRY_OFFSETS_DEG = (0.0, 10.0, -10.0, 20.0, -20.0)
@@ -200,10 +214,98 @@ def _generate_and_extract(gmsh: object, name: str) -> TetMesh:
 
 
 def _check_mesh_size(mesh_size: float, name: str) -> float:
-    mesh_size = float(mesh_size)
+    try:
+        mesh_size = float(mesh_size)
+    except (TypeError, ValueError):
+        raise MeshError(
+            f"meshing '{name}': mesh_size must be a length in m (a number), got {mesh_size!r}"
+        ) from None
     if not (np.isfinite(mesh_size) and mesh_size > 0.0):
         raise MeshError(f"meshing '{name}': mesh_size must be a positive length in m, got {mesh_size}")
     return mesh_size
+
+
+def check_body_length(value: object, parameter: str, where: str) -> float:
+    """A body size (radius, edge, height, nominal diameter, ...) as a float, checked.
+
+    Parameters
+    ----------
+    value : float
+        The length in m.
+    parameter : str
+        Its keyword (named in the error).
+    where : str
+        The shape or function (named in the error).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    CaseFileError
+        If ``value`` is not a number, not finite, or outside ``MIN_BODY_LENGTH`` ..
+        ``MAX_BODY_LENGTH`` (gmsh would crash or hang on it).
+    """
+    if isinstance(value, (bool, np.bool_)):
+        raise CaseFileError(f"{where}: {parameter} must be a length in m (a number), got {value!r}")
+    try:
+        length = float(value)
+    except (TypeError, ValueError):
+        raise CaseFileError(
+            f"{where}: {parameter} must be a length in m (a number), got {value!r}"
+        ) from None
+    if not np.isfinite(length) or length <= 0.0:
+        raise CaseFileError(
+            f"{where}: {parameter} must be a positive length in m (finite), got {length}"
+        )
+    if not MIN_BODY_LENGTH <= length <= MAX_BODY_LENGTH:
+        raise CaseFileError(
+            f"{where}: {parameter} = {length:g} m is outside the sizes riprap meshes "
+            f"({MIN_BODY_LENGTH:g} m to {MAX_BODY_LENGTH:g} m); give the size in metres"
+        )
+    return length
+
+
+def check_tetrahedron_estimate(volume: float, mesh_size: float, name: str,
+                               error: type[RiprapError] = MeshError) -> float:
+    """Refuse a mesh_size that would fill ``volume`` with an absurd number of tetrahedra.
+
+    Parameters
+    ----------
+    volume : float
+        Volume of the body in m^3 (its absolute value is used).
+    mesh_size : float
+        Largest element edge in m.
+    name : str
+        Shape or file named in the error.
+    error : type
+        The :class:`RiprapError` subclass raised (``CaseFileError`` for API arguments).
+
+    Returns
+    -------
+    float
+        The estimate ``TETRAHEDRA_PER_CUBED_MESH_SIZE * volume / mesh_size ** 3``.
+
+    Raises
+    ------
+    RiprapError
+        ``error``, with the estimate, when it exceeds ``MAX_TETRAHEDRA_PER_SHAPE``.
+    """
+    volume = abs(float(volume))
+    mesh_size = float(mesh_size)
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        estimate = TETRAHEDRA_PER_CUBED_MESH_SIZE * volume / mesh_size**3
+    if not estimate <= MAX_TETRAHEDRA_PER_SHAPE:
+        smallest = (TETRAHEDRA_PER_CUBED_MESH_SIZE * volume
+                    / MAX_TETRAHEDRA_PER_SHAPE) ** (1.0 / 3.0)
+        raise error(
+            f"meshing '{name}': mesh_size = {mesh_size:g} m would make about {estimate:.3g} "
+            f"tetrahedra ({TETRAHEDRA_PER_CUBED_MESH_SIZE:g} x volume {volume:.3g} m^3 / "
+            f"mesh_size^3), more than riprap's limit of {MAX_TETRAHEDRA_PER_SHAPE:.0e} per shape; "
+            f"use mesh_size >= {smallest:.3g} m or leave it out for the default"
+        )
+    return float(estimate)
 
 
 def _enclosed_volume(vertices: np.ndarray, triangles: np.ndarray) -> float:
@@ -249,7 +351,8 @@ def tetrahedralize_surface(
     Raises
     ------
     MeshError
-        If gmsh fails or the result is invalid, naming ``name``.
+        If gmsh fails or the result is invalid, or the mesh would have more than
+        ``MAX_TETRAHEDRA_PER_SHAPE`` tetrahedra (estimated before meshing), naming ``name``.
     """
     vertices = np.asarray(vertices, dtype=np.float64)
     triangles = np.asarray(triangles, dtype=np.int64)
@@ -258,16 +361,26 @@ def tetrahedralize_surface(
             f"meshing '{name}': vertices must have shape (n, 3) and triangles (m, 3), got "
             f"{vertices.shape} and {triangles.shape}"
         )
-    if len(triangles) < 4 or triangles.min() < 0 or triangles.max() >= len(vertices):
+    if len(triangles) < 4:
+        raise MeshError(f"meshing '{name}': need at least 4 triangles, got {len(triangles)}")
+    out_of_range = np.flatnonzero(((triangles < 0) | (triangles >= len(vertices))).any(axis=1))
+    if out_of_range.size:
+        listed = ", ".join(f"{k} {triangles[k].tolist()}" for k in out_of_range[:5])
         raise MeshError(
-            f"meshing '{name}': need at least 4 triangles with vertex indices in "
-            f"0..{len(vertices) - 1}"
+            f"meshing '{name}': {out_of_range.size} triangles have vertex indices outside "
+            f"0..{len(vertices) - 1}: triangles {listed}"
         )
-    if not np.isfinite(vertices).all():
-        raise MeshError(f"meshing '{name}': vertex coordinates must be finite")
+    bad_vertices = np.flatnonzero(~np.isfinite(vertices[np.unique(triangles)]).all(axis=1))
+    if bad_vertices.size:
+        listed = ", ".join(str(int(np.unique(triangles)[k])) for k in bad_vertices[:5])
+        raise MeshError(
+            f"meshing '{name}': vertex coordinates must be finite (nan or inf at vertices {listed})"
+        )
+    volume = _enclosed_volume(vertices, triangles)
     if mesh_size is None:
-        mesh_size = default_mesh_size(_enclosed_volume(vertices, triangles))
+        mesh_size = default_mesh_size(volume)
     mesh_size = _check_mesh_size(mesh_size, name)
+    check_tetrahedron_estimate(volume, mesh_size, name)
     used = np.unique(triangles)
     failures = []
     # gmsh's re-parametrisation sometimes fails on one particular patch layout ("wrong topology of
@@ -344,7 +457,8 @@ def mesh_occ_shape(
     Raises
     ------
     MeshError
-        If the build leaves no or several solids, or gmsh fails.
+        If the build leaves no or several solids, the mesh would have more than
+        ``MAX_TETRAHEDRA_PER_SHAPE`` tetrahedra (estimated before meshing), or gmsh fails.
     """
     mesh_size = _check_mesh_size(mesh_size, name)
     with _gmsh_session(name) as gmsh:
@@ -360,6 +474,7 @@ def mesh_occ_shape(
                 f"building shape '{name}' left {len(volumes)} solids instead of one; fuse the parts "
                 f"with occ.fuse"
             )
+        check_tetrahedron_estimate(gmsh.model.occ.getMass(*volumes[0]), mesh_size, name)
         _set_size_options(gmsh, mesh_size)
         try:
             return _generate_and_extract(gmsh, name)

@@ -5,13 +5,25 @@ frame (described in each docstring), with lengths in metres. The default ``mesh_
 :func:`~riprap.geometry.meshing.default_mesh_size` (nominal diameter / 3.8), capped where a shape
 has a thin part so that there are always elements across it; built-in shapes get roughly 200-1500
 tetrahedra at the default and no slivers (every tetrahedron has gmsh SICN >= 0.05).
+
+Sizes are checked before gmsh is called (gmsh crashes on absurd ones): every body length must be
+finite and within ``MIN_BODY_LENGTH`` .. ``MAX_BODY_LENGTH`` (1e-5 m .. 1e4 m), and a
+``mesh_size`` whose estimated tetrahedron count (``6 volume / mesh_size^3``) exceeds
+``MAX_TETRAHEDRA_PER_SHAPE`` (2e6) is refused with the estimate
+(:mod:`riprap.geometry.meshing`); each error is a :class:`CaseFileError` naming the keyword.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from riprap.errors import CaseFileError
-from riprap.geometry.meshing import default_mesh_size, mesh_occ_shape, tetrahedralize_surface
+from riprap.geometry.meshing import (
+    check_body_length,
+    check_tetrahedron_estimate,
+    default_mesh_size,
+    mesh_occ_shape,
+    tetrahedralize_surface,
+)
 from riprap.geometry.tetmesh import TetMesh
 
 # Sphere element size as a fraction of the radius. The generic rule (nominal diameter / 3.8 =
@@ -32,11 +44,51 @@ _TETRAPOD_DEFAULT_LEG_DIAMETER_RATIO = 0.4
 _TETRAPOD_CONE_SETBACK = 0.25  # fraction of the base radius
 
 
+# Random rocks: most hull points accepted (24 is the default; thousands of points only make tiny
+# hull facets that gmsh remeshes away, and the spacing search would run for hours at 1e8).
+_ROCK_MAX_VERTICES = 2000
+
+# Random rocks: axis ratios (elongation, flatness) beyond these make needles or sheets that no
+# mesh size resolves.
+_ROCK_MIN_AXIS_RATIO = 0.01
+_ROCK_MAX_AXIS_RATIO = 100.0
+
+
 def _positive(value: float, parameter: str, shape: str) -> float:
-    value = float(value)
-    if not (np.isfinite(value) and value > 0.0):
-        raise CaseFileError(f"{shape}: {parameter} must be a positive length in m, got {value}")
-    return value
+    """A body length, finite and within ``MIN_BODY_LENGTH`` .. ``MAX_BODY_LENGTH`` m."""
+    return check_body_length(value, parameter, shape)
+
+
+def _number(value: object, parameter: str, shape: str) -> float:
+    if isinstance(value, (bool, np.bool_)):
+        raise CaseFileError(f"{shape}: {parameter} must be a number, got {value!r}")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise CaseFileError(f"{shape}: {parameter} must be a number, got {value!r}") from None
+
+
+def _axis_ratio(value: object, parameter: str, shape: str) -> float:
+    ratio = _number(value, parameter, shape)
+    if not _ROCK_MIN_AXIS_RATIO <= ratio <= _ROCK_MAX_AXIS_RATIO:
+        raise CaseFileError(
+            f"{shape}: {parameter} = {ratio:g} is outside {_ROCK_MIN_AXIS_RATIO:g} .. "
+            f"{_ROCK_MAX_AXIS_RATIO:g} (a ratio of the rock's semi-axes)"
+        )
+    return ratio
+
+
+def _mesh_size(mesh_size: object, default: float, volume: float, shape: str) -> float:
+    """The element size (given, or ``default``), refused when not a positive length or when the
+    body of ``volume`` m^3 would get more than ``MAX_TETRAHEDRA_PER_SHAPE`` tetrahedra."""
+    if mesh_size is None:
+        mesh_size = default
+    else:
+        mesh_size = _number(mesh_size, "mesh_size", shape)
+        if not (np.isfinite(mesh_size) and mesh_size > 0.0):
+            raise CaseFileError(f"{shape}: mesh_size must be a positive length in m, got {mesh_size}")
+    check_tetrahedron_estimate(volume, mesh_size, shape, error=CaseFileError)
+    return float(mesh_size)
 
 
 def sphere(*, radius: float, mesh_size: float | None = None) -> TetMesh:
@@ -55,12 +107,11 @@ def sphere(*, radius: float, mesh_size: float | None = None) -> TetMesh:
     TetMesh
     """
     radius = _positive(radius, "radius", "sphere")
-    if mesh_size is None:
-        mesh_size = _SPHERE_MESH_SIZE_PER_RADIUS * radius
+    name = f"sphere(radius={radius:g})"
+    mesh_size = _mesh_size(mesh_size, _SPHERE_MESH_SIZE_PER_RADIUS * radius,
+                           4.0 / 3.0 * np.pi * radius**3, name)
     return mesh_occ_shape(
-        lambda occ: occ.addSphere(0.0, 0.0, 0.0, radius),
-        mesh_size=mesh_size,
-        name=f"sphere(radius={radius:g})",
+        lambda occ: occ.addSphere(0.0, 0.0, 0.0, radius), mesh_size=mesh_size, name=name
     )
 
 
@@ -79,15 +130,15 @@ def box(*, lengths: tuple[float, float, float], mesh_size: float | None = None) 
     -------
     TetMesh
     """
-    if len(lengths) != 3:
-        raise CaseFileError(f"box: lengths must be three edge lengths (x, y, z) in m, got {lengths}")
+    if isinstance(lengths, (str, bytes)) or not hasattr(lengths, "__len__") or len(lengths) != 3:
+        raise CaseFileError(f"box: lengths must be three edge lengths (x, y, z) in m, got {lengths!r}")
     lx, ly, lz = (_positive(length, "lengths", "box") for length in lengths)
     return _box(lx, ly, lz, mesh_size, f"box(lengths=({lx:g}, {ly:g}, {lz:g}))")
 
 
 def _box(lx: float, ly: float, lz: float, mesh_size: float | None, name: str) -> TetMesh:
-    if mesh_size is None:
-        mesh_size = min(default_mesh_size(lx * ly * lz), lx, ly, lz)
+    mesh_size = _mesh_size(mesh_size, min(default_mesh_size(lx * ly * lz), lx, ly, lz),
+                           lx * ly * lz, name)
     return mesh_occ_shape(
         lambda occ: occ.addBox(-lx / 2, -ly / 2, -lz / 2, lx, ly, lz), mesh_size=mesh_size, name=name
     )
@@ -195,10 +246,23 @@ def random_rock(
     TetMesh
     """
     size = _positive(size, "size", "random_rock")
-    elongation = _positive(elongation, "elongation", "random_rock")
-    flatness = _positive(flatness, "flatness", "random_rock")
-    if int(n_vertices) != n_vertices or n_vertices < 8:
+    elongation = _axis_ratio(elongation, "elongation", "random_rock")
+    flatness = _axis_ratio(flatness, "flatness", "random_rock")
+    vertex_count = _number(n_vertices, "n_vertices", "random_rock")
+    if not (np.isfinite(vertex_count) and vertex_count == int(vertex_count) and vertex_count >= 8):
         raise CaseFileError(f"random_rock: n_vertices must be an integer >= 8, got {n_vertices}")
+    if vertex_count > _ROCK_MAX_VERTICES:
+        raise CaseFileError(
+            f"random_rock: n_vertices = {vertex_count:g} is more than {_ROCK_MAX_VERTICES} hull "
+            f"points; a rock needs a few dozen (default 24)"
+        )
+    n_vertices = int(vertex_count)
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise CaseFileError(f"random_rock: seed must be a non-negative integer, got {seed!r}")
+    seed = int(seed)
+    name = (f"random_rock(size={size:g}, elongation={elongation:g}, flatness={flatness:g}, "
+            f"seed={seed})")
+    mesh_size = _mesh_size(mesh_size, default_mesh_size(size**3), size**3, name)
     rng = np.random.default_rng(seed)
     directions = _spaced_directions(rng, int(n_vertices))
     radii = 1.0 + rng.uniform(-_ROCK_RADIAL_JITTER, _ROCK_RADIAL_JITTER, size=len(directions))
@@ -206,15 +270,7 @@ def random_rock(
     vertices, triangles = _hull_surface(points)
     volume, centroid = _surface_volume_and_centroid(vertices, triangles)
     vertices = (vertices - centroid) * (size / volume ** (1.0 / 3.0))
-    if mesh_size is None:
-        mesh_size = default_mesh_size(size**3)
-    return tetrahedralize_surface(
-        vertices,
-        triangles,
-        mesh_size=mesh_size,
-        name=f"random_rock(size={size:g}, elongation={elongation:g}, flatness={flatness:g}, "
-        f"seed={seed})",
-    )
+    return tetrahedralize_surface(vertices, triangles, mesh_size=mesh_size, name=name)
 
 
 def tetrapod(
@@ -258,7 +314,7 @@ def tetrapod(
     TetMesh
     """
     height = _positive(height, "height", "tetrapod")
-    leg_diameter_ratio = float(leg_diameter_ratio)
+    leg_diameter_ratio = _number(leg_diameter_ratio, "leg_diameter_ratio", "tetrapod")
     if not 0.15 <= leg_diameter_ratio <= 0.5:
         raise CaseFileError(
             f"tetrapod: leg_diameter_ratio must lie in 0.15..0.5 (leg diameter at the centre / "
@@ -272,9 +328,10 @@ def tetrapod(
         np.array([np.sin(polar) * np.cos(a), np.sin(polar) * np.sin(a), np.cos(polar)])
         for a in (0.0, 2.0 * np.pi / 3.0, 4.0 * np.pi / 3.0)
     ]
-    if mesh_size is None:
-        leg_volume = np.pi * leg_length / 3.0 * (base_radius**2 + base_radius * tip_radius + tip_radius**2)
-        mesh_size = min(default_mesh_size(4.0 * leg_volume), 2.0 * tip_radius)
+    name = f"tetrapod(height={height:g}, leg_diameter_ratio={leg_diameter_ratio:g})"
+    leg_volume = np.pi * leg_length / 3.0 * (base_radius**2 + base_radius * tip_radius + tip_radius**2)
+    mesh_size = _mesh_size(mesh_size, min(default_mesh_size(4.0 * leg_volume), 2.0 * tip_radius),
+                           4.0 * leg_volume, name)
 
     # The cones start a little behind the centre, widened to keep the radius at the centre, so
     # that their four base discs do not all pass through one point (OpenCASCADE's union fails on
@@ -289,11 +346,7 @@ def tetrapod(
         ]
         occ.fuse(legs[:1], legs[1:])
 
-    return mesh_occ_shape(
-        build,
-        mesh_size=mesh_size,
-        name=f"tetrapod(height={height:g}, leg_diameter_ratio={leg_diameter_ratio:g})",
-    )
+    return mesh_occ_shape(build, mesh_size=mesh_size, name=name)
 
 
 def l_shape(
@@ -326,9 +379,9 @@ def l_shape(
     thickness = _positive(thickness, "thickness", "l_shape")
     if width >= length:
         raise CaseFileError(f"l_shape: width ({width:g} m) must be less than length ({length:g} m)")
-    if mesh_size is None:
-        volume = (2.0 * length - width) * width * thickness
-        mesh_size = min(default_mesh_size(volume), width, thickness)
+    name = f"l_shape(length={length:g}, width={width:g}, thickness={thickness:g})"
+    volume = (2.0 * length - width) * width * thickness
+    mesh_size = _mesh_size(mesh_size, min(default_mesh_size(volume), width, thickness), volume, name)
     x0, y0, z0 = -length / 2, -length / 2, -thickness / 2
 
     def build(occ: object) -> None:
@@ -336,8 +389,4 @@ def l_shape(
         second = occ.addBox(x0, y0, z0, width, length, thickness)
         occ.fuse([(3, first)], [(3, second)])
 
-    return mesh_occ_shape(
-        build,
-        mesh_size=mesh_size,
-        name=f"l_shape(length={length:g}, width={width:g}, thickness={thickness:g})",
-    )
+    return mesh_occ_shape(build, mesh_size=mesh_size, name=name)

@@ -348,10 +348,20 @@ def check_closed_surface(vertices: np.ndarray, triangles: np.ndarray, name: str 
         raise MeshError(
             f"surface '{name}' has {len(triangles)} triangles; a closed surface needs at least 4"
         )
-    triangles = triangles.astype(np.int64)
-    if triangles.min() < 0 or triangles.max() >= len(vertices):
+    if not np.issubdtype(triangles.dtype, np.integer) and not (
+        np.issubdtype(triangles.dtype, np.floating) and np.array_equal(triangles, np.round(triangles))
+    ):
         raise MeshError(
-            f"surface '{name}': triangle vertex indices must lie in 0..{len(vertices) - 1}"
+            f"surface '{name}': triangle vertex indices must be integers, got dtype {triangles.dtype}"
+        )
+    triangles = triangles.astype(np.int64)
+    out_of_range = np.flatnonzero(((triangles < 0) | (triangles >= len(vertices))).any(axis=1))
+    if out_of_range.size:
+        listed = [f"{k} (vertices {triangles[k].tolist()})" for k in out_of_range[:_MAX_LISTED]]
+        raise MeshError(
+            f"surface '{name}': {out_of_range.size} triangles refer to vertices that do not exist "
+            f"(indices must lie in 0..{len(vertices) - 1}): triangles "
+            f"{_listing(listed, out_of_range.size)}"
         )
     if not np.isfinite(vertices).all():
         bad = np.flatnonzero(~np.isfinite(vertices).all(axis=1))

@@ -197,8 +197,8 @@ class TetMesh:
 
         Checks, in order: at least one tetrahedron; finite coordinates; every tetrahedron
         positively oriented ("inverted" otherwise); no degenerate tetrahedron (volume below
-        ``DEGENERATE_VOLUME_FRACTION`` x bounding-box diagonal^3); no face shared by more than two
-        tetrahedra; a boundary that is a closed 2-manifold (every boundary edge used by exactly two
+        ``DEGENERATE_VOLUME_FRACTION`` x bounding-box diagonal^3); no tetrahedron repeated (the
+        same four nodes twice); no face shared by more than two tetrahedra; a boundary that is a closed 2-manifold (every boundary edge used by exactly two
         boundary faces). Unused nodes are allowed.
 
         Raises
@@ -238,16 +238,39 @@ class TetMesh:
                 f"tets {_listing(listed, degenerate.size)}; remesh with mesh optimisation or "
                 f"remove these tetrahedra"
             )
+        self._check_repeated_tets()
         faces, counts, first = self._face_table()
         overused = np.flatnonzero(counts > 2)
         if overused.size:
-            listed = [str(faces[first[k]].tolist()) for k in overused[:_MAX_LISTED]]
+            keys = np.sort(faces, axis=1)
+            listed = []
+            for k in overused[:_MAX_LISTED]:
+                owners = np.flatnonzero((keys == keys[first[k]]).all(axis=1)) // 4
+                listed.append(f"{faces[first[k]].tolist()} (tets {owners.tolist()})")
             raise MeshError(
                 f"mesh '{name}' has {overused.size} faces shared by more than two tetrahedra "
-                f"(overlapping elements): faces {_listing(listed, overused.size)}; remesh the body"
+                f"(overlapping elements): faces {_listing(listed, overused.size)}; remove the "
+                f"overlapping tetrahedra or remesh the body"
             )
         boundary = faces[first[counts == 1]]
         self._check_closed_boundary(boundary)
+
+    def _check_repeated_tets(self) -> None:
+        # A repeated tetrahedron (same four nodes, any order) counts its volume and mass twice and
+        # hides its faces from the boundary; the face counts alone do not always reveal it.
+        keys = np.sort(self.tets, axis=1)
+        _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+        inverse = inverse.reshape(-1)
+        repeated = np.flatnonzero(counts > 1)
+        if repeated.size:
+            listed = []
+            for k in repeated[:_MAX_LISTED]:
+                copies = np.flatnonzero(inverse == k)
+                listed.append(f"{self.tets[copies[0]].tolist()} (tets {copies.tolist()})")
+            raise MeshError(
+                f"mesh '{self.name}' has {repeated.size} repeated tetrahedra (the same four nodes "
+                f"more than once): {_listing(listed, repeated.size)}; remove the duplicates"
+            )
 
     def _check_closed_boundary(self, boundary: np.ndarray) -> None:
         edges = np.sort(boundary[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)

@@ -147,11 +147,45 @@ def load_pack_state(path):
 
 
 def _pvd_frames(pvd: Path) -> list[tuple[float, str]]:
+    if not pvd.is_file():
+        raise CaseFileError(f"{pvd}: missing; the run folder lacks its ParaView series (was the "
+                            "run written with paraview output off, or the file deleted?)")
     try:
         root = ElementTree.parse(pvd).getroot()
-        return sorted((float(d.attrib["timestep"]), d.attrib["file"]) for d in root.iter("DataSet"))
+        frames = sorted((float(d.attrib["timestep"]), d.attrib["file"])
+                        for d in root.iter("DataSet"))
     except (ElementTree.ParseError, KeyError, ValueError, OSError) as error:
         raise CaseFileError(f"{pvd}: cannot read the ParaView series: {error}") from None
+    bad = [time for time, _ in frames if not np.isfinite(time)]
+    if bad:
+        raise CaseFileError(f"{pvd}: a frame has timestep {bad[0]!r}; times must be finite")
+    return frames
+
+
+def _read_frame_mesh(path: Path, what: str):
+    """``meshio.read`` of one frame file; a missing, empty or truncated file is a CaseFileError
+    naming the frame (meshio itself would call ``sys.exit`` on some of them)."""
+    import contextlib
+    import io
+
+    import meshio
+
+    if not path.is_file():
+        raise CaseFileError(f"{path}: {what} is listed in the series but the file does not exist; "
+                            "the run folder is incomplete (copied in part, or the run was cut off)")
+    if path.stat().st_size == 0:
+        raise CaseFileError(f"{path}: {what} is empty (0 bytes); the run was cut off while "
+                            "writing it, analyse another frame (--frame)")
+    said = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            return meshio.read(path)
+    except (Exception, SystemExit) as error:
+        detail = " ".join(said.getvalue().split())
+        if not isinstance(error, SystemExit):
+            detail = f"{type(error).__name__}: {error}" + (f" ({detail})" if detail else "")
+        raise CaseFileError(f"{path}: cannot read {what} ({detail or 'no reason given'}); the "
+                            "file is truncated or corrupt, analyse another frame (--frame)") from None
 
 
 def _fit_pose(local, world, centroid):
@@ -165,23 +199,54 @@ def _fit_pose(local, world, centroid):
     return rotation, world_mean - rotation @ (local_mean - centroid)
 
 
-def _read_contacts_vtu(path: Path):
-    """Contact records of one frame of ``contacts.pvd`` (``body_i``, ``body_j``, forces)."""
-    import meshio
-
+def _no_contact_records():
     from riprap.solid.solver import ContactRecords
 
-    try:
-        mesh = meshio.read(path)
-    except ValueError as error:
+    return ContactRecords(body_i=np.zeros(0, np.int64), body_j=np.zeros(0, np.int64),
+                          points=np.zeros((0, 3)), normal_forces=np.zeros((0, 3)),
+                          tangential_forces=np.zeros((0, 3)), stiffness=np.zeros(0))
+
+
+def _integer_array(values, count: int, name: str, path: Path) -> np.ndarray:
+    values = np.asarray(values).reshape(-1)
+    if values.size != count:
+        raise CaseFileError(f"{path}: '{name}' has {values.size} values for {count} points")
+    if not np.issubdtype(values.dtype, np.integer):
+        exact = np.isfinite(values) & (values == np.round(values))
+        if not exact.all():
+            k = int(np.flatnonzero(~exact)[0])
+            raise CaseFileError(f"{path}: '{name}' of point {k} is {values[k]!r}, not an integer "
+                                "body index")
+    return values.astype(np.int64)
+
+
+def _finite_vectors(values, count: int, name: str, path: Path) -> np.ndarray:
+    values = np.asarray(values, dtype=float)
+    if values.size != 3 * count:
+        raise CaseFileError(f"{path}: '{name}' has {values.size} numbers for {count} points "
+                            "(expected 3 each)")
+    values = values.reshape(count, 3)
+    bad = np.flatnonzero(~np.isfinite(values).all(axis=1))
+    if bad.size:
+        raise CaseFileError(f"{path}: '{name}' of point {int(bad[0])} is {values[bad[0]].tolist()} "
+                            f"(not finite; {bad.size} such points)")
+    return values
+
+
+def _read_contacts_vtu(path: Path, what: str = "the contacts frame"):
+    """Contact records of one frame of ``contacts.pvd`` (``body_i``, ``body_j``, forces)."""
+    from riprap.solid.solver import ContactRecords
+
+    if path.is_file() and path.stat().st_size > 0:
         # meshio cannot read a VTU without points: a frame with no contacts.
-        pieces = [piece.attrib.get("NumberOfPoints") for piece in
-                  ElementTree.parse(path).getroot().iter("Piece")]
+        try:
+            pieces = [piece.attrib.get("NumberOfPoints") for piece in
+                      ElementTree.parse(path).getroot().iter("Piece")]
+        except (ElementTree.ParseError, OSError):
+            pieces = []
         if pieces and all(count == "0" for count in pieces):
-            return ContactRecords(body_i=np.zeros(0, np.int64), body_j=np.zeros(0, np.int64),
-                                  points=np.zeros((0, 3)), normal_forces=np.zeros((0, 3)),
-                                  tangential_forces=np.zeros((0, 3)), stiffness=np.zeros(0))
-        raise CaseFileError(f"{path}: cannot read the contacts frame: {error}") from None
+            return _no_contact_records()
+    mesh = _read_frame_mesh(path, what)
     data = mesh.point_data
     missing = [name for name in ("body_i", "body_j", "normal_force", "tangential_force")
                if name not in data]
@@ -190,27 +255,31 @@ def _read_contacts_vtu(path: Path):
                             "older riprap?); analyse the pack instead")
     count = len(mesh.points)
     return ContactRecords(
-        body_i=np.asarray(data["body_i"], dtype=np.int64).reshape(count),
-        body_j=np.asarray(data["body_j"], dtype=np.int64).reshape(count),
-        points=np.asarray(mesh.points, dtype=float).reshape(-1, 3),
-        normal_forces=np.asarray(data["normal_force"], dtype=float).reshape(-1, 3),
-        tangential_forces=np.asarray(data["tangential_force"], dtype=float).reshape(-1, 3),
+        body_i=_integer_array(data["body_i"], count, "body_i", path),
+        body_j=_integer_array(data["body_j"], count, "body_j", path),
+        points=_finite_vectors(mesh.points, count, "points", path),
+        normal_forces=_finite_vectors(data["normal_force"], count, "normal_force", path),
+        tangential_forces=_finite_vectors(data["tangential_force"], count, "tangential_force",
+                                          path),
         stiffness=np.zeros(count))
 
 
 def load_run_state(run_folder, *, frame: int = -1):
     """The state at frame ``frame`` (index into ``bodies.pvd``'s list, -1 the last) of a run
     started from a pack."""
-    import meshio
-
     run_folder = Path(run_folder)
     summary_path = run_folder / "summary.json"
     try:
         summary = json.loads(summary_path.read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as error:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
         raise CaseFileError(f"{summary_path}: cannot read the run summary ({error}); the analysis "
                             "of a run needs it to find the case the run was started from") from None
+    if not isinstance(summary, dict):
+        raise CaseFileError(f"{summary_path}: not a run summary (a JSON object is expected)")
     case_file = summary.get("case_file")
+    if not isinstance(case_file, (str, type(None))):
+        raise CaseFileError(f"{summary_path}: 'case_file' must be a path (a string), got "
+                            f"{case_file!r}")
     if not case_file:
         raise CaseFileError(f"{summary_path}: no 'case_file' (runs of this riprap version record "
                             "the case they ran); analyse the pack instead, or run it again")
@@ -222,16 +291,34 @@ def load_run_state(run_folder, *, frame: int = -1):
     contact_frames = dict(_pvd_frames(run_folder / "contacts.pvd"))
     if not frames:
         raise CaseFileError(f"{run_folder / 'bodies.pvd'}: lists no frames")
+    if isinstance(frame, (bool, np.bool_)) or not isinstance(frame, (int, np.integer)):
+        raise CaseFileError(f"{run_folder}: frame must be an integer (0..{len(frames) - 1}, or -1 "
+                            f"for the last), got {frame!r}")
     if not -len(frames) <= frame < len(frames):
         raise CaseFileError(f"{run_folder}: frame {frame} does not exist; the run wrote "
                             f"{len(frames)} frames (0..{len(frames) - 1}, or -1 for the last)")
     time, body_file = frames[frame]
     if time not in contact_frames:
         raise CaseFileError(f"{run_folder / 'contacts.pvd'}: no frame at t = {time!r} s")
-    bodies_mesh = meshio.read(run_folder / body_file)
+    frame_path = run_folder / body_file
+    what = f"frame {frame % len(frames)} of bodies.pvd (t = {time:g} s)"
+    bodies_mesh = _read_frame_mesh(frame_path, what)
     points = np.asarray(bodies_mesh.points, dtype=float)
-    triangles = np.asarray(bodies_mesh.cells_dict["triangle"], dtype=np.int64)
-    owners = np.asarray(bodies_mesh.cell_data_dict["body_id"]["triangle"], dtype=np.int64)
+    cells = bodies_mesh.cells_dict
+    owner_data = bodies_mesh.cell_data_dict.get("body_id", {})
+    if "triangle" not in cells or "triangle" not in owner_data:
+        raise CaseFileError(f"{frame_path}: {what} has no body surfaces with 'body_id' (cell "
+                            f"types {', '.join(sorted(cells)) or 'none'}); it is not a riprap "
+                            "bodies frame, or was written by an older riprap")
+    triangles = np.asarray(cells["triangle"], dtype=np.int64)
+    owners = _integer_array(owner_data["triangle"], len(triangles), "body_id", frame_path)
+    if points.ndim != 2 or points.shape[1] != 3 or not np.isfinite(points).all():
+        raise CaseFileError(f"{frame_path}: {what} has non-finite or non-3D point coordinates")
+    if triangles.size and (triangles.min() < 0 or triangles.max() >= len(points)):
+        raise CaseFileError(f"{frame_path}: {what} has triangles with point indices outside "
+                            f"0..{len(points) - 1}; the file is corrupt")
+    if owners.size and owners.min() < 0:
+        raise CaseFileError(f"{frame_path}: {what} has a negative body_id {int(owners.min())}")
     shape_of_body = pack["shape_of_body"]
     if owners.max(initial=-1) + 1 != n_bodies:
         raise CaseFileError(f"{run_folder / body_file}: has {owners.max(initial=-1) + 1} bodies, "
@@ -251,7 +338,8 @@ def load_run_state(run_folder, *, frame: int = -1):
             raise CaseFileError(f"{run_folder / body_file}: body {b} has {len(world)} surface "
                                 f"nodes, its shape '{shape_names[k]}' {len(local)}")
         rotations[b], positions[b] = _fit_pose(local, world, centroids[k])
-    contacts = _read_contacts_vtu(run_folder / contact_frames[time])
+    contacts = _read_contacts_vtu(run_folder / contact_frames[time],
+                                  f"the contacts frame at t = {time:g} s (contacts.pvd)")
     return _layer_state(pack, positions=positions, rotations=rotations, contacts=contacts,
                         time=time, source=f"{run_folder} frame {frame} (t = {time:g} s)")
 

@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -88,28 +89,87 @@ def write_layer_file(directory, layer) -> Path:
     return path
 
 
+def _is_number(value) -> bool:
+    """A finite JSON number (true/false are not numbers, NaN/Infinity are not finite)."""
+    return (isinstance(value, (int, float)) and not isinstance(value, bool)
+            and math.isfinite(value))
+
+
+def _is_integer(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_point(value) -> bool:
+    return isinstance(value, list) and len(value) == 3 and all(_is_number(v) for v in value)
+
+
+# Fields of layer.json that must be positive (sizes of a unit).
+_POSITIVE_FIELDS = ("nominal_diameter_m", "unit_volume_m3", "unit_height_m")
+
+
 def _check_field(name, value, kind, problems) -> None:
-    if kind == "string" and not (isinstance(value, str) and value):
-        problems.append(f"'{name}' must be a non-empty string, got {value!r}")
-    elif kind == "number" and not (isinstance(value, (int, float)) and math.isfinite(value)):
-        problems.append(f"'{name}' must be a finite number, got {value!r}")
-    elif kind == "integers" and not (isinstance(value, list)
-                                     and all(isinstance(v, int) for v in value)):
-        problems.append(f"'{name}' must be a list of integers")
-    elif kind == "points" and not (isinstance(value, list) and all(
-            isinstance(p, list) and len(p) == 3 for p in value)):
-        problems.append(f"'{name}' must be a list of [x, y, z] points")
+    """Append to ``problems`` what is wrong with field ``name`` (as ``(name, message)``)."""
+    def bad(message):
+        problems.append((name, message))
+
+    if kind == "string":
+        if not (isinstance(value, str) and value):
+            bad(f"'{name}' must be a non-empty string, got {value!r}")
+    elif kind == "number":
+        if not _is_number(value):
+            bad(f"'{name}' must be a finite number, got {value!r}")
+        elif name in _POSITIVE_FIELDS and value <= 0:
+            bad(f"'{name}' must be positive, got {value!r}")
+    elif kind == "integers":
+        if not isinstance(value, list):
+            bad(f"'{name}' must be a list of integers, got {value!r}")
+            return
+        wrong = [k for k, v in enumerate(value) if not _is_integer(v) or v < 0]
+        if wrong:
+            k = wrong[0]
+            bad(f"'{name}' must be a list of integers >= 0; entry {k} is {value[k]!r}"
+                + (f" ({len(wrong)} bad entries)" if len(wrong) > 1 else ""))
+    elif kind == "points":
+        if not isinstance(value, list):
+            bad(f"'{name}' must be a list of [x, y, z] points, got {value!r}")
+            return
+        wrong = [k for k, v in enumerate(value) if not _is_point(v)]
+        if wrong:
+            k = wrong[0]
+            bad(f"'{name}' must be a list of [x, y, z] points (3 finite numbers each); entry {k} "
+                f"is {value[k]!r}" + (f" ({len(wrong)} bad entries)" if len(wrong) > 1 else ""))
     elif kind == "axes":
         if not isinstance(value, dict) or "nose" not in value:
-            problems.append(f"'{name}' must map axis names to [x, y, z], with a 'nose' axis")
-        elif any(not (isinstance(v, list) and len(v) == 3) for v in value.values()):
-            problems.append(f"'{name}': every axis must be [x, y, z]")
+            bad(f"'{name}' must map axis names to [x, y, z], with a 'nose' axis")
+            return
+        for axis, vector in value.items():
+            if not _is_point(vector):
+                bad(f"'{name}': axis '{axis}' must be [x, y, z] (3 finite numbers), got {vector!r}")
+            elif math.hypot(*vector) == 0.0:
+                bad(f"'{name}': axis '{axis}' is the zero vector; give a direction")
     elif kind == "slope":
-        missing = [f for f in _SLOPE_FIELDS if not isinstance(value, dict) or f not in value]
+        if not isinstance(value, dict):
+            bad(f"'slope' must be a table of {', '.join(_SLOPE_FIELDS)}, got {value!r}")
+            return
+        missing = [f for f in _SLOPE_FIELDS if f not in value]
         if missing:
-            problems.append(f"'slope' lacks {', '.join(missing)}")
-    elif kind == "mapping" and not isinstance(value, dict):
-        problems.append(f"'{name}' must be a table of numbers")
+            bad(f"'slope' lacks {', '.join(missing)}")
+        for field in _SLOPE_FIELDS:
+            if field in value and not _is_number(value[field]):
+                bad(f"'slope': '{field}' must be a finite number, got {value[field]!r}")
+    elif kind == "mapping":
+        if not isinstance(value, dict):
+            bad(f"'{name}' must be a table of numbers, got {value!r}")
+            return
+        for key, number in value.items():
+            if not _is_number(number):
+                bad(f"'{name}': '{key}' must be a finite number, got {number!r}")
+
+
+def _field_line(text: str, name: str) -> int | None:
+    """Line of the first ``"name":`` in the JSON text (for messages), or None."""
+    match = re.search(r'"' + re.escape(name) + r'"\s*:', text)
+    return text.count("\n", 0, match.start()) + 1 if match else None
 
 
 def read_layer_file(directory, n_bodies: int | None = None):
@@ -126,10 +186,16 @@ def read_layer_file(directory, n_bodies: int | None = None):
             "beside pack.toml (which bodies are armour units, their rows and design positions, the "
             "slope); this pack was written without it (by an older riprap or by hand). Place the "
             "layer again with this version, or write layer.json (riprap.io.layer_file.write_layer_file).")
+    text = read_text_file(path, what="layer file", extension=".json")
+    if not text.strip():
+        raise CaseFileError(f"{path}: is empty; write it again (riprap place, or "
+                            "riprap.io.layer_file.write_layer_file)")
     try:
-        data = json.loads(read_text_file(path, what="layer file", extension=".json"))
+        data = json.loads(text)
     except json.JSONDecodeError as error:
         raise CaseFileError(f"{path}:{error.lineno}: not valid JSON: {error.msg}") from None
+    except RecursionError:
+        raise CaseFileError(f"{path}: not valid JSON (nested too deeply)") from None
     if not isinstance(data, dict) or data.get("format") != LAYER_FORMAT:
         raise CaseFileError(f"{path}: not a riprap layer description (its 'format' is "
                             f"{data.get('format') if isinstance(data, dict) else None!r}, expected "
@@ -142,26 +208,37 @@ def read_layer_file(directory, n_bodies: int | None = None):
     problems = []
     missing = [name for name in _FIELDS if name not in data]
     if missing:
-        problems.append("missing field(s): " + ", ".join(
-            f"'{name}' ({_FIELDS[name][1]})" for name in missing))
+        problems.append((None, "missing field(s): " + ", ".join(
+            f"'{name}' ({_FIELDS[name][1]})" for name in missing)))
     for name, (kind, _) in _FIELDS.items():
         if name in data:
             _check_field(name, data[name], kind, problems)
     if not problems:
         n_units = len(data["unit_bodies"])
+        if n_units == 0:
+            problems.append(("unit_bodies", "'unit_bodies' is empty; a layer has at least one unit"))
         for name in ("rows", "design_positions"):
             if len(data[name]) != n_units:
-                problems.append(f"'{name}' has {len(data[name])} entries, 'unit_bodies' {n_units}")
+                problems.append((name, f"'{name}' has {len(data[name])} entries, 'unit_bodies' "
+                                       f"{n_units}"))
         if n_bodies is not None:
             bad = [b for b in data["unit_bodies"] if not 0 <= b < n_bodies]
             if bad:
-                problems.append(f"'unit_bodies' names bodies {bad[:5]} but the pack has {n_bodies} "
-                                "bodies (indices from 0)")
+                problems.append(("unit_bodies", f"'unit_bodies' names bodies {bad[:5]} but the pack "
+                                                f"has {n_bodies} bodies (indices from 0)"))
         if len(set(data["unit_bodies"])) != n_units:
-            problems.append("'unit_bodies' lists a body twice")
+            problems.append(("unit_bodies", "'unit_bodies' lists a body twice"))
     if problems:
-        raise CaseFileError.from_problems([f"{path}: {p}" for p in problems], 20)
-    slope = Slope(**{name: float(data["slope"][name]) for name in _SLOPE_FIELDS})
+        located = []
+        for name, message in problems:
+            line = _field_line(text, name) if name else None
+            located.append(f"{path}:{line}: {message}" if line else f"{path}: {message}")
+        raise CaseFileError.from_problems(located, 20)
+    try:
+        slope = Slope(**{name: float(data["slope"][name]) for name in _SLOPE_FIELDS})
+    except CaseFileError as error:
+        line = _field_line(text, "slope")
+        raise CaseFileError(f"{path}{f':{line}' if line else ''}: 'slope': {error}") from None
     return LayerDescription(
         unit_kind=data["unit_kind"], unit_shape=data["unit_shape"],
         nominal_diameter=float(data["nominal_diameter_m"]), unit_volume=float(data["unit_volume_m3"]),
@@ -192,8 +269,31 @@ def write_contact_table(path, contacts) -> Path:
     return path
 
 
+def _body_index(text: str, column: str, where: str) -> int:
+    """An integer body index, exactly (``1.7`` is refused, never truncated)."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        value = float(text)
+    except ValueError:
+        raise CaseFileError(f"{where}: {column} = {text.strip()!r} is not a number; body indices "
+                            "are integers") from None
+    if not (math.isfinite(value) and value.is_integer() and abs(value) < 2**53):
+        raise CaseFileError(f"{where}: {column} = {text.strip()} is not an integer body index "
+                            "(bodies count from 0; body_j = -1 - w for wall w)")
+    return int(value)
+
+
 def read_contact_table(path):
-    """Read a contact table written by :func:`write_contact_table` into ``ContactRecords``."""
+    """Read a contact table written by :func:`write_contact_table` into ``ContactRecords``.
+
+    A table with its header and no rows is a state without contacts; an empty file, or one
+    without the header line, is refused (it is not a table the writer makes). Every row must have
+    integer body indices (``body_i >= 0``, ``body_j != body_i``) and finite numbers; errors name
+    the file, the line and the column.
+    """
     from riprap.solid.solver import ContactRecords
 
     path = Path(path)
@@ -204,27 +304,50 @@ def read_contact_table(path):
             "the run's history, are unknown.")
     rows = []
     header_seen = False
-    for number, line in enumerate(read_text_file(path, what="contact table", extension=".csv").splitlines(), start=1):
+    text_of_file = read_text_file(path, what="contact table", extension=".csv")
+    for number, line in enumerate(text_of_file.splitlines(), start=1):
         text = line.strip()
         if not text or text.startswith("#"):
             continue
+        where = f"{path}:{number}"
         if not header_seen:
             columns = tuple(name.strip() for name in text.split(","))
             if columns != CONTACT_COLUMNS:
-                raise CaseFileError(f"{path}:{number}: columns {', '.join(columns)}; expected "
-                                    f"{', '.join(CONTACT_COLUMNS)}")
+                raise CaseFileError(f"{where}: columns {', '.join(columns)}; expected "
+                                    f"{', '.join(CONTACT_COLUMNS)} (the header line comes first)")
             header_seen = True
             continue
         fields = text.split(",")
         try:
             values = [float(v) for v in fields]
         except ValueError:
-            raise CaseFileError(f"{path}:{number}: not all fields are numbers: {text!r}") from None
-        if len(values) != len(CONTACT_COLUMNS) or not all(math.isfinite(v) for v in values):
-            raise CaseFileError(f"{path}:{number}: expected {len(CONTACT_COLUMNS)} finite numbers, "
-                                f"got {text!r}")
-        rows.append(values)
-    table = np.asarray(rows, dtype=float).reshape(-1, len(CONTACT_COLUMNS))
-    return ContactRecords(body_i=table[:, 0].astype(np.int64), body_j=table[:, 1].astype(np.int64),
-                          points=table[:, 2:5].copy(), normal_forces=table[:, 5:8].copy(),
-                          tangential_forces=table[:, 8:11].copy(), stiffness=np.zeros(len(table)))
+            raise CaseFileError(f"{where}: not all fields are numbers: {text!r}") from None
+        if len(fields) != len(CONTACT_COLUMNS):
+            raise CaseFileError(f"{where}: expected {len(CONTACT_COLUMNS)} fields "
+                                f"({', '.join(CONTACT_COLUMNS)}), got {len(fields)}: {text!r}")
+        values = values[2:]
+        for column, value in zip(CONTACT_COLUMNS[2:], values):
+            if not math.isfinite(value):
+                raise CaseFileError(f"{where}: {column} = {value} is not finite; expected "
+                                    f"{len(CONTACT_COLUMNS)} finite numbers, got {text!r}")
+        body_i = _body_index(fields[0], "body_i", where)
+        body_j = _body_index(fields[1], "body_j", where)
+        if body_i < 0:
+            raise CaseFileError(f"{where}: body_i = {body_i}; body_i is a body (from 0), only "
+                                "body_j may be a wall (-1 - w)")
+        if body_j == body_i:
+            raise CaseFileError(f"{where}: body_i and body_j are both {body_i}; a contact joins "
+                                "two different bodies")
+        rows.append([body_i, body_j] + values)
+    if not header_seen:
+        state = "is empty" if not text_of_file.strip() else "has no header line"
+        raise CaseFileError(
+            f"{path}: {state}; a contact table starts with the header "
+            f"{','.join(CONTACT_COLUMNS)} (a table with the header and no rows means no "
+            "contacts). Write it again (riprap place, or riprap.io.layer_file.write_contact_table).")
+    body_i = np.array([row[0] for row in rows], dtype=np.int64)
+    body_j = np.array([row[1] for row in rows], dtype=np.int64)
+    table = np.asarray([row[2:] for row in rows], dtype=float).reshape(-1, len(CONTACT_COLUMNS) - 2)
+    return ContactRecords(body_i=body_i, body_j=body_j,
+                          points=table[:, 0:3].copy(), normal_forces=table[:, 3:6].copy(),
+                          tangential_forces=table[:, 6:9].copy(), stiffness=np.zeros(len(table)))

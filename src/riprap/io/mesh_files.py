@@ -9,6 +9,8 @@ the file.
 """
 from __future__ import annotations
 
+import contextlib
+import io
 from pathlib import Path
 
 import numpy as np
@@ -21,16 +23,92 @@ from riprap.geometry.tetmesh import TetMesh
 SURFACE_SUFFIXES = (".stl", ".obj", ".ply", ".off")
 VOLUME_SUFFIXES = (".msh", ".vtu", ".vtk", ".mesh")
 
+# How many bad faces, tetrahedra or vertices an error message lists before "and N more".
+_MAX_LISTED = 5
+
 
 def _read_with_meshio(path: Path) -> object:
+    """``meshio.read(path)``; every failure, including meshio's ``sys.exit(1)`` on files it cannot
+    parse (empty or truncated .vtu/.ply), becomes a :class:`MeshError` naming the file."""
     import meshio
 
+    if path.is_dir():
+        raise MeshError(f"mesh file '{path}' is a folder; give the mesh file itself")
     if not path.is_file():
         raise MeshError(f"mesh file '{path}' does not exist (looked in {path.resolve().parent})")
     try:
-        return meshio.read(path)
-    except Exception as error:  # meshio raises several unrelated types for unreadable files
-        raise MeshError(f"mesh file '{path}' could not be read by meshio: {error}") from error
+        size = path.stat().st_size
+    except OSError as error:
+        raise MeshError(f"mesh file '{path}' cannot be read: {error.strerror}") from None
+    if size == 0:
+        raise MeshError(f"mesh file '{path}' is empty (0 bytes); export or copy the mesh again")
+    # meshio prints why a reader failed, then calls sys.exit(1); keep what it says for the message.
+    said = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            mesh = meshio.read(path)
+    except (Exception, SystemExit) as error:
+        # meshio raises several unrelated types (and SystemExit) for unreadable files
+        detail = " ".join(said.getvalue().split())
+        if not isinstance(error, SystemExit):
+            detail = f"{type(error).__name__}: {error}" + (f" ({detail})" if detail else "")
+        raise MeshError(
+            f"mesh file '{path}' could not be read by meshio ({detail or 'no reason given'}); the "
+            f"file is probably truncated, corrupt or not a {path.suffix} file, export it again"
+        ) from None
+    return mesh
+
+
+def _mesh_points(mesh: object, path: Path) -> np.ndarray:
+    try:
+        points = np.asarray(mesh.points, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise MeshError(
+            f"mesh file '{path}': its point coordinates are not numbers ({error})"
+        ) from None
+    if points.ndim != 2 or len(points) == 0:
+        raise MeshError(f"mesh file '{path}' has no points; export the mesh again")
+    if points.shape[1] != 3:
+        raise MeshError(
+            f"mesh file '{path}' has {points.shape[1]}-dimensional points; riprap needs 3D "
+            f"coordinates (x, y, z) in m"
+        )
+    return points
+
+
+def _check_indices(cells: np.ndarray, n_points: int, first_cell: int, what: tuple[str, str],
+                   path: Path, one_based: bool) -> None:
+    """Refuse cells (faces or tetrahedra) whose vertex indices are not vertices of the file."""
+    bad = np.flatnonzero(((cells < 0) | (cells >= n_points)).any(axis=1))
+    if not bad.size:
+        return
+    offset = 1 if one_based else 0
+    listed = []
+    for k in bad[:_MAX_LISTED]:
+        index = int(cells[k][(cells[k] < 0) | (cells[k] >= n_points)][0]) + offset
+        listed.append(f"{what[0]} {first_cell + k + offset} (vertex {index})")
+    more = f" and {bad.size - _MAX_LISTED} more" if bad.size > _MAX_LISTED else ""
+    numbering = (f"numbered 1..{n_points}; relative (negative) indices are not read"
+                 if one_based else f"numbered 0..{n_points - 1}")
+    raise MeshError(
+        f"mesh file '{path}': vertex indices out of range in {bad.size} "
+        f"{what[0] if bad.size == 1 else what[1]}: {', '.join(listed)}{more}; the file has "
+        f"{n_points} vertices ({numbering}); it is corrupt or was written with another "
+        f"numbering, export it again"
+    )
+
+
+def _check_finite_points(points: np.ndarray, used: np.ndarray, path: Path, one_based: bool) -> None:
+    bad = used[~np.isfinite(points[used]).all(axis=1)]
+    if bad.size:
+        offset = 1 if one_based else 0
+        listed = [f"{int(i) + offset} {points[i].tolist()}" for i in bad[:_MAX_LISTED]]
+        more = f" and {bad.size - _MAX_LISTED} more" if bad.size > _MAX_LISTED else ""
+        raise MeshError(
+            f"mesh file '{path}': non-finite coordinates (nan or inf) at {bad.size} "
+            f"{'vertex' if bad.size == 1 else 'vertices'}: {', '.join(listed)}{more}; fix the file "
+            f"or the program that wrote it"
+        )
 
 
 def _merge_coincident_vertices(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -46,23 +124,82 @@ def _merge_coincident_vertices(points: np.ndarray, triangles: np.ndarray) -> tup
     return unique_points, renumber[triangles]
 
 
-def _surface_triangles(mesh: object, path: Path) -> np.ndarray:
+def _cell_indices(data: np.ndarray, path: Path, what: str) -> np.ndarray:
+    """A cell block's index array as int64 rows; float or text indices are refused."""
+    if data.size and not np.issubdtype(data.dtype, np.integer):
+        raise MeshError(f"mesh file '{path}': {what} indices are not integers")
+    return data.astype(np.int64).reshape(len(data), -1)
+
+
+def _joined(blocks: list[np.ndarray], mesh: object, path: Path, wanted: str, hint: str) -> np.ndarray:
+    """The blocks stacked; none, or all empty, is refused naming the cell types the file has."""
+    if sum(len(block) for block in blocks) == 0:
+        kinds = sorted({block.type for block in mesh.cells}) or ["none"]
+        raise MeshError(f"mesh file '{path}' has no {wanted} (cell types: {', '.join(kinds)}); {hint}")
+    return np.concatenate(blocks)
+
+
+def _surface_triangles(mesh: object, path: Path, n_points: int) -> np.ndarray:
+    """Triangles of a surface file, quads split; faces are numbered in file order in errors."""
+    one_based = path.suffix.lower() == ".obj"
     blocks = []
+    first_face = 0
     for block in mesh.cells:
-        data = np.asarray(block.data, dtype=np.int64)
+        data = np.asarray(block.data)
+        if block.type in ("vertex", "line"):
+            continue
+        if block.type not in ("triangle", "quad"):
+            corners = f"{data.shape[1]} corners" if data.ndim == 2 else "several corners"
+            raise MeshError(
+                f"mesh file '{path}' has {len(data)} faces of type '{block.type}' ({corners}), "
+                f"from face {first_face + int(one_based)} on; riprap reads triangle and quad faces "
+                f"only, triangulate the surface when exporting"
+            )
+        data = _cell_indices(data, path, "face vertex")
+        _check_indices(data, n_points, first_face, ("face", "faces"), path, one_based)
+        first_face += len(data)
         if block.type == "triangle":
             blocks.append(data)
-        elif block.type == "quad":
+        else:
             # Split along the 0-2 diagonal; both halves keep the quad's orientation.
             blocks.append(data[:, [0, 1, 2]])
             blocks.append(data[:, [0, 2, 3]])
-    if not blocks:
-        kinds = sorted({block.type for block in mesh.cells}) or ["none"]
+    return _joined(blocks, mesh, path, "triangle or quad faces",
+                   "export the closed surface of the body")
+
+
+# Volume cells riprap cannot use: taking only the tetrahedra of a file that also has these would
+# silently drop part of the body.
+_OTHER_VOLUME_CELL_PREFIXES = ("hexahedron", "wedge", "pyramid", "polyhedron")
+
+
+def _is_tetra(cell_type: str) -> bool:
+    """'tetra' and the higher-order Lagrange tetrahedra ('tetra10', 'tetra20', ...), whose first
+    four nodes are the corners."""
+    return cell_type == "tetra" or (cell_type.startswith("tetra") and cell_type[5:].isdigit())
+
+
+def _volume_tets(mesh: object, path: Path, n_points: int) -> np.ndarray:
+    """Tetrahedra of a volume file (corner nodes of quadratic ones), tetrahedra numbered in file
+    order in errors."""
+    others = sorted({block.type for block in mesh.cells
+                     if block.type.startswith(_OTHER_VOLUME_CELL_PREFIXES)})
+    if others:
         raise MeshError(
-            f"mesh file '{path}' has no triangle or quad faces (cell types: {', '.join(kinds)}); "
-            f"export the closed surface of the body"
+            f"mesh file '{path}' has volume cells of type {', '.join(others)}; riprap needs a mesh "
+            f"of tetrahedra only (taking the tetrahedra alone would drop part of the body), "
+            f"remesh it with tetrahedra"
         )
-    return np.concatenate(blocks)
+    blocks = []
+    for block in mesh.cells:
+        if not _is_tetra(block.type):
+            continue
+        data = _cell_indices(np.asarray(block.data), path, "tetrahedron node")[:, :4]
+        _check_indices(data, n_points, sum(len(b) for b in blocks), ("tetrahedron", "tetrahedra"),
+                       path, False)
+        blocks.append(data)
+    return _joined(blocks, mesh, path, "tetrahedra", "riprap needs a tetrahedral volume mesh, "
+                   "or give the closed surface as .stl")
 
 
 def read_mesh(path: str | Path, *, mesh_size: float | None = None) -> TetMesh:
@@ -94,8 +231,10 @@ def read_mesh(path: str | Path, *, mesh_size: float | None = None) -> TetMesh:
     name = str(path)
     if suffix in SURFACE_SUFFIXES:
         mesh = _read_with_meshio(path)
-        triangles = _surface_triangles(mesh, path)
-        vertices, triangles = _merge_coincident_vertices(np.asarray(mesh.points, dtype=np.float64), triangles)
+        points = _mesh_points(mesh, path)
+        triangles = _surface_triangles(mesh, path, len(points))
+        _check_finite_points(points, np.unique(triangles), path, suffix == ".obj")
+        vertices, triangles = _merge_coincident_vertices(points, triangles)
         check_closed_surface(vertices, triangles, name=name)
         return tetrahedralize_surface(vertices, triangles, mesh_size=mesh_size, name=name)
     if suffix in VOLUME_SUFFIXES:
@@ -105,17 +244,9 @@ def read_mesh(path: str | Path, *, mesh_size: float | None = None) -> TetMesh:
                 f"to surface files (.stl, .obj, .ply, .off), leave it out"
             )
         mesh = _read_with_meshio(path)
-        blocks = [np.asarray(block.data, dtype=np.int64)[:, :4] for block in mesh.cells if block.type in ("tetra", "tetra10")]
-        if not blocks:
-            kinds = sorted({block.type for block in mesh.cells}) or ["none"]
-            raise MeshError(
-                f"mesh file '{path}' has no tetrahedra (cell types: {', '.join(kinds)}); riprap "
-                f"needs a tetrahedral volume mesh, or give the closed surface as .stl"
-            )
-        tets = np.concatenate(blocks)
-        points = np.asarray(mesh.points, dtype=np.float64)
-        if points.ndim == 2 and points.shape[1] == 2:
-            raise MeshError(f"mesh file '{path}' is two-dimensional; riprap needs 3D coordinates")
+        points = _mesh_points(mesh, path)
+        tets = _volume_tets(mesh, path, len(points))
+        _check_finite_points(points, np.unique(tets), path, False)
         body = TetMesh.from_arrays(points, tets, name=name, fix_orientation=False)
         body.check()
         return body
