@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from riprap.errors import RiprapError
 from riprap.geometry import shapes as builtin_shapes
 from riprap.geometry.tetmesh import TetMesh
 from riprap.simulation import Simulation
@@ -77,7 +78,12 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
     for m in case.materials:
         sim.add_material(build_material(m))
     for spec in case.shapes:
-        sim.add_shape(spec.name, build_shape(spec))
+        try:
+            mesh = build_shape(spec)
+        except RiprapError as error:
+            # The shape builders name the key and value; the case file names the entry.
+            raise type(error)(f"{case.source}: [[shapes]] '{spec.name}': {error}") from None
+        sim.add_shape(spec.name, mesh)
     for body in case.bodies:
         sim.add_body(shape=body.shape, material=body.material, position=body.position,
                      orientation=body.orientation, velocity=body.velocity,
