@@ -98,6 +98,8 @@ BROKEN_CASES = {
                                   "place", "beyond the crest"),
     "two_unit_sizes": (_edit(PLACEMENT, "height = 0.5", "height = 0.5\nmass = 300.0"),
                        "place", "exactly one"),
+    "grid_unit_outside_the_flume": (_edit(PLACEMENT, "rows = 3\nunits_per_row = 3",
+                                          'grid_file = "grid_outside.csv"'), "place", "side walls"),
     "user_orientations_without_grid": (_edit(PLACEMENT, "units_per_row = 3",
                                              'units_per_row = 3\norientation = "user"'),
                                        "place", "grid_file"),
@@ -107,6 +109,7 @@ BROKEN_CASES = {
 def _write_case(tmp_path, name):
     text, command, phrase = BROKEN_CASES[name]
     (tmp_path / "grid.csv").write_text("x,y,z\n1.0,1.0,1.0\n")
+    (tmp_path / "grid_outside.csv").write_text("x,y,z\n1.0,1.0,1.0\n1.5,-2.0,1.5\n")
     path = tmp_path / f"{name}.toml"
     path.write_text(text)
     return path, command, phrase
@@ -149,13 +152,14 @@ def _unwritable_folders(tmp_path):
 
 
 @pytest.mark.parametrize("where", ["under_a_file", "is_a_file", "name_too_long"])
-@pytest.mark.parametrize("command", ["run", "analyse"])
+@pytest.mark.parametrize("command", ["run", "analyse", "demo"])
 def test_an_unwritable_output_folder_is_one_line_and_exit_2(command, where, tmp_path, capsys):
     out = _unwritable_folders(tmp_path)[where]
     case = tmp_path / "case.toml"
     case.write_text(RIGID)
-    target = str(case) if command == "run" else str(tmp_path)
-    assert main([command, target, "--out", str(out), "--quiet"][: 4 if command == "analyse" else 5]) == 2
+    arguments = {"run": ["run", str(case), "--quiet"], "analyse": ["analyse", str(tmp_path)],
+                 "demo": ["demo", "--quiet"]}[command]
+    assert main(arguments + ["--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("riprap: error:") and len(err.splitlines()) == 1 and "Traceback" not in err
     assert "output folder" in err or "riprap" in err

@@ -60,7 +60,7 @@ def test_units_stay_where_the_pack_put_them(pack_run):
     assert moved.max() < DISPLACEMENT_OVER_DN * layer["nominal_diameter_m"]
     assert np.linalg.norm(arrays["velocities"][units], axis=1).max() < REST_SPEED
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["simulated_time"] == pytest.approx(RUN_TIME)
+    assert abs(summary["simulated_time"] - RUN_TIME) <= summary["time_step"]
 
 
 @pytest.mark.parametrize("frame", [0, -1])

@@ -89,4 +89,4 @@ def test_units_overlapping_at_the_start_are_named_with_their_grid_line():
     with pytest.raises(OverlapError, match=r"unit 1 \(grid line 8\) overlaps unit 0"):
         place_units(slope, _cube_unit(), _no_underlayer(), positions=positions, orientations=q,
                     materials=_materials(), grid_lines=np.array([7, 8, 9]), end_time=0.1,
-                    progress=False, paraview=False, picture=False)
+                    release="free_fall", progress=False, paraview=False, picture=False)

@@ -101,9 +101,21 @@ def prepare_placement(case) -> PlacementInputs:
 
         grid = read_grid_file(case.base_dir / pl.grid_file)
     unit = _armour_unit(case)
+    if grid is not None:
+        from riprap.placement.place import check_start_positions
+
+        check_start_positions(slope, unit, grid.positions, _unit_orientations(case, slope, grid),
+                              grid_lines=grid.lines, release=pl.release)
     rocks = rock_library(RockGrading(dn50=ul.dn50, dn85_over_dn15=ul.dn85_over_dn15),
                          n_shapes=ul.rock_shapes, n_size_classes=ul.size_classes, seed=ul.seed)
     return PlacementInputs(slope=slope, materials=materials, unit=unit, rocks=rocks, grid=grid)
+
+
+def _unit_orientations(case, slope, grid):
+    """The orientations of the units of a grid file, as the placement will use them."""
+    pl = case.placement
+    return unit_orientations(len(grid.positions), mode=pl.orientation, slope=slope, seed=pl.seed,
+                             max_tilt_deg=pl.max_tilt_deg, user=grid.orientations)
 
 
 def run_placement(case, *, output_directory=None, progress: bool = True) -> dict:

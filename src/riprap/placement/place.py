@@ -466,6 +466,16 @@ def _shift_inside_walls(slope, unit_shape, positions, orientations) -> None:
             positions[k, 1] -= y.max() - (slope.width - gap)
 
 
+def check_start_positions(slope, unit, positions, orientations, *, grid_lines=None,
+                          release: str = default_of("placement", "release")) -> None:
+    """Refuse units of a user's grid that start outside the flume (naming unit and grid line),
+    before any rock is dropped; ``place_units`` makes the same check."""
+    unit_shape = RigidShape.from_mesh(unit.mesh, name=UNIT_SHAPE_NAME)
+    _check_inside(slope, unit_shape, np.asarray(positions, dtype=float),
+                  np.asarray(orientations, dtype=float), grid_lines,
+                  above_face=release == "free_fall")
+
+
 def _check_inside(slope, unit_shape, positions, orientations, grid_lines, above_face=True) -> None:
     """Every unit must start inside the flume (between the side walls, above the face)."""
     problems = []
