@@ -248,14 +248,28 @@ class FluidSolver:
 
     def step(self, dt: float | None = None) -> StepReport:
         """Advance by ``dt`` (default: the stable step)."""
+        dt, courant = self.begin_step(dt)
+        u, v, w, densities = self.predict(dt)
+        betas = self._face_coefficients(densities)
+        pressure, report = self.project(u, v, w, betas, dt)
+        return self.finish_step(u, v, w, pressure, report, dt, courant)
+
+    def begin_step(self, dt: float | None = None) -> tuple[float, float]:
+        """The step's ``dt`` (default: the stable step) and Courant number; refuses above 0.5."""
         if self.initial_water_volume is None:
             self.initial_water_volume = self.water_volume()
         dt = self.stable_time_step() if dt is None else float(dt)
-        h = self.h
-        courant = self.max_speed() * dt / h
+        courant = self.max_speed() * dt / self.h
         if courant > 0.5 + 1e-12:
             raise InstabilityError(f"fluid: Courant number {courant:.3f} > 0.5 at t = {self.time:.6g} s "
                                    f"(dt = {dt:.3e} s, largest speed {self.max_speed():.3g} m/s)")
+        return dt, courant
+
+    def predict(self, dt: float):
+        """The step up to the pressure: water moved (PLIC), momentum moved with the mass fluxes,
+        viscosity, gravity, surface tension, obstacle faces zeroed. Returns (u*, v*, w*, the
+        transported face densities per axis); ``fraction`` is already at the new time."""
+        h = self.h
         density_start = self.cell_density()
         viscosity_start = self.cell_viscosity()
         water_fluxes = self._advect_water(dt)
@@ -286,15 +300,23 @@ class FluidSolver:
         if self.surface_tension > 0:
             self._add_surface_tension(u, v, w, densities, dt)
         self._zero_solid_faces(u, v, w)
-        betas = self._face_coefficients(densities)
+        return u, v, w, densities
+
+    def project(self, u, v, w, betas, dt: float):
+        """Make (u, v, w) divergence free in place with face coefficients ``betas`` (1/rho);
+        returns (pressure, the pressure solver's report)."""
         rhs = np.empty_like(self.pressure)
-        momentum.divergence(u, v, w, h, rhs)
+        momentum.divergence(u, v, w, self.h, rhs)
         rhs /= dt
         started = time.perf_counter()
         pressure, report = self.pressure_solver.solve(betas[0], betas[1], betas[2], rhs,
                                                       p_initial=self.pressure)
         self.last_pressure_seconds = time.perf_counter() - started
         self._correct(u, v, w, pressure, betas, dt)
+        return pressure, report
+
+    def finish_step(self, u, v, w, pressure, report, dt: float, courant: float) -> StepReport:
+        """Store the new state, advance the clock, report and check that it is finite."""
         self.u, self.v, self.w, self.pressure = u, v, w, pressure
         self.time += dt
         self.step_count += 1

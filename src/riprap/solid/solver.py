@@ -185,6 +185,9 @@ class SolidSolver:
         self.wall_materials = np.array([self.material_index(w.material) for w in self.walls], dtype=np.int64)
         self.history_keys = np.zeros(0, dtype=np.int64)
         self.history_springs = np.zeros((0, interactions.HISTORY_WIDTH))
+        # Force (3) and torque (3) held on each free body besides gravity and contacts (N, N m):
+        # the fluid's, in a coupled run.
+        self.external_loads = np.zeros((n, 6))
         if self.initial_contact_history is not None:
             self._load_initial_history(*self.initial_contact_history)
         self._margin = _BROAD_PHASE_MARGIN * float(self.bounding_radius.max())
@@ -257,7 +260,7 @@ class SolidSolver:
         return (self.masses, self.inverse_masses, self.inverse_principal_inertia, self.fixed,
                 self.shape_index, self.material_index_of_body, self.gravity, self.wall_points,
                 self.wall_normals, self.wall_materials, self.bounding_radius, self._pair_penalty,
-                self._pair_friction, self._pair_damping, self._pair_tangential)
+                self._pair_friction, self._pair_damping, self._pair_tangential, self.external_loads)
 
     def _compute_forces(self, step: float) -> None:
         (self.history_keys, self.history_springs, results, body_pairs, wall_pairs, self._omegas,

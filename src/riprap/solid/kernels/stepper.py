@@ -15,8 +15,10 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
                    inverse_masses, inverse_principal_inertia, fixed, shape_index, material_index,
                    gravity, wall_points, wall_normals, wall_materials, bounding_radius,
                    pair_penalty, pair_friction, pair_damping_ratio, pair_tangential_ratio,
-                   history_keys, history_springs, margin, step, piece_cache, skin, shape_arrays):
-    """Forces and torques of every body at the current positions (gravity + contacts).
+                   external_loads, history_keys, history_springs, margin, step, piece_cache, skin,
+                   shape_arrays):
+    """Forces and torques of every body at the current positions (gravity + contacts + the
+    external loads (n, 6): force and torque held on each free body, e.g. a fluid's).
 
     Returns (history_keys, history_springs, results, body_pairs, wall_pairs, omegas, overflow,
     piece_cache).
@@ -43,8 +45,8 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
     overflow = False
     for b in range(n):
         for c in range(3):
-            forces[b, c] = 0.0 if fixed[b] else masses[b] * gravity[c]
-            torques[b, c] = 0.0
+            forces[b, c] = 0.0 if fixed[b] else masses[b] * gravity[c] + external_loads[b, c]
+            torques[b, c] = 0.0 if fixed[b] else external_loads[b, 3 + c]
     interactions.accumulate(body_pairs, wall_pairs, results, forces, torques)
     n_body_pairs = body_pairs.shape[0]
     n_active = 0
@@ -75,7 +77,7 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
 def advance(n_steps, positions, quaternions, velocities, angular_momenta, forces, torques, omegas,
             masses, inverse_masses, inverse_principal_inertia, fixed, shape_index, material_index,
             gravity, wall_points, wall_normals, wall_materials, bounding_radius, pair_penalty,
-            pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys,
+            pair_friction, pair_damping_ratio, pair_tangential_ratio, external_loads, history_keys,
             history_springs, margin, step, local_damping, piece_cache, skin, shape_arrays):
     """Advance ``n_steps`` velocity-Verlet steps. Returns (steps done, status, history_keys,
     history_springs, results, body_pairs, wall_pairs, omegas, piece_cache) of the last force
@@ -93,7 +95,7 @@ def advance(n_steps, positions, quaternions, velocities, angular_momenta, forces
             positions, quaternions, velocities, angular_momenta, forces, torques, masses,
             inverse_masses, inverse_principal_inertia, fixed, shape_index, material_index,
             gravity, wall_points, wall_normals, wall_materials, bounding_radius, pair_penalty,
-            pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys,
+            pair_friction, pair_damping_ratio, pair_tangential_ratio, external_loads, history_keys,
             history_springs, margin, step, piece_cache, skin, shape_arrays)
         integrate.kick(velocities, angular_momenta, omegas, forces, torques, inverse_masses,
                        0.5 * step, local_damping)

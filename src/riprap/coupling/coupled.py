@@ -1,0 +1,230 @@
+"""Two-way coupling of rigid bodies and the air-water flow: one step of both.
+
+Method (``docs/coupling.md``): the rigidity-constraint projection of Sharma & Patankar (2005) on
+riprap's staggered grid, with exact solid fractions. The whole box is one fluid whose density on a
+face is the mixture of the fluid's and the bodies' (by the exact solid fraction of the face's
+control volume); the pressure projection moves body and fluid inertia together, so no added-mass
+instability appears at any density ratio; after it, each body's region is made rigid with the
+motion that conserves the momentum and angular momentum of body and fluid together. The force of
+the fluid on a body is the momentum this gives it, so the two sides' forces are equal and opposite
+by construction. Within a fluid step the bodies take several contact sub-steps with the fluid's
+force of the previous step held.
+
+One step of :meth:`CoupledSolver.step`:
+
+1. the solid volume of every body in every cell, at the present poses;
+2. the fluid predictor (water, momentum, viscosity, gravity, surface tension);
+3. each body's faces take the motion the body would have after falling freely for the step
+   (blend by solid fraction); the mixture density goes into the pressure projection;
+4. each free body's rigid motion from its 6 x 6 momentum system; the fluid's load on every body
+   (its own momentum change, or what holding a fixed body still takes); the final blend;
+5. the bodies move over the step in contact sub-steps with gravity, contacts and that load held:
+   without contacts they end with exactly the motion of step 4. The fluid meets what contacts
+   changed at the next step's blend, whose momentum bookkeeping keeps the sum exact.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from riprap.coupling.kernels import rigid_coupling
+from riprap.coupling.solid_volumes import rigid_body_cell_volumes
+from riprap.errors import CaseFileError
+from riprap.fluid.solver import FluidSolver
+from riprap.solid.kernels import integrate
+from riprap.solid.solver import SolidSolver
+
+__all__ = ["CoupledSolver", "CoupledStepReport", "fluid_box_walls"]
+
+
+def fluid_box_walls(grid, material: str) -> list:
+    """The sides of the fluid box as walls for the bodies (an open top is not a wall)."""
+    from riprap.solid.walls import Wall
+
+    walls = []
+    for axis in range(3):
+        for side, (point, sign) in enumerate(((grid.lower, 1.0), (grid.upper, -1.0))):
+            if axis == 2 and side == 1 and grid.open_top:
+                continue
+            normal = [0.0, 0.0, 0.0]
+            normal[axis] = sign
+            walls.append(Wall(point=tuple(point), normal=tuple(normal), material=material))
+    return walls
+
+
+@dataclass
+class CoupledStepReport:
+    """What one coupled step did (the fluid's report plus the solids')."""
+
+    time: float
+    time_step: float
+    courant_number: float
+    pressure_iterations: int
+    water_volume_error: float
+    solid_substeps: int
+    max_body_speed: float
+
+
+class CoupledSolver:
+    """A :class:`FluidSolver` and a :class:`SolidSolver` that push each other.
+
+    Parameters
+    ----------
+    fluid : FluidSolver
+    solids : SolidSolver
+        With its shapes, materials, bodies and walls; its gravity should equal the fluid's.
+    solid_time_step : float, optional
+        Contact sub-step (s); default the solids' automatic step.
+    wall_material : str, optional
+        Material of the fluid box's sides as walls for the bodies (every side but an open top);
+        default the first material. None: add no walls (the caller's walls bound the bodies).
+    """
+
+    def __init__(self, fluid: FluidSolver, solids: SolidSolver, *, solid_time_step: float | None = None,
+                 wall_material: str | None = ""):
+        if not np.allclose(fluid.gravity, solids.gravity):
+            raise CaseFileError(f"coupling: the fluid's gravity {fluid.gravity.tolist()} differs from "
+                                f"the bodies' {solids.gravity.tolist()}")
+        self.fluid = fluid
+        self.solids = solids
+        if wall_material is not None:
+            solids.add_walls(fluid_box_walls(fluid.grid, wall_material or solids.materials[0].name))
+        solids.finalize()
+        self.solid_time_step = float(solid_time_step or solids.time_step)
+        n = solids.n_bodies
+        #: Force (3) and torque (3) of the fluid on every body over the last step (N, N m).
+        self.fluid_loads = np.zeros((n, 6))
+        grid = fluid.grid
+        self._lower = np.asarray(grid.lower, dtype=np.float64)
+        self._cells = np.asarray(grid.cells, dtype=np.int64)
+        self._densities = np.array([solids.materials[m].density
+                                    for m in solids.material_index_of_body], dtype=np.float64)
+
+    # ------------------------------------------------------------------ helpers
+    def _world_inertia(self):
+        s = self.solids
+        rotations = s.rotation_matrices()
+        return np.einsum("bij,bj,bkj->bik", rotations, s.principal_inertia, rotations)
+
+    def _motions(self, velocities, angular_momenta, inertia):
+        omegas = np.linalg.solve(inertia, angular_momenta[..., None])[..., 0]
+        motions = np.concatenate([velocities, omegas], axis=1)
+        motions[self.solids.fixed] = 0.0
+        return motions
+
+    # ------------------------------------------------------------------ the step
+    def step(self, dt: float | None = None) -> CoupledStepReport:
+        fluid, solids = self.fluid, self.solids
+        dt, courant = fluid.begin_step(dt)
+        free = ~solids.fixed
+        inertia = self._world_inertia()
+        # Every body is blended in with the motion it would have after falling freely for dt
+        # (a fixed one as if it were a body of the fluid's own density, which water at rest
+        # balances exactly); the projection then adds what the fluid does to it.
+        # The contact forces of the last sub-step count too, so that a body resting on a wall or
+        # on other bodies is not blended in falling into them (the fluid, which cannot drain from
+        # a gap thinner than a cell, would then carry it instead of the contact).
+        dry = np.where(free[:, None], np.concatenate([solids.forces, solids.torques], axis=1)
+                       - solids.external_loads, 0.0)
+        predicted = self._motions(solids.velocities + dry[:, :3] * (dt / solids.masses[:, None]),
+                                  solids.angular_momenta + dry[:, 3:] * dt, inertia)
+        predicted[~free, :3] = fluid.gravity * dt
+
+        volumes = rigid_body_cell_volumes(fluid.grid, solids)
+        cell_volume = fluid.h ** 3
+        faces = [np.zeros_like(q) for q in (fluid.u, fluid.v, fluid.w)]
+        arguments = (volumes.origin, volumes.shape, volumes.offset, volumes.values, cell_volume,
+                     self._cells)
+        rigid_coupling.face_fractions(*arguments, *faces)
+        capped = [np.minimum(phi, 1.0) for phi in faces]
+
+        u, v, w, fluid_densities = fluid.predict(dt)
+        velocities = (u, v, w)
+        fluid_part = [velocity.copy() for velocity in velocities]
+        densities = np.where(free, self._densities, rigid_coupling.FOLLOWS_FLUID)
+        solid_density = [np.zeros_like(q) for q in velocities]
+        rigid_coupling.accumulate_density(*arguments, densities, *faces, *fluid_densities,
+                                          *solid_density)
+        blended_rigid = [np.zeros_like(q) for q in velocities]
+        rigid_momentum = [np.zeros_like(q) for q in velocities]
+        centres = solids.positions
+        ones = np.ones(solids.n_bodies)
+        rigid_coupling.accumulate_rigid(*arguments, self._lower, fluid.h, centres, predicted, ones,
+                                        *faces, *fluid_densities, *blended_rigid)
+        rigid_coupling.accumulate_rigid(*arguments, self._lower, fluid.h, centres, predicted,
+                                        densities, *faces, *fluid_densities, *rigid_momentum)
+        mixture, unaccounted = [], []
+        for a in range(3):
+            velocities[a][...] = (1.0 - capped[a]) * fluid_part[a] + blended_rigid[a]
+            density = (1.0 - capped[a]) * fluid_densities[a] + solid_density[a]
+            mixture.append(density)
+            unaccounted.append(density * velocities[a] - (1.0 - capped[a]) * fluid_densities[a]
+                               * fluid_part[a] - rigid_momentum[a])
+        betas = fluid._face_coefficients(mixture)
+        blended = [velocity.copy() for velocity in velocities]
+        pressure, report = fluid.project(u, v, w, betas, dt)
+
+        n = solids.n_bodies
+        matrices = np.zeros((n, 6, 6))
+        body_matrices = np.zeros((n, 6, 6))
+        rhs = np.zeros((n, 6))
+        rigid_coupling.momentum_systems(*arguments, self._lower, fluid.h, centres, densities,
+                                        *faces, *fluid_densities, u, v, w, *unaccounted, matrices,
+                                        body_matrices, rhs)
+        final = np.zeros((n, 6))
+        for b in np.flatnonzero(free):
+            final[b] = np.linalg.solve(matrices[b], rhs[b])
+        # The fluid's load: the body's own momentum change; for a fixed body what holding it
+        # still takes (the momentum the fluid gave its faces, less the fall it was blended in with).
+        loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted)
+                 - np.einsum("bij,bj->bi", matrices - body_matrices, final)) / dt
+        rigid = [np.zeros_like(q) for q in velocities]
+        rigid_coupling.accumulate_rigid(*arguments, self._lower, fluid.h, centres, final, ones,
+                                        *faces, *fluid_densities, *rigid)
+        projected = [velocity.copy() for velocity in velocities]
+        for a in range(3):
+            velocities[a][...] = (1.0 - capped[a]) * velocities[a] + rigid[a]
+        self.last_exchange_balance = self._exchange_balance(
+            capped, fluid_densities, fluid_part, velocities, mixture, blended, projected,
+            body_matrices, predicted, final, free)
+        fluid_report = fluid.finish_step(u, v, w, pressure, report, dt, courant)
+
+        # The bodies then move over the step in contact sub-steps with the fluid's load held:
+        # without contacts they end with exactly the motion the projection gave them.
+        self.fluid_loads = np.where(free[:, None], loads, 0.0)
+        self.fixed_body_loads = np.where(free[:, None], 0.0, loads)
+        substeps = self._advance_solids(dt)
+        speeds = np.linalg.norm(solids.velocities[free], axis=1)
+        return CoupledStepReport(time=fluid.time, time_step=dt, courant_number=courant,
+                                 pressure_iterations=fluid_report.pressure_iterations,
+                                 water_volume_error=fluid_report.water_volume_error,
+                                 solid_substeps=substeps,
+                                 max_body_speed=float(speeds.max(initial=0.0)))
+
+    def _exchange_balance(self, capped, fluid_densities, before, after, mixture, blended,
+                          projected, body_matrices, predicted, final, free) -> np.ndarray:
+        """Momentum of fluid and free bodies after the exchange, less before, less the pressure's
+        impulse (which only the walls do not return): zero to round-off (N s, per axis)."""
+        volume = self.fluid.h ** 3
+        interior = (np.s_[1:-1], np.s_[:, 1:-1], np.s_[:, :, 1:-1])
+        balance = np.zeros(3)
+        for a in range(3):
+            fluid_share = ((1.0 - capped[a]) * fluid_densities[a])[interior[a]]
+            balance[a] = volume * (np.sum(fluid_share * (after[a] - before[a])[interior[a]])
+                                   - np.sum((mixture[a] * (projected[a] - blended[a]))[interior[a]]))
+        bodies = np.einsum("bij,bj->bi", body_matrices[free], final[free] - predicted[free])
+        return balance + bodies[:, :3].sum(axis=0)
+
+    def _advance_solids(self, dt: float) -> int:
+        solids = self.solids
+        substeps = max(1, math.ceil(dt / self.solid_time_step - 1e-9))
+        solids.set_time_step(dt / substeps)
+        # The last sub-step's forces (used by the first half kick) take the new loads too.
+        change = self.fluid_loads - solids.external_loads
+        solids.forces += change[:, :3]
+        solids.torques += change[:, 3:]
+        solids.external_loads[:] = self.fluid_loads
+        solids.advance(substeps)
+        return substeps
