@@ -140,6 +140,8 @@ class CoupledSolver:
         rigid_coupling.face_fractions(*arguments, *faces)
         capped = [np.minimum(phi, 1.0) for phi in faces]
 
+        start_density = fluid.cell_density()
+        start_velocities = (fluid.u, fluid.v, fluid.w)
         u, v, w, fluid_densities = fluid.predict(dt)
         velocities = (u, v, w)
         fluid_part = [velocity.copy() for velocity in velocities]
@@ -147,9 +149,29 @@ class CoupledSolver:
         solid_density = [np.zeros_like(q) for q in velocities]
         rigid_coupling.accumulate_density(*arguments, densities, *faces, *fluid_densities,
                                           *solid_density)
+        centres = solids.positions
+        # What the predictor's fluxes (advection, viscous stress, surface tension) moved across
+        # each body's surface is the body's: its faces' momentum change there, less gravity.
+        impulses = []
+        for a in range(3):
+            old = np.zeros_like(start_velocities[a])
+            index = [slice(None)] * 3
+            index[a] = slice(1, -1)
+            low, high = [slice(None)] * 3, [slice(None)] * 3
+            low[a], high[a] = slice(0, -1), slice(1, None)
+            old[tuple(index)] = 0.5 * (start_density[tuple(low)] + start_density[tuple(high)])
+            impulses.append(fluid_densities[a] * (velocities[a] - fluid.gravity[a] * dt)
+                            - old * start_velocities[a])
+        transferred = np.zeros((solids.n_bodies, 6))
+        rigid_coupling.body_impulses(*arguments, self._lower, fluid.h, centres, *faces, *impulses,
+                                     transferred)
+        body_mass = self._body_mass_matrices(arguments, centres, densities, faces, fluid_densities)
+        predicted_dry = predicted.copy()
+        for b in range(solids.n_bodies):
+            if np.any(transferred[b]):
+                predicted[b] += np.linalg.lstsq(body_mass[b], transferred[b], rcond=None)[0]
         blended_rigid = [np.zeros_like(q) for q in velocities]
         rigid_momentum = [np.zeros_like(q) for q in velocities]
-        centres = solids.positions
         ones = np.ones(solids.n_bodies)
         rigid_coupling.accumulate_rigid(*arguments, self._lower, fluid.h, centres, predicted, ones,
                                         *faces, *fluid_densities, *blended_rigid)
@@ -178,7 +200,7 @@ class CoupledSolver:
             final[b] = np.linalg.solve(matrices[b], rhs[b])
         # The fluid's load: the body's own momentum change; for a fixed body what holding it
         # still takes (the momentum the fluid gave its faces, less the fall it was blended in with).
-        loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted)
+        loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted_dry)
                  - np.einsum("bij,bj->bi", matrices - body_matrices, final)) / dt
         rigid = [np.zeros_like(q) for q in velocities]
         rigid_coupling.accumulate_rigid(*arguments, self._lower, fluid.h, centres, final, ones,
@@ -202,6 +224,16 @@ class CoupledSolver:
                                  water_volume_error=fluid_report.water_volume_error,
                                  solid_substeps=substeps,
                                  max_body_speed=float(speeds.max(initial=0.0)))
+
+    def _body_mass_matrices(self, arguments, centres, densities, faces, fluid_densities):
+        """Each body's own grid mass matrix sum phi_b' rho_b J^T J h^3 (n, 6, 6)."""
+        n = self.solids.n_bodies
+        zeros = [np.zeros_like(phi) for phi in faces]
+        matrices, body, rhs = np.zeros((n, 6, 6)), np.zeros((n, 6, 6)), np.zeros((n, 6))
+        rigid_coupling.momentum_systems(*arguments, self._lower, self.fluid.h, centres, densities,
+                                        *faces, *fluid_densities, *zeros, *zeros, matrices, body,
+                                        rhs)
+        return body
 
     def _exchange_balance(self, capped, fluid_densities, before, after, mixture, blended,
                           projected, body_matrices, predicted, final, free) -> np.ndarray:

@@ -1,0 +1,1 @@
+"""Benchmark cases with published reference data, shared by bench/, tests/verification/ and examples/."""
