@@ -162,10 +162,8 @@ class CoupledSolver:
             old[tuple(index)] = 0.5 * (start_density[tuple(low)] + start_density[tuple(high)])
             impulses.append(fluid_densities[a] * (velocities[a] - fluid.gravity[a] * dt)
                             - old * start_velocities[a])
-        transferred = np.zeros((solids.n_bodies, 6))
-        rigid_coupling.body_impulses(*arguments, self._lower, fluid.h, centres, *faces, *impulses,
-                                     transferred)
-        body_mass = self._body_mass_matrices(arguments, centres, densities, faces, fluid_densities)
+        body_mass, transferred = self._transferred(arguments, centres, densities, faces, capped,
+                                                   fluid_densities, impulses)
         predicted_dry = predicted.copy()
         for b in range(solids.n_bodies):
             if np.any(transferred[b]):
@@ -225,15 +223,19 @@ class CoupledSolver:
                                  solid_substeps=substeps,
                                  max_body_speed=float(speeds.max(initial=0.0)))
 
-    def _body_mass_matrices(self, arguments, centres, densities, faces, fluid_densities):
-        """Each body's own grid mass matrix sum phi_b' rho_b J^T J h^3 (n, 6, 6)."""
+    def _transferred(self, arguments, centres, densities, faces, capped, fluid_densities,
+                     impulses):
+        """Each body's own grid mass matrix sum phi_b' rho_b J^T J h^3 (n, 6, 6), and the momentum
+        and angular momentum sum phi_b' J^T i_f h^3 that the face momenta ``impulses`` (per unit
+        volume) give it (n, 6): the momentum system with no velocity and C = -i phi."""
         n = self.solids.n_bodies
         zeros = [np.zeros_like(phi) for phi in faces]
+        sources = [-impulse * np.maximum(cap, 1e-300) for impulse, cap in zip(impulses, capped)]
         matrices, body, rhs = np.zeros((n, 6, 6)), np.zeros((n, 6, 6)), np.zeros((n, 6))
         rigid_coupling.momentum_systems(*arguments, self._lower, self.fluid.h, centres, densities,
-                                        *faces, *fluid_densities, *zeros, *zeros, matrices, body,
+                                        *faces, *fluid_densities, *zeros, *sources, matrices, body,
                                         rhs)
-        return body
+        return body, rhs
 
     def _exchange_balance(self, capped, fluid_densities, before, after, mixture, blended,
                           projected, body_matrices, predicted, final, free) -> np.ndarray:

@@ -224,24 +224,3 @@ def momentum_systems(origin, shape, offset, values, cell_volume, cells, lower, h
                     matrices[b, m, n] += weight * jac[m] * jac[n]
                     body_matrices[b, m, n] += own_weight * jac[m] * jac[n]
 
-
-@kernel
-def body_impulses(origin, shape, offset, values, cell_volume, cells, lower, h, centres, phi_x,
-                  phi_y, phi_z, impulse_x, impulse_y, impulse_z, out):
-    """out[b] = sum over body b's faces of phi_b' J^T i_f h^3: the momentum and angular momentum
-    (about the centre) that the face momenta ``impulse`` (per unit volume) give the body."""
-    position = np.empty(3)
-    rho = np.empty(3)
-    jac = np.empty(6)
-    volume = h * h * h
-    for b in range(origin.shape[0]):
-        for m in range(6):
-            out[b, m] = 0.0
-        axes, indices, halves = _body_faces(origin, shape, offset, values, cell_volume, cells, b)
-        for f in range(axes.shape[0]):
-            axis, i, j, k = axes[f], indices[f, 0], indices[f, 1], indices[f, 2]
-            share = halves[f] / max(1.0, _pick(axis, i, j, k, phi_x, phi_y, phi_z))
-            value = share * volume * _pick(axis, i, j, k, impulse_x, impulse_y, impulse_z)
-            _face_jacobian(axis, i, j, k, lower, h, centres[b], position, rho, jac)
-            for m in range(6):
-                out[b, m] += jac[m] * value
