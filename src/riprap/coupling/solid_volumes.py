@@ -18,7 +18,7 @@ from riprap.coupling.kernels import tet_cell_volumes
 from riprap.errors import CaseFileError
 from riprap.fluid.grid import FluidGrid
 
-__all__ = ["BodyCellVolumes", "body_cell_volumes", "rigid_body_cell_volumes"]
+__all__ = ["BodyCellVolumes", "body_cell_volumes", "rigid_body_cell_volumes", "merge_blocks"]
 
 
 @dataclass(frozen=True)
@@ -94,20 +94,37 @@ def body_cell_volumes(grid: FluidGrid, nodes, tets, tet_start) -> BodyCellVolume
     return BodyCellVolumes(grid=grid, origin=origin, shape=shape, offset=offset, values=values)
 
 
-def rigid_body_cell_volumes(grid: FluidGrid, solver) -> BodyCellVolumes:
-    """:func:`body_cell_volumes` of every body of a :class:`riprap.solid.solver.SolidSolver` at
-    its present position and orientation."""
+def rigid_body_cell_volumes(grid: FluidGrid, solver, bodies=None) -> BodyCellVolumes:
+    """:func:`body_cell_volumes` of the bodies of a :class:`riprap.solid.solver.SolidSolver` at
+    their present position and orientation: all of them, or those listed in ``bodies`` (the
+    result's blocks are then in that order)."""
     if not solver._ready:
         solver.finalize()
     table = solver.table
     rotations = solver.rotation_matrices()
     node_parts, tet_parts, tet_start = [], [], [0]
     node_count = 0
-    for body, s in enumerate(solver.shape_index):
+    chosen = range(solver.n_bodies) if bodies is None else [int(b) for b in bodies]
+    for body in chosen:
+        s = solver.shape_index[body]
         local = table.nodes[table.node_offset[s]:table.node_offset[s + 1]]
         node_parts.append(local @ rotations[body].T + solver.positions[body])
         tet_parts.append(table.tets[table.tet_offset[s]:table.tet_offset[s + 1]] + node_count)
         node_count += len(local)
         tet_start.append(tet_start[-1] + len(tet_parts[-1]))
+    if not node_parts:
+        empty = np.zeros((0, 3), dtype=np.int64)
+        return BodyCellVolumes(grid=grid, origin=empty, shape=empty.copy(),
+                               offset=np.zeros(1, dtype=np.int64), values=np.zeros(0))
     return body_cell_volumes(grid, np.concatenate(node_parts), np.concatenate(tet_parts),
                              np.array(tet_start))
+
+
+def merge_blocks(grid: FluidGrid, parts) -> BodyCellVolumes:
+    """One :class:`BodyCellVolumes` from per-body (origin, volumes) blocks, in order."""
+    origin = np.array([p[0] for p in parts], dtype=np.int64).reshape(-1, 3)
+    shape = np.array([p[1].shape for p in parts], dtype=np.int64).reshape(-1, 3)
+    sizes = [p[1].size for p in parts]
+    offset = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    values = (np.concatenate([p[1].reshape(-1) for p in parts]) if parts else np.zeros(0))
+    return BodyCellVolumes(grid=grid, origin=origin, shape=shape, offset=offset, values=values)
