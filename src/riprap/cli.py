@@ -53,10 +53,11 @@ def _run_fluid_case(case, path: Path, out: str | None, restart: str | None, quie
     from riprap.case.build_fluid import build_fluid_run
 
     run = build_fluid_run(case, output_directory=out, progress=not quiet)
-    grid = run.solver.grid
+    grid = run.fluid.grid
+    bodies = (f", {run.solver.solids.n_bodies} bodies coupled to the flow" if run.coupled else "")
     print(f"riprap: fluid case {path}: {grid.cells[0]} x {grid.cells[1]} x {grid.cells[2]} cells of "
           f"{grid.cell_size:.4g} m ({'2D' if grid.two_dimensional else '3D'}), water "
-          f"{run.solver.water_volume():.4g} m^3")
+          f"{run.fluid.water_volume():.4g} m^3{bodies}")
     summary = run.run(restart_from=restart)
     print(f"riprap: {summary.end_reason} at t = {summary.simulated_time:.4f} s after {summary.steps} "
           f"steps ({summary.time_step_min:.2e}..{summary.time_step_max:.2e} s) in "

@@ -447,20 +447,9 @@ class Simulation:
     def surface_arrays(self):
         """World boundary surfaces of all bodies: points (n, 3), triangles (m, 3), body of each
         triangle (m,)."""
-        s = self.solver
-        rotations = s.rotation_matrices()
-        points, triangles, owners = [], [], []
-        offset = 0
-        for b in range(s.n_bodies):
-            shape = s.shapes[s.shape_index[b]]
-            used = np.unique(shape.triangles)
-            remap = np.full(len(shape.mesh.nodes), -1, dtype=np.int64)
-            remap[used] = np.arange(len(used))
-            points.append(shape.mesh.nodes[used] @ rotations[b].T + s.positions[b])
-            triangles.append(remap[shape.triangles] + offset)
-            owners.append(np.full(len(shape.triangles), b, dtype=np.int64))
-            offset += len(used)
-        return np.concatenate(points), np.concatenate(triangles), np.concatenate(owners)
+        from riprap.solid.surfaces import surface_arrays
+
+        return surface_arrays(self.solver)
 
     def contact_forces_on_bodies(self) -> np.ndarray:
         """Total contact force on each body (N), i.e. the force without gravity."""

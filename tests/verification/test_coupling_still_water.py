@@ -82,6 +82,9 @@ def test_a_held_body_feels_archimedes_buoyancy(sphere):
     assert abs(load[2] - WATER * 9.81 * volume) < BUOYANCY_TOLERANCE * WATER * 9.81 * volume
     assert np.all(np.abs(load[:2]) < BUOYANCY_TOLERANCE * WATER * 9.81 * volume)
     assert coupled.fluid.max_speed() < 1e-6
+    # In still water the whole load is the pressure's.
+    assert abs(coupled.pressure_loads[0, 2] - load[2]) < 1e-3 * load[2]
+    assert np.all(np.abs(coupled.viscous_loads[0, :3]) < 1e-3 * load[2])
 
 
 def test_a_neutrally_buoyant_sphere_stays_put(sphere):

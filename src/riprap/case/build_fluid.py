@@ -53,13 +53,31 @@ def build_fluid_solver(case) -> FluidSolver:
 
 
 def build_fluid_run(case, *, output_directory=None, progress: bool = True) -> FluidRun:
-    """A :class:`FluidRun` of ``case`` (``[simulation]`` end time, output and checkpoint intervals)."""
+    """A :class:`FluidRun` of ``case`` (``[simulation]`` end time, output and checkpoint intervals);
+    with bodies, they move in the flow and push it (two-way coupling, ``docs/coupling.md``)."""
     settings = case.simulation
     end_time = min(settings.end_time, SMOKE_END_TIME) if smoke_mode() else settings.end_time
     source = Path(case.source)
-    return FluidRun(build_fluid_solver(case), end_time=end_time,
+    model = build_fluid_solver(case)
+    if case.body_count > 0:
+        model = _coupled(case, model)
+    return FluidRun(model, end_time=end_time,
                     output_interval=settings.output_interval,
                     checkpoint_interval=settings.checkpoint_interval,
                     output_directory=output_directory or case.output.directory,
                     paraview=case.output.paraview, picture=case.output.picture, progress=progress,
                     case_file=str(source.resolve()) if source.is_file() else "")
+
+
+def _coupled(case, fluid):
+    """The case's bodies (as ``riprap run`` builds them for a dry run) coupled to ``fluid``; the
+    fluid box's sides are walls for them, of the first material."""
+    from riprap.case.build import build_simulation
+    from riprap.coupling.coupled import CoupledSolver
+
+    simulation = build_simulation(case, progress=False)
+    solids = simulation.solver
+    simulation.build_without_checks()
+    smallest = min(shape.min_subtet_height for shape in solids.shapes)
+    solids.check_no_initial_overlap(0.01 * smallest, accepted=simulation.accepted_overlaps)
+    return CoupledSolver(fluid, solids)

@@ -49,10 +49,6 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
             add((where,), "riprap place makes its own bodies (rocks and units) and would ignore "
                 "these; remove them, or run them as a separate case")
         _check_placement(tables, add, ok)
-    elif tables.get("fluid") is not None and has_bodies:
-        where = "bodies" if tables.get("bodies") else "body_grids"
-        add((where,), "bodies in the fluid (two-way coupling) are not available yet: run the "
-            "bodies and the fluid as separate cases")
 
 
 def _check_placement(tables: Tables, add: Callable, ok: Callable) -> None:

@@ -61,15 +61,18 @@ def check_case(case: Case, *, output_directory=None) -> CheckReport:
         if inputs.grid is not None:
             report.checked.append(f"grid file ({len(inputs.grid.positions)} units)")
     elif case.is_fluid:
-        from riprap.case.build_fluid import build_fluid_solver
+        from riprap.case.build_fluid import build_fluid_run
 
-        solver = build_fluid_solver(case)
+        run = build_fluid_run(case, output_directory=out, progress=False)
         cells = "x".join(map(str, case.fluid.cells))
+        bodies = f" with {case.body_count} bodies in it" if run.coupled else ""
         report = CheckReport(
-            f"air and water on {cells} cells",
+            f"air and water on {cells} cells{bodies}",
             checked=["tables and keys", "fluid grid and memory",
-                     f"water regions ({solver.water_volume():.4g} m^3 of water)"],
+                     f"water regions ({run.fluid.water_volume():.4g} m^3 of water)"],
             not_checked=["whether the flow stays stable (the time step adapts to it)"])
+        if run.coupled:
+            report.checked.append("bodies: meshes, overlaps, inside the fluid box, cells across")
     else:
         from riprap.case.build import build_simulation
 

@@ -109,7 +109,48 @@ class CoupledSolver:
         self._blocks = None
         self._block_poses = None
         self.last_clipped_bodies = 0
+        self.fixed_body_loads = np.zeros((n, 6))
+        self.viscous_loads = np.zeros((n, 6))
+        self.pressure_loads = np.zeros((n, 6))
         self._check_bodies_in_grid()
+
+    # ------------------------------------------------------------------ the run loop's view
+    # (riprap.fluid.run.FluidRun drives a CoupledSolver as it drives a FluidSolver)
+    @property
+    def time(self) -> float:
+        return self.fluid.time
+
+    @property
+    def grid(self):
+        return self.fluid.grid
+
+    @property
+    def last_pressure_seconds(self) -> float:
+        return self.fluid.last_pressure_seconds
+
+    @property
+    def last_report(self):
+        return self.fluid.last_report
+
+    def stable_time_step(self) -> float:
+        return self.fluid.stable_time_step()
+
+    def state_arrays(self) -> dict:
+        """Fluid and bodies, and the loads held between them: a restart continues bit for bit."""
+        arrays = self.fluid.state_arrays()
+        for name, value in self.solids.state_arrays().items():
+            arrays[f"bodies_{name}"] = value
+        arrays["bodies_fluid_loads"] = self.fluid_loads.copy()
+        arrays["bodies_external_loads"] = self.solids.external_loads.copy()
+        return arrays
+
+    def load_state_arrays(self, arrays: dict) -> None:
+        self.fluid.load_state_arrays(arrays)
+        self.solids.load_state_arrays({name[len("bodies_"):]: value for name, value in arrays.items()
+                                       if name.startswith("bodies_")})
+        self.fluid_loads = np.array(arrays["bodies_fluid_loads"], dtype=np.float64)
+        self.solids.external_loads[:] = arrays["bodies_external_loads"]
+        self._blocks = self._block_poses = None
 
     # ------------------------------------------------------------------ helpers
     def _solid_volumes(self):
@@ -271,6 +312,12 @@ class CoupledSolver:
         # without contacts they end with exactly the motion the projection gave them.
         self.fluid_loads = np.where(free[:, None], loads, 0.0)
         self.fixed_body_loads = np.where(free[:, None], 0.0, loads)
+        #: The fluid's load on every body (fixed ones too) split into the pressure's (minus the
+        #: pressure gradient over the body's share of every face) and the rest: viscous stress,
+        #: with the momentum of the no-slip blend and advection (N, N m).
+        self.pressure_loads = self._pressure_loads(arguments, centres, densities, faces, capped,
+                                                   fluid_densities, pressure)
+        self.viscous_loads = loads - self.pressure_loads
         substeps = self._advance_solids(dt)
         speeds = np.linalg.norm(solids.velocities[free], axis=1)
         return CoupledStepReport(time=fluid.time, time_step=dt, courant_number=courant,
@@ -292,6 +339,20 @@ class CoupledSolver:
                                         *faces, *fluid_densities, *zeros, *sources, matrices, body,
                                         rhs)
         return body, rhs
+
+    def _pressure_loads(self, arguments, centres, densities, faces, capped, fluid_densities,
+                        pressure) -> np.ndarray:
+        """-sum phi_b' J^T grad p h^3 for every body (n, 6): buoyancy and form drag."""
+        h = self.fluid.h
+        gradients = []
+        for a in range(3):
+            gradient = np.zeros_like(faces[a])
+            index = [slice(None)] * 3
+            index[a] = slice(1, -1)
+            gradient[tuple(index)] = -np.diff(pressure, axis=a) / h
+            gradients.append(gradient)
+        return self._transferred(arguments, centres, densities, faces, capped, fluid_densities,
+                                 gradients)[1]
 
     def _exchange_balance(self, capped, fluid_densities, before, after, mixture, blended,
                           projected, body_matrices, predicted, final, free) -> np.ndarray:

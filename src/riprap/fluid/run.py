@@ -75,11 +75,20 @@ class FluidRun:
         self._frame_index = 0
         self._checkpoint_index = 0
         self._restarted = False
+        #: True when the model is a coupled one (bodies in the flow).
+        self.coupled = hasattr(solver, "solids")
 
     # ------------------------------------------------------------------ outputs
-    def _write_frame(self, series) -> None:
-        s = self.solver
+    @property
+    def fluid(self):
+        """The fluid solver (the model itself, or the fluid of a coupled model)."""
+        return getattr(self.solver, "fluid", self.solver)
+
+    def _write_frame(self, series, body_series=None) -> None:
+        s = self.fluid
         velocity = s.cell_velocity()
+        if body_series is not None:
+            self._write_bodies(body_series)
         if series is not None:
             series.add_image(s.time, origin=s.grid.lower, spacing=s.h, cells=s.grid.cells,
                              cell_data={"water_fraction": s.fraction, "pressure": s.pressure,
@@ -92,11 +101,42 @@ class FluidRun:
                              fraction=s.fraction, velocity=velocity, solid=s.solid, time=s.time)
         self._frame_index += 1
 
+    def _write_bodies(self, series) -> None:
+        """The bodies of a coupled model as a second series beside the fluid's, at the same
+        times: surfaces with velocity, the fluid's force on each body and the contact force."""
+        from riprap.solid.surfaces import surface_arrays
+
+        coupled = self.solver
+        solids = coupled.solids
+        points, triangles, owners = surface_arrays(solids)
+        fluid_force = coupled.fluid_loads[:, :3] + coupled.fixed_body_loads[:, :3]
+        gravity = np.where(solids.fixed[:, None], 0.0, solids.masses[:, None] * solids.gravity)
+        contact = solids.forces - gravity - solids.external_loads[:, :3]
+        series.add(coupled.time, points=points, cells=triangles, cell_type="triangle",
+                   cell_data={"body_id": owners, "velocity": solids.velocities[owners],
+                              "fluid_force": fluid_force[owners],
+                              "contact_force": contact[owners],
+                              "fixed": solids.fixed[owners].astype(np.int64)})
+
+    def _body_force_rows(self) -> list[str]:
+        """Rows of ``body_forces.csv`` for the present time (one per body)."""
+        coupled = self.solver
+        solids = coupled.solids
+        gravity = np.where(solids.fixed[:, None], 0.0, solids.masses[:, None] * solids.gravity)
+        contact = solids.forces - gravity - solids.external_loads[:, :3]
+        rows = []
+        for b in range(solids.n_bodies):
+            values = [coupled.time, *solids.positions[b], *solids.velocities[b],
+                      *coupled.pressure_loads[b, :3], *coupled.viscous_loads[b, :3], *contact[b]]
+            rows.append(f"{b}," + ",".join(repr(float(v)) for v in values))
+        return rows
+
     def _save(self, name: str, state: dict) -> Path:
         from riprap.io.checkpoint import save_checkpoint
 
-        metadata = {"kind": "riprap fluid run", "cells": list(self.solver.grid.cells),
-                    "cell_size": self.solver.h, "frame_index": self._frame_index,
+        metadata = {"kind": "riprap fluid run", "cells": list(self.fluid.grid.cells),
+                    "cell_size": self.fluid.h, "bodies": int(getattr(self.solver, "solids", None)
+                                                              .n_bodies if self.coupled else 0), "frame_index": self._frame_index,
                     "checkpoint_index": self._checkpoint_index, "time": float(state["clock"][0])}
         return save_checkpoint(self.output_directory / name, arrays=state, metadata=metadata)
 
@@ -106,9 +146,13 @@ class FluidRun:
         arrays, metadata = load_checkpoint(path)
         if metadata.get("kind") != "riprap fluid run":
             raise RiprapError(f"{path}: not a fluid checkpoint (kind {metadata.get('kind')!r})")
-        if list(metadata.get("cells", [])) != list(self.solver.grid.cells):
+        if list(metadata.get("cells", [])) != list(self.fluid.grid.cells):
             raise RiprapError(f"{path}: written for a grid of {metadata.get('cells')} cells, this "
-                              f"case has {list(self.solver.grid.cells)}")
+                              f"case has {list(self.fluid.grid.cells)}")
+        bodies = self.solver.solids.n_bodies if self.coupled else 0
+        if int(metadata.get("bodies", 0)) != bodies:
+            raise RiprapError(f"{path}: written for {metadata.get('bodies', 0)} bodies, this case "
+                              f"has {bodies}")
         self.solver.load_state_arrays(arrays)
         self._frame_index = int(metadata["frame_index"])
         self._checkpoint_index = int(metadata["checkpoint_index"])
@@ -126,13 +170,22 @@ class FluidRun:
         if restart_from is not None:
             self.restart(restart_from)
         series = vtk.ParaViewSeries(out, "fluid", append=self._restarted) if self.paraview else None
+        body_series = (vtk.ParaViewSeries(out, "bodies", append=self._restarted)
+                       if self.paraview and self.coupled else None)
+        forces = None
+        if self.coupled:
+            from riprap.io.body_forces import BodyForceTable
+
+            forces = BodyForceTable(out / "body_forces.csv", append=self._restarted)
         if not self._restarted:
-            self._write_frame(series)
+            self._write_frame(series, body_series)
+            if forces is not None:
+                forces.append(self._body_force_rows())
         next_frame = self._frame_index * self.output_interval
         next_checkpoint = ((self._checkpoint_index + 1) * self.checkpoint_interval
                            if self.checkpoint_interval > 0 else np.inf)
         steps = 0
-        steps_start = s.step_count
+        steps_start = self.fluid.step_count
         smallest, largest, courant_max = np.inf, 0.0, 0.0
         iterations = []
         pressure_seconds = 0.0
@@ -158,8 +211,10 @@ class FluidRun:
                 courant_max = max(courant_max, report.courant_number)
                 iterations.append(report.pressure_iterations)
                 if s.time >= next_frame - _TIME_SLACK * self.output_interval:
-                    self._write_frame(series)
+                    self._write_frame(series, body_series)
                     next_frame = self._frame_index * self.output_interval
+                    if forces is not None:
+                        forces.append(self._body_force_rows())
                 if s.time >= next_checkpoint:
                     self._checkpoint_index += 1
                     self._save("checkpoint.npz", s.state_arrays())
@@ -169,12 +224,16 @@ class FluidRun:
         outputs = {"checkpoint": str(self._save("checkpoint.npz", s.state_arrays()))}
         if series is not None:
             outputs["paraview"] = str(out / "fluid.pvd")
+        if body_series is not None:
+            outputs["bodies"] = str(out / "bodies.pvd")
+        if forces is not None:
+            outputs["body_forces"] = str(forces.path)
         if self.picture:
             outputs["pictures"] = str(out / "free_surface")
         summary = FluidRunSummary(
-            end_reason=end_reason, simulated_time=s.time, steps=s.step_count - steps_start,
-            cells=s.grid.n_cells, wall_time=wall,
-            cell_updates_per_second=steps * s.grid.n_cells / max(wall, 1e-9),
+            end_reason=end_reason, simulated_time=s.time, steps=self.fluid.step_count - steps_start,
+            cells=self.fluid.grid.n_cells, wall_time=wall,
+            cell_updates_per_second=steps * self.fluid.grid.n_cells / max(wall, 1e-9),
             time_step_min=float(smallest if steps else 0.0), time_step_max=float(largest),
             courant_number_max=float(courant_max),
             water_volume_error=float(s.last_report.water_volume_error if s.last_report else 0.0),
