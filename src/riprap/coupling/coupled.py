@@ -152,6 +152,10 @@ class CoupledSolver:
         self.solids.external_loads[:] = arrays["bodies_external_loads"]
         self._blocks = self._block_poses = None
 
+    def body_fraction(self) -> np.ndarray:
+        """Solid fraction of every cell held by the bodies, at their present poses (nx, ny, nz)."""
+        return self._solid_volumes().solid_fraction()
+
     # ------------------------------------------------------------------ helpers
     def _solid_volumes(self):
         """Every body's cell volumes; only bodies whose pose changed since they were last

@@ -98,7 +98,8 @@ class FluidRun:
 
             free_surface_png(self.output_directory / "free_surface"
                              / f"free_surface_{self._frame_index:04d}.png", grid=s.grid,
-                             fraction=s.fraction, velocity=velocity, solid=s.solid, time=s.time)
+                             fraction=s.fraction, velocity=velocity, solid=s.solid, time=s.time,
+                             bodies=self.solver.body_fraction() if self.coupled else None)
         self._frame_index += 1
 
     def _write_bodies(self, series) -> None:
@@ -270,10 +271,12 @@ class _Progress:
 
     def update(self, solver, report) -> None:
         if self.enabled:
+            bodies = (f"  bodies: {report.solid_substeps} sub-steps, fastest "
+                      f"{report.max_body_speed:.3g} m/s" if hasattr(report, "solid_substeps") else "")
             self.bar.update(self.task, completed=solver.time, dt=f"{report.time_step:.2e}",
                             cfl=f"{report.courant_number:.2f}",
                             mass=f"{report.water_volume_error:.1e}",
-                            iterations=str(report.pressure_iterations))
+                            iterations=str(report.pressure_iterations) + bodies)
 
     def __exit__(self, *exc):
         if self.enabled:

@@ -12,8 +12,9 @@ __all__ = ["free_surface_png"]
 _ARROWS_ACROSS = 24
 
 
-def free_surface_png(path, *, grid, fraction, velocity, solid, time: float) -> Path:
-    """Write the section picture; ``velocity`` (nx, ny, nz, 3) at cell centres (m/s)."""
+def free_surface_png(path, *, grid, fraction, velocity, solid, time: float, bodies=None) -> Path:
+    """Write the section picture; ``velocity`` (nx, ny, nz, 3) at cell centres (m/s); ``bodies``
+    (nx, ny, nz), optional: the solid fraction of the moving bodies, drawn cut by the section."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -30,6 +31,12 @@ def free_surface_png(path, *, grid, fraction, velocity, solid, time: float) -> P
     if solid.any():
         axes.pcolormesh(x_faces, z_faces, np.ma.masked_where(~solid[:, j, :].T, solid[:, j, :].T),
                         cmap="Greys", vmin=0, vmax=1.5, shading="flat")
+    if bodies is not None and bodies[:, j, :].max(initial=0.0) > 0.0:
+        cut = bodies[:, j, :].T
+        axes.pcolormesh(x_faces, z_faces, np.ma.masked_where(cut < 0.02, cut), cmap="copper_r",
+                        vmin=0.0, vmax=1.6, shading="flat")
+        axes.contour(grid.centres(0), grid.centres(2), cut, levels=[0.5], colors="saddlebrown",
+                     linewidths=1.0)
     xc, zc = grid.centres(0), grid.centres(2)
     if section.max() > 0.5 > section.min():
         axes.contour(xc, zc, section, levels=[0.5], colors="navy", linewidths=1.0)
@@ -42,7 +49,8 @@ def free_surface_png(path, *, grid, fraction, velocity, solid, time: float) -> P
     axes.set_xlabel("x (m)")
     axes.set_ylabel("z (m)")
     where = "" if grid.two_dimensional else f" at y = {grid.centres(1)[j]:.3g} m"
-    axes.set_title(f"water fraction{where}, t = {time:.4f} s", fontsize=10)
+    bodies_note = ", bodies cut by the section in brown" if bodies is not None else ""
+    axes.set_title(f"water fraction{where}{bodies_note}, t = {time:.4f} s", fontsize=10)
     figure.colorbar(image, ax=axes, shrink=0.8, label="water fraction")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
