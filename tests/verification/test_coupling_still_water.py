@@ -15,6 +15,10 @@ Sources and tolerances:
   carrying its buoyancy: centre within ``REST_GAP`` = 2 % of the radius of one radius above the
   floor, fluid load within ``REST_LOAD_TOLERANCE`` = 10 % of rho_w g V (measured 3-4 %: the water
   still moves after the sphere's fall).
+- Two concrete cubes stacked on the floor under water stay at rest on their contacts (as in a dry
+  run): slower than ``STACK_REST_SPEED`` = 1 mm/s, moving less than ``STACK_DRIFT`` = 0.5 mm over
+  0.3 s once settled, the fluid carrying their buoyancy together within ``REST_LOAD_TOLERANCE`` (measured: top
+  cube 1.02 rho_w g V, bottom cube, flush on the floor, 0.88).
 """
 import numpy as np
 import pytest
@@ -31,6 +35,8 @@ BUOYANCY_TOLERANCE = 0.01
 DRIFT_OVER_D = 0.01
 REST_GAP = 0.02
 REST_LOAD_TOLERANCE = 0.10
+STACK_REST_SPEED = 1e-3
+STACK_DRIFT = 5e-4
 WATER = 998.2
 BOX = 0.4
 RADIUS = 0.05
@@ -106,3 +112,27 @@ def test_a_heavy_sphere_sinks_and_rests_on_the_floor(sphere):
     assert abs(centre - RADIUS) < REST_GAP * RADIUS
     buoyancy = WATER * 9.81 * coupled.solids.shapes[0].volume
     assert abs(coupled.fluid_loads[0, 2] - buoyancy) < REST_LOAD_TOLERANCE * buoyancy
+
+
+def test_two_stacked_cubes_rest_on_their_contacts_under_water():
+    side = 0.08
+    fluid = _tank(24)
+    solids = SolidSolver(gravity=fluid.gravity)
+    shape = solids.add_shape(RigidShape.from_mesh(shapes.cube(side=side, mesh_size=side / 2)))
+    solids.add_material(Material(name="concrete", density=2400.0, restitution=0.3,
+                                 contact_penalty=1.0e8))
+    start = np.array([(0.2, 0.2, 0.5 * side + 0.001), (0.21, 0.2, 1.5 * side + 0.003)])
+    for position in start:
+        solids.add_body(shape=shape, material="concrete", position=position)
+    coupled = CoupledSolver(fluid, solids)
+    while fluid.time < 0.3:              # they settle by the small gaps they start with
+        coupled.step()
+    settled = solids.positions.copy()
+    while fluid.time < 0.6:
+        coupled.step()
+    assert np.linalg.norm(solids.velocities, axis=1).max() < STACK_REST_SPEED
+    assert np.abs(solids.positions - settled).max() < STACK_DRIFT
+    buoyancy = WATER * 9.81 * side ** 3
+    total = coupled.fluid_loads[:, 2].sum()
+    assert abs(total - 2 * buoyancy) < REST_LOAD_TOLERANCE * 2 * buoyancy
+    assert len(solids.contacts) == 2
