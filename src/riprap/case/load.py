@@ -851,7 +851,7 @@ class _Validator:
         minimum = part.minimum_count
         if part.name == "shapes" and "placement" in data:
             minimum = 0
-        if part.name in ("shapes", "materials") and "fluid" in data:
+        if part.name in ("shapes", "materials") and ("fluid" in data or "pack" in data):
             minimum = 0
         raw = data.get(part.name, _NOT_GIVEN)
         entries: list = []
@@ -941,9 +941,11 @@ class _Validator:
                         name,
                     )
 
-    def _check_body_count(self, tables: dict) -> None:
+    def _check_body_count(self, tables: dict, top: dict | None = None) -> None:
         if tables.get("placement") is not None or tables.get("fluid") is not None:
             return               # riprap place makes the bodies; a fluid case needs none
+        if top and top.get("pack") not in (None, "", _INVALID):
+            return               # the pack brings its bodies
         total = len(tables["bodies"])
         for values in tables["body_grids"]:
             counts = None if values is None else values.get("counts", _INVALID)
@@ -964,11 +966,11 @@ class _Validator:
                                      else self._single(part, data))
         self._check_unique(tables)
         self._check_references(tables)
-        self._check_body_count(tables)
+        self._check_body_count(tables, top)
         check_cross_rules(tables, self._problems.add, _INVALID)
         if self._problems:
             return None
-        return Case(
+        case = Case(
             format_version=top["format_version"],
             source=self._source,
             base_dir=self._base_dir,
@@ -991,6 +993,36 @@ class _Validator:
             obstacles=tuple(_with_parameters(RegionSpec, "obstacles", values)
                             for values in tables["obstacles"]),
         )
+        if top.get("pack"):
+            case = _with_pack(case, top["pack"])
+        return case
+
+
+def _with_pack(case: Case, pack_path) -> Case:
+    """``case`` with the pack's materials, shapes, bodies and walls first, and its contact history
+    unless the case names one (the history's body and wall numbers are the pack's, which stay
+    first)."""
+    import dataclasses
+
+    pack = load_case(pack_path)
+    if pack.is_fluid or pack.is_placement:
+        raise CaseFileError(f"{case.source}: pack = {str(pack_path)!r} is not a pack of bodies "
+                            "(it has [fluid] or [placement])")
+    for field in ("materials", "shapes"):
+        ours = {item.name for item in getattr(case, field)}
+        clash = sorted(ours & {item.name for item in getattr(pack, field)})
+        if clash:
+            raise CaseFileError(f"{case.source}: {field} {', '.join(map(repr, clash))} are in the "
+                                f"pack {pack_path} and in this file; give this file's other names")
+    simulation = case.simulation
+    if not simulation.contact_history and pack.simulation.contact_history:
+        simulation = dataclasses.replace(simulation,
+                                         contact_history=pack.simulation.contact_history)
+    return dataclasses.replace(case, simulation=simulation,
+                               materials=pack.materials + case.materials,
+                               shapes=pack.shapes + case.shapes, bodies=pack.bodies + case.bodies,
+                               body_grids=pack.body_grids + case.body_grids,
+                               walls=pack.walls + case.walls)
 
 
 def _optional(spec_class, values: dict | None):

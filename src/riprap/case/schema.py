@@ -253,6 +253,11 @@ KEYS: tuple[Key, ...] = (
     Key("", "format_version", "integer", "-",
         "Version of the case-file format; this riprap reads version 1.",
         valid_range=Range(minimum=FORMAT_VERSION, maximum=FORMAT_VERSION)),
+    Key("", "pack", "path", "-",
+        "A placed pack (`pack.toml` written by `riprap place`) whose materials, shapes, bodies, "
+        "walls and contact history this case takes first; this file adds to them (e.g. [fluid] "
+        "and water to put the layer in water). Bodies of this file use its own shapes and "
+        "materials.", default="", extensions=(".toml",)),
     # [simulation]
     Key("simulation", "end_time", "number", "s", "Simulated time at which the run stops.",
         valid_range=_POSITIVE),

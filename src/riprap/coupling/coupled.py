@@ -44,6 +44,14 @@ __all__ = ["CoupledSolver", "CoupledStepReport", "fluid_box_walls", "MINIMUM_CEL
 MINIMUM_CELLS_ACROSS = 3.0
 
 
+def _same_plane(a, b, tolerance: float = 1e-9) -> bool:
+    """Whether two walls are the same half-space (same outward normal, same plane)."""
+    normal_a, normal_b = np.asarray(a.normal, float), np.asarray(b.normal, float)
+    if np.linalg.norm(normal_a - normal_b) > tolerance:
+        return False
+    return abs(float(np.dot(np.asarray(a.point, float) - np.asarray(b.point, float), normal_a))) <= tolerance
+
+
 def fluid_box_walls(grid, material: str) -> list:
     """The sides of the fluid box as walls for the bodies (an open top is not a wall)."""
     from riprap.solid.walls import Wall
@@ -95,7 +103,11 @@ class CoupledSolver:
         self.fluid = fluid
         self.solids = solids
         if wall_material is not None:
-            solids.add_walls(fluid_box_walls(fluid.grid, wall_material or solids.materials[0].name))
+            # A side that is already a wall (a pack's flume walls, its bed) is not added twice:
+            # two coincident walls would push twice.
+            solids.add_walls([wall for wall in fluid_box_walls(fluid.grid,
+                                                               wall_material or solids.materials[0].name)
+                              if not any(_same_plane(wall, other) for other in solids.walls)])
         solids.finalize()
         self.solid_time_step = float(solid_time_step or solids.time_step)
         n = solids.n_bodies
