@@ -200,9 +200,14 @@ class Simulation:
         check_rigid_run(end_time=self.end_time, time_step=solver.time_step,
                         moving_bodies=int((~solver.fixed).sum()), start_time=solver.time)
         if not self._restarted:
-            smallest = min(s.min_subtet_height for s in solver.shapes)
-            solver.check_no_initial_overlap(_INITIAL_OVERLAP_FRACTION * smallest,
-                                            accepted=self.accepted_overlaps)
+            self.check_start_overlaps()
+
+    def check_start_overlaps(self) -> None:
+        """Refuse bodies that overlap at the start (beyond the accepted resting contacts of a
+        pack) or occupy the same place."""
+        smallest = min(shape.min_subtet_height for shape in self.solver.shapes)
+        self.solver.check_no_initial_overlap(_INITIAL_OVERLAP_FRACTION * smallest,
+                                             accepted=self.accepted_overlaps)
 
     def contact_history(self):
         """The current contacts as a :class:`riprap.io.contact_history.ContactHistory` (spring
@@ -453,9 +458,7 @@ class Simulation:
 
     def contact_forces_on_bodies(self) -> np.ndarray:
         """Total contact force on each body (N), i.e. the force without gravity."""
-        s = self.solver
-        gravity = np.where(s.fixed[:, None], 0.0, s.masses[:, None] * s.gravity)
-        return s.forces - gravity
+        return self.solver.contact_forces()
 
     def contact_statistics(self) -> dict:
         """Per body: coordination number, largest contact force (N) and factor of safety against

@@ -52,14 +52,14 @@ def _tank(cells, *, gravity=(0.0, 0.0, -9.81), level=0.3, sides="no_slip"):
 
 
 def _coupled(fluid, mesh, *, density, position, fixed=False, velocity=(0.0, 0.0, 0.0),
-             angular_velocity=(0.0, 0.0, 0.0)):
+             angular_velocity=(0.0, 0.0, 0.0), check_momentum=False):
     solids = SolidSolver(gravity=fluid.gravity)
     shape = solids.add_shape(RigidShape.from_mesh(mesh))
     solids.add_material(Material(name="body", density=density, restitution=0.5,
                                  contact_penalty=1.0e7))
     solids.add_body(shape=shape, material="body", position=position, velocity=velocity,
                     angular_velocity=angular_velocity, fixed=fixed)
-    return CoupledSolver(fluid, solids)
+    return CoupledSolver(fluid, solids, check_momentum=check_momentum)
 
 
 @pytest.fixture(scope="module")
@@ -71,7 +71,7 @@ def test_momentum_exchanged_between_fluid_and_body_sums_to_zero():
     fluid = _tank(16, gravity=(0.0, 0.0, 0.0), level=BOX, sides="free_slip")
     coupled = _coupled(fluid, shapes.box(lengths=(0.1, 0.06, 0.08), mesh_size=0.02), density=1500.0,
                        position=(0.15, 0.2, 0.2), velocity=(0.3, 0.1, -0.05),
-                       angular_velocity=(1.0, 2.0, 3.0))
+                       angular_velocity=(1.0, 2.0, 3.0), check_momentum=True)
     momentum = coupled.solids.masses[0] * 0.3
     for _ in range(20):
         coupled.step()

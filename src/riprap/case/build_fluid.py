@@ -78,6 +78,5 @@ def _coupled(case, fluid):
     simulation = build_simulation(case, progress=False)
     solids = simulation.solver
     simulation.build_without_checks()
-    smallest = min(shape.min_subtet_height for shape in solids.shapes)
-    solids.check_no_initial_overlap(0.01 * smallest, accepted=simulation.accepted_overlaps)
+    simulation.check_start_overlaps()
     return CoupledSolver(fluid, solids)

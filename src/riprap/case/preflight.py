@@ -6,14 +6,12 @@ tell is listed as not checked, never passed over in silence.
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from riprap.case.load import Case
-from riprap.io.output_folder import OutputFolderError
+from riprap.io.output_folder import check_output_folder
 
-__all__ = ["CheckReport", "check_case", "check_output_folder"]
+__all__ = ["CheckReport", "check_case"]
 
 
 @dataclass
@@ -24,25 +22,6 @@ class CheckReport:
     description: str
     checked: list[str] = field(default_factory=list)
     not_checked: list[str] = field(default_factory=list)
-
-
-def check_output_folder(path) -> str:
-    """Refuse an output folder that cannot be made or written, without making it."""
-    folder = Path(path)
-    if folder.exists() and not folder.is_dir():
-        raise OutputFolderError(f"output folder {folder}: a file of that name exists; choose "
-                                "another --out folder")
-    existing = folder
-    while not existing.exists():
-        if existing.parent == existing:
-            break
-        existing = existing.parent
-    if existing.exists() and not existing.is_dir():
-        raise OutputFolderError(f"output folder {folder}: {existing} is a file, not a folder")
-    if not os.access(existing, os.W_OK | os.X_OK):
-        raise OutputFolderError(f"cannot write the output folder {folder}: {existing} is not "
-                                "writable; choose a folder you may write to (--out)")
-    return f"output folder {folder} can be written"
 
 
 def check_case(case: Case, *, output_directory=None) -> CheckReport:

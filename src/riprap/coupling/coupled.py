@@ -93,15 +93,22 @@ class CoupledSolver:
     wall_material : str, optional
         Material of the fluid box's sides as walls for the bodies (every side but an open top);
         default the first material. None: add no walls (the caller's walls bound the bodies).
+    check_momentum : bool
+        Measure every step how far the exchange is from conserving momentum
+        (``last_exchange_balance``; a few whole-grid passes, so off unless asked for).
     """
 
     def __init__(self, fluid: FluidSolver, solids: SolidSolver, *, solid_time_step: float | None = None,
-                 wall_material: str | None = ""):
+                 wall_material: str | None = "", check_momentum: bool = False):
         if not np.allclose(fluid.gravity, solids.gravity):
             raise CaseFileError(f"coupling: the fluid's gravity {fluid.gravity.tolist()} differs from "
                                 f"the bodies' {solids.gravity.tolist()}")
         self.fluid = fluid
         self.solids = solids
+        self.check_momentum = bool(check_momentum)
+        #: Momentum after the last exchange less before less the walls' pressure impulse (N s),
+        #: with ``check_momentum``; None otherwise.
+        self.last_exchange_balance = None
         if wall_material is not None:
             # A side that is already a wall (a pack's flume walls, its bed) is not added twice:
             # two coincident walls would push twice.
@@ -296,7 +303,7 @@ class CoupledSolver:
             unaccounted.append(density * velocities[a] - (1.0 - capped[a]) * fluid_densities[a]
                                * fluid_part[a] - rigid_momentum[a])
         betas = fluid._face_coefficients(mixture)
-        blended = [velocity.copy() for velocity in velocities]
+        blended = [velocity.copy() for velocity in velocities] if self.check_momentum else None
         pressure, report = fluid.project(u, v, w, betas, dt)
 
         n = solids.n_bodies
@@ -316,12 +323,13 @@ class CoupledSolver:
         rigid = [np.zeros_like(q) for q in velocities]
         rigid_coupling.accumulate_rigid(*arguments, self._lower, fluid.h, centres, final, ones,
                                         *faces, *fluid_densities, *rigid)
-        projected = [velocity.copy() for velocity in velocities]
+        projected = [velocity.copy() for velocity in velocities] if self.check_momentum else None
         for a in range(3):
             velocities[a][...] = (1.0 - capped[a]) * velocities[a] + rigid[a]
-        self.last_exchange_balance = self._exchange_balance(
-            capped, fluid_densities, fluid_part, velocities, mixture, blended, projected,
-            body_matrices, predicted, final, free)
+        if self.check_momentum:
+            self.last_exchange_balance = self._exchange_balance(
+                capped, fluid_densities, fluid_part, velocities, mixture, blended, projected,
+                body_matrices, predicted, final, free)
         fluid_report = fluid.finish_step(u, v, w, pressure, report, dt, courant)
 
         # The bodies then move over the step in contact sub-steps with the fluid's load held:

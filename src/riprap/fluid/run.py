@@ -111,8 +111,7 @@ class FluidRun:
         solids = coupled.solids
         points, triangles, owners = surface_arrays(solids)
         fluid_force = coupled.fluid_loads[:, :3] + coupled.fixed_body_loads[:, :3]
-        gravity = np.where(solids.fixed[:, None], 0.0, solids.masses[:, None] * solids.gravity)
-        contact = solids.forces - gravity - solids.external_loads[:, :3]
+        contact = solids.contact_forces()
         series.add(coupled.time, points=points, cells=triangles, cell_type="triangle",
                    cell_data={"body_id": owners, "velocity": solids.velocities[owners],
                               "fluid_force": fluid_force[owners],
@@ -123,8 +122,7 @@ class FluidRun:
         """Rows of ``body_forces.csv`` for the present time (one per body)."""
         coupled = self.solver
         solids = coupled.solids
-        gravity = np.where(solids.fixed[:, None], 0.0, solids.masses[:, None] * solids.gravity)
-        contact = solids.forces - gravity - solids.external_loads[:, :3]
+        contact = solids.contact_forces()
         rows = []
         for b in range(solids.n_bodies):
             values = [coupled.time, *solids.positions[b], *solids.velocities[b],

@@ -9,7 +9,8 @@ from pathlib import Path
 
 from riprap.errors import RiprapError
 
-__all__ = ["OutputFolderError", "prepare_output_folder", "describe_os_error"]
+__all__ = ["OutputFolderError", "prepare_output_folder", "check_output_folder",
+           "describe_os_error"]
 
 
 class OutputFolderError(RiprapError):
@@ -32,6 +33,28 @@ def describe_os_error(error: OSError) -> str:
     return f"{where}: {reason}" + (f" ({hint})" if hint else "")
 
 
+def _refuse_a_file_in_the_way(folder: Path) -> None:
+    if folder.exists() and not folder.is_dir():
+        raise OutputFolderError(f"output folder {folder}: a file of that name exists; choose "
+                                "another --out folder")
+
+
+def check_output_folder(path) -> str:
+    """Refuse an output folder that cannot be made or written, without making it (riprap check);
+    returns what was checked."""
+    folder = Path(path)
+    _refuse_a_file_in_the_way(folder)
+    existing = folder
+    while not existing.exists() and existing.parent != existing:
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        raise OutputFolderError(f"output folder {folder}: {existing} is a file, not a folder")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise OutputFolderError(f"cannot write the output folder {folder}: {existing} is not "
+                                "writable; choose a folder you may write to (--out)")
+    return f"output folder {folder} can be written"
+
+
 def prepare_output_folder(path) -> Path:
     """Make ``path`` (and its parents) and check that a file can be written in it.
 
@@ -41,9 +64,7 @@ def prepare_output_folder(path) -> Path:
         Naming the folder and the reason (not writable, under a file, name too long, disk full).
     """
     folder = Path(path)
-    if folder.exists() and not folder.is_dir():
-        raise OutputFolderError(f"output folder {folder}: a file of that name exists; choose "
-                                "another --out folder")
+    _refuse_a_file_in_the_way(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / f".riprap-write-test-{os.getpid()}"

@@ -352,6 +352,12 @@ class SolidSolver:
         return integrate.angular_velocities(self.quaternions, self.angular_momenta,
                                             self.inverse_principal_inertia)
 
+    def contact_forces(self) -> np.ndarray:
+        """Total contact force on each body (N): its force less gravity and the external loads."""
+        self.finalize()
+        gravity = np.where(self.fixed[:, None], 0.0, self.masses[:, None] * self.gravity)
+        return self.forces - gravity - self.external_loads[:, :3]
+
     def kinetic_energy(self) -> float:
         omega = self.angular_velocities
         translational = 0.5 * np.sum(self.masses[~self.fixed] * np.sum(self.velocities[~self.fixed] ** 2, axis=1))
