@@ -122,8 +122,9 @@ def test_report_explains_a_unit_at_rest_below_one(report):
 def test_report_unit_labels_keep_their_capitals_and_design_rows_are_indented(report):
     assert "Largest contact force (N)" in report
     assert "(n)" not in report
-    for label, _ in PER_UNIT_FIELDS.values():
-        assert label[:1].upper() + label[1:] in report
+    for column, (label, _) in PER_UNIT_FIELDS.items():
+        if column in _units():          # the displacement needs a reference state: none here
+            assert label[:1].upper() + label[1:] in report
     assert re.findall(r"<th class='name detail'>(.*?)</th>", report) == [
         "design", "design", "design (m)"]
     assert "<th class='name'>  " not in report

@@ -7,8 +7,10 @@ touched; how many of them units), the largest contact force it carries (all cont
 units, with the underlayer), its weight, factors of safety against sliding
 (:func:`~riprap.analysis.unit_contacts.sliding_factor_of_safety`) and rocking
 (:func:`~riprap.analysis.rocking.rocking_factor_of_safety`), ``factor_of_safety`` the smaller of
-the two, and for each named axis of the unit its world direction, trend and plunge and its point
-on the lower-hemisphere equal-area net.
+the two, for each named axis of the unit its world direction, trend and plunge and its point
+on the lower-hemisphere equal-area net, and how far it moved and turned since the reference state
+(frame 0 of a run; :mod:`~riprap.analysis.displacements`; NaN for a pack on its own). When the
+source recorded no contacts (a coupled run), the contact columns are NaN.
 
 Per layer (``LayerAnalysis.layer``): packing density coefficient, porosity and layer thickness
 (:mod:`riprap.placement.layer_metrics`, the same definitions as ``riprap place``), against the
@@ -23,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from riprap.analysis.displacements import DISPLACEMENT_COLUMNS, unit_displacements
 from riprap.analysis.orientations import equal_area_points, lower_hemisphere, trend_plunge
 from riprap.analysis.rocking import rocking_factor_of_safety
 from riprap.analysis.unit_contacts import sliding_factor_of_safety, unit_contacts
@@ -32,6 +35,13 @@ __all__ = ["LayerAnalysis", "analyse_layer", "CONTACT_FORCE_PERCENTILES"]
 
 #: Percentiles of the contact forces reported per layer.
 CONTACT_FORCE_PERCENTILES = (50, 90, 99)
+#: Per-unit columns that come from the contacts (NaN when the source recorded none).
+CONTACT_COLUMNS = ("coordination_number", "unit_contacts", "underlayer_contacts",
+                   "max_contact_force_N", "max_contact_force_unit_unit_N",
+                   "max_contact_force_unit_underlayer_N", "max_contact_force_over_weight",
+                   "factor_of_safety", "factor_of_safety_sliding", "factor_of_safety_rocking")
+#: A unit counts as moved in the layer summary when its centroid moved more than this many D_n.
+MOVED_THRESHOLD_DN = 0.1
 
 
 @dataclass(frozen=True, eq=False)
@@ -136,6 +146,7 @@ def analyse_layer(state) -> LayerAnalysis:
         "factor_of_safety_sliding": sliding,
         "factor_of_safety_rocking": rocking,
     }
+    columns.update(_displacement_columns(state, bodies))
     nose_axes = None
     for name, axis in layer.unit_axes.items():
         world = state.rotations[bodies] @ np.asarray(axis, dtype=float)
@@ -196,6 +207,44 @@ def analyse_layer(state) -> LayerAnalysis:
         "units_below_factor_of_safety_1": [int(k) for k in np.flatnonzero(fos < 1.0)],
         "mean_distance_from_design_m": float(columns["distance_from_design_m"].mean()) if n_units else 0.0,
         "nose_axis_fabric": _fabric(nose_axes) if nose_axes is not None else {},
+        **_displacement_summary(state, columns),
     }
+    if not state.contacts_recorded:
+        columns.update({name: np.full(n_units, np.nan) for name in CONTACT_COLUMNS})
+        summary["contacts_recorded"] = False
+        summary["units_below_factor_of_safety_1"] = []
+        for key in ("coordination_number_mean", "coordination_number_min",
+                    "coordination_number_max", "max_contact_force_N", "factor_of_safety_min",
+                    "factor_of_safety_median"):
+            summary[key] = None
+        summary["coordination_number_histogram"] = {}
     return LayerAnalysis(units=columns, layer=summary, unit_unit_forces=unit_unit,
                          unit_underlayer_forces=unit_underlayer, state=state)
+
+
+def _displacement_columns(state, bodies) -> dict:
+    """The units' displacement and rotation since the state's reference (NaN without one)."""
+    if state.reference_positions is None:
+        return {name: np.full(len(bodies), np.nan) for name in DISPLACEMENT_COLUMNS}
+    return unit_displacements(state.positions[bodies], state.rotations[bodies],
+                              np.asarray(state.reference_positions)[bodies],
+                              np.asarray(state.reference_rotations)[bodies],
+                              nominal_diameter=state.layer.nominal_diameter,
+                              slope=state.layer.slope)
+
+
+def _displacement_summary(state, columns) -> dict:
+    """Layer figures of the displacements: the reference, largest and mean, units moved."""
+    if state.reference_positions is None:
+        return {"displacement_reference": state.reference_note or "none"}
+    distance, over_dn = columns["displacement_m"], columns["displacement_over_dn"]
+    turned = columns["rotation_deg"]
+    moved = np.flatnonzero(over_dn > MOVED_THRESHOLD_DN)
+    return {"displacement_reference": state.reference_note,
+            "displacement_reference_time_s": float(state.reference_time),
+            "max_displacement_m": float(distance.max(initial=0.0)),
+            "max_displacement_over_dn": float(over_dn.max(initial=0.0)),
+            "mean_displacement_m": float(distance.mean()) if len(distance) else 0.0,
+            "max_rotation_deg": float(turned.max(initial=0.0)),
+            "moved_threshold_over_dn": MOVED_THRESHOLD_DN,
+            "units_moved": [int(k) for k in moved]}

@@ -127,6 +127,16 @@ class LayerState:
     layer : LayerDescription
     source : str
         Where the state was read from (named in the report and in errors).
+    reference_positions, reference_rotations : (n, 3) and (n, 3, 3) float, or None
+        The same bodies' poses in the state the displacements are measured from (frame 0 of a
+        run); None: no reference (a pack on its own), the displacement columns are NaN.
+    reference_time : float
+        Simulated time of the reference state (s).
+    reference_note : str
+        What the reference is, or why there is none.
+    contacts_recorded : bool
+        False when the source recorded no contacts (a coupled run writes no ``contacts.pvd``):
+        ``contacts`` is then empty because nothing was recorded, not because nothing touches.
     """
 
     positions: np.ndarray
@@ -146,6 +156,11 @@ class LayerState:
     time: float
     layer: LayerDescription
     source: str = ""
+    reference_positions: np.ndarray | None = None
+    reference_rotations: np.ndarray | None = None
+    reference_time: float = float("nan")
+    reference_note: str = ""
+    contacts_recorded: bool = True
     _faces: dict = field(default_factory=dict, repr=False)
 
     @property

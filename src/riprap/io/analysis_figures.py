@@ -11,6 +11,9 @@
 - ``histograms``: coordination numbers, contact forces (unit-unit and unit-underlayer) and
   factors of safety.
 
+A field with no finite value (the contact fields of a run that recorded no contacts, the
+displacement of a pack on its own) is not drawn (:func:`drawn_fields`).
+
 A 3D view and the face view of the same field share its colour map and range
 (:func:`colour_scale`); factors of safety are drawn up to :data:`FACTOR_OF_SAFETY_DISPLAY_CAP`.
 """
@@ -22,14 +25,15 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["stereonet_figure", "layer_view_png", "slope_view_figure", "histogram_figure",
-           "comparison_stereonets", "comparison_histograms", "colour_scale", "PER_UNIT_FIELDS",
-           "FACTOR_OF_SAFETY_DISPLAY_CAP"]
+           "comparison_stereonets", "comparison_histograms", "colour_scale", "drawn_fields",
+           "PER_UNIT_FIELDS", "FACTOR_OF_SAFETY_DISPLAY_CAP"]
 
 #: Per-unit fields drawn on the layer, with their colour-bar labels and colour maps.
 PER_UNIT_FIELDS = {
     "max_contact_force_N": ("largest contact force (N)", "viridis"),
     "coordination_number": ("coordination number (bodies and walls touched)", "plasma"),
     "factor_of_safety": ("factor of safety (smaller of sliding and rocking)", "RdYlGn"),
+    "displacement_over_dn": ("displacement since the reference state (D_n)", "YlOrRd"),
 }
 #: Factors of safety above this are shown as "> cap" in the report's tables, with the top colour
 #: in the pictures and in the histogram's last bin. Beyond a few the number says only that the
@@ -67,18 +71,26 @@ def _display_values(column: str, values) -> np.ndarray:
     return values
 
 
+def drawn_fields(units: dict) -> list[str]:
+    """The fields of :data:`PER_UNIT_FIELDS` in ``units`` that have a finite value for some unit."""
+    return [column for column in PER_UNIT_FIELDS
+            if column in units and np.isfinite(np.asarray(units[column], dtype=float)).any()]
+
+
 def colour_scale(column: str, values) -> tuple[str, float, float]:
     """Colour map, lowest and highest value of the colour scale of a per-unit ``column``.
 
     Factors of safety: 0 to :data:`FACTOR_OF_SAFETY_DISPLAY_CAP`; other fields: their finite
-    range over ``values`` (one unit wide if all are equal). Every figure of one field uses this,
-    so a colour means the same value in the 3D view and the face view."""
+    range over ``values`` (one unit wide if all are equal), displacements from 0. Every figure of
+    one field uses this, so a colour means the same value in the 3D view and the face view."""
     _, colour_map = PER_UNIT_FIELDS.get(column, (column, "viridis"))
     if column.startswith("factor_of_safety"):
         return colour_map, 0.0, FACTOR_OF_SAFETY_DISPLAY_CAP
     values = np.asarray(values, dtype=float)
     finite = values[np.isfinite(values)]
     low, high = (float(finite.min()), float(finite.max())) if len(finite) else (0.0, 1.0)
+    if column.startswith("displacement"):
+        low = 0.0
     return colour_map, low, high if high > low else low + 1.0
 
 
@@ -212,7 +224,11 @@ def slope_view_figure(path, analysis, column: str) -> list[Path]:
 
 def _histogram_axes(axes, analysis, label=None, colour=None):
     units = analysis.units
-    coordination = units["coordination_number"]
+    coordination = np.asarray(units["coordination_number"], dtype=float)
+    coordination = coordination[np.isfinite(coordination)]
+    if not len(coordination) and len(units["coordination_number"]):
+        for axis in axes:
+            axis.text(0.5, 0.5, "no contacts recorded", transform=axis.transAxes, ha="center")
     low, high = (int(coordination.min()), int(coordination.max())) if len(coordination) else (0, 0)
     bins = np.arange(low, high + 2) - 0.5
     axes[0].hist(coordination, bins=bins, color=colour, alpha=0.6 if label else 0.9,
@@ -236,6 +252,7 @@ def _histogram_axes(axes, analysis, label=None, colour=None):
     axes[1].set_xlabel("contact force (N)")
     axes[1].set_ylabel("contacts")
     fos = _display_values("factor_of_safety", units["factor_of_safety"])
+    fos = fos[~np.isnan(fos)]
     axes[2].hist(fos, bins=np.linspace(0.0, FACTOR_OF_SAFETY_DISPLAY_CAP, 26), color=colour,
                  alpha=0.6 if label else 0.9, edgecolor="black", linewidth=0.4, label=label)
     axes[2].axvline(1.0, color="crimson", linewidth=1.0)

@@ -3,11 +3,15 @@
 - A pack (``riprap place``'s output folder, or its ``pack.toml``): poses from ``pack.toml``, shapes
   from ``shapes/*.vtu``, contact forces from ``contacts.csv``, the layer from ``layer.json``
   (:mod:`riprap.io.layer_file`).
-- A run (the output folder of ``riprap run pack.toml``): its ``summary.json`` names the case it
-  ran (``case_file``), which must be a pack; a frame of ``bodies.pvd`` gives every body's world
-  surface, from which its pose is fitted exactly (the rotation that carries the stored mesh's
-  surface nodes onto the frame's, Kabsch 1976, Acta Cryst. A32: 922), and the same frame of
-  ``contacts.pvd`` gives the contacts with their forces.
+- A run (the output folder of ``riprap run pack.toml``, or of a case that includes a pack with
+  ``pack = "..."``, such as a pack put in water): its ``summary.json`` names the case it ran
+  (``case_file``), which must be a pack or include one (whose ``layer.json`` says which bodies are
+  units); a frame of ``bodies.pvd`` gives every body's world surface, from which its pose is
+  fitted exactly (the rotation that carries the stored mesh's surface nodes onto the frame's,
+  Kabsch 1976, Acta Cryst. A32: 922), and the same frame of ``contacts.pvd`` gives the contacts
+  with their forces. Frame 0 of ``bodies.pvd`` is the reference the units' displacements are
+  measured from. A coupled run (``fluid.pvd`` beside) writes no ``contacts.pvd``: its state has
+  no contacts and says so (``contacts_recorded`` False).
 """
 from __future__ import annotations
 
@@ -100,13 +104,27 @@ def _check_contacts(contacts, n_bodies, n_walls, where) -> None:
                             f"{int(body_j[row])}, but there are {n_bodies} bodies and {n_walls} walls")
 
 
+def _included_pack(case_file: Path) -> Path | None:
+    """The pack a case file takes its bodies from (top-level ``pack = "..."``), or None."""
+    import tomllib
+
+    try:
+        top = tomllib.loads(case_file.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return None                       # load_case names what is wrong with it
+    pack = top.get("pack")
+    return case_file.parent / pack if isinstance(pack, str) and pack else None
+
+
 def _read_pack(pack_file: Path) -> dict:
-    """Everything of a pack but the poses and contacts: the case's shapes, materials, walls and
-    bodies, and its layer description (checked against the case)."""
+    """Everything of a pack, or of a case that includes one, but the poses and contacts: the
+    case's shapes, materials, walls and bodies, and the pack's layer description (checked against
+    the case; the pack's bodies come first in a case that includes it, so its numbers hold)."""
     from riprap.io.layer_file import read_layer_file
 
     case, shape_names, meshes, centroids, materials, walls = _case_parts(pack_file)
-    layer = read_layer_file(pack_file.parent, n_bodies=len(case.bodies))
+    included = _included_pack(pack_file)
+    layer = read_layer_file((included or pack_file).parent, n_bodies=len(case.bodies))
     _check_layer_against_case(layer, case, shape_names, pack_file)
     material_names = [m.name for m in materials]
     return {"case": case, "shape_names": shape_names, "meshes": meshes, "centroids": centroids,
@@ -117,7 +135,9 @@ def _read_pack(pack_file: Path) -> dict:
                                          dtype=np.int64)}
 
 
-def _layer_state(pack: dict, *, positions, rotations, contacts, time: float, source: str):
+def _layer_state(pack: dict, *, positions, rotations, contacts, time: float, source: str,
+                 **reference):
+    """``reference``: the keyword arguments of LayerState's reference and ``contacts_recorded``."""
     from riprap.analysis.layer_state import LayerState
 
     case, walls = pack["case"], pack["walls"]
@@ -129,7 +149,7 @@ def _layer_state(pack: dict, *, positions, rotations, contacts, time: float, sou
         fixed=np.array([b.fixed for b in case.bodies], dtype=bool),
         wall_points=walls[0], wall_normals=walls[1], wall_materials=walls[2],
         contacts=contacts, gravity=np.asarray(case.simulation.gravity, dtype=float),
-        time=float(time), layer=pack["layer"], source=source)
+        time=float(time), layer=pack["layer"], source=source, **reference)
 
 
 def load_pack_state(path):
@@ -143,7 +163,7 @@ def load_pack_state(path):
         pack, positions=np.array([b.position for b in bodies], dtype=float).reshape(-1, 3),
         rotations=_rotation_matrices([b.orientation for b in bodies]),
         contacts=read_contact_table(folder / CONTACTS_FILE_NAME), time=0.0,
-        source=str(pack_file))
+        source=str(pack_file), reference_note="none: a pack on its own has no earlier state")
 
 
 def _pvd_frames(pvd: Path) -> list[tuple[float, str]]:
@@ -266,8 +286,40 @@ def _read_contacts_vtu(path: Path, what: str = "the contacts frame"):
 
 def load_run_state(run_folder, *, frame: int = -1):
     """The state at frame ``frame`` (index into ``bodies.pvd``'s list, -1 the last) of a run
-    started from a pack."""
+    started from a pack (or from a case that includes one), with frame 0's poses as the reference
+    of the displacements."""
     run_folder = Path(run_folder)
+    pack_file = _run_case_file(run_folder)
+    pack = _read_pack(pack_file)
+    frames = _pvd_frames(run_folder / "bodies.pvd")
+    coupled = (run_folder / "fluid.pvd").is_file() and not (run_folder / "contacts.pvd").exists()
+    contact_frames = {} if coupled else dict(_pvd_frames(run_folder / "contacts.pvd"))
+    if not frames:
+        raise CaseFileError(f"{run_folder / 'bodies.pvd'}: lists no frames")
+    if isinstance(frame, (bool, np.bool_)) or not isinstance(frame, (int, np.integer)):
+        raise CaseFileError(f"{run_folder}: frame must be an integer (0..{len(frames) - 1}, or -1 "
+                            f"for the last), got {frame!r}")
+    if not -len(frames) <= frame < len(frames):
+        raise CaseFileError(f"{run_folder}: frame {frame} does not exist; the run wrote "
+                            f"{len(frames)} frames (0..{len(frames) - 1}, or -1 for the last)")
+    time = frames[frame][0]
+    if not coupled and time not in contact_frames:
+        raise CaseFileError(f"{run_folder / 'contacts.pvd'}: no frame at t = {time!r} s")
+    positions, rotations = _frame_poses(run_folder, frames, frame, pack, pack_file)
+    reference = _reference_poses(run_folder, frames, frame, pack, pack_file,
+                                 now=(positions, rotations))
+    if coupled:
+        contacts = _no_contact_records()
+    else:
+        contacts = _read_contacts_vtu(run_folder / contact_frames[time],
+                                      f"the contacts frame at t = {time:g} s (contacts.pvd)")
+    return _layer_state(pack, positions=positions, rotations=rotations, contacts=contacts,
+                        time=time, source=f"{run_folder} frame {frame} (t = {time:g} s)",
+                        contacts_recorded=not coupled, **reference)
+
+
+def _run_case_file(run_folder: Path) -> Path:
+    """The case a run folder's ``summary.json`` says the run ran."""
     summary_path = run_folder / "summary.json"
     try:
         summary = json.loads(summary_path.read_text(encoding="utf-8"))
@@ -283,23 +335,32 @@ def load_run_state(run_folder, *, frame: int = -1):
     if not case_file:
         raise CaseFileError(f"{summary_path}: no 'case_file' (runs of this riprap version record "
                             "the case they ran); analyse the pack instead, or run it again")
-    pack_file = Path(case_file)
-    pack = _read_pack(pack_file)
+    return Path(case_file)
+
+
+def _reference_poses(run_folder: Path, frames, frame: int, pack: dict, pack_file: Path, *,
+                     now) -> dict:
+    """LayerState's reference keywords: frame 0's poses (``now``, the poses of frame ``frame``,
+    when that is frame 0), or none, with the reason, when frame 0 cannot be read."""
+    time = frames[0][0]
+    note = f"frame 0 of {run_folder / 'bodies.pvd'} (t = {time:g} s)"
+    if frame % len(frames) == 0:
+        positions, rotations = now
+    else:
+        try:
+            positions, rotations = _frame_poses(run_folder, frames, 0, pack, pack_file)
+        except CaseFileError as error:
+            return {"reference_note": f"none: {note} cannot be read ({error})"}
+    return {"reference_positions": positions, "reference_rotations": rotations,
+            "reference_time": float(time), "reference_note": note}
+
+
+def _frame_poses(run_folder: Path, frames, frame: int, pack: dict, pack_file: Path):
+    """Every body's centroid and rotation in frame ``frame`` of ``bodies.pvd``, fitted to its
+    surface nodes."""
     n_bodies = len(pack["case"].bodies)
     shape_names, meshes, centroids = pack["shape_names"], pack["meshes"], pack["centroids"]
-    frames = _pvd_frames(run_folder / "bodies.pvd")
-    contact_frames = dict(_pvd_frames(run_folder / "contacts.pvd"))
-    if not frames:
-        raise CaseFileError(f"{run_folder / 'bodies.pvd'}: lists no frames")
-    if isinstance(frame, (bool, np.bool_)) or not isinstance(frame, (int, np.integer)):
-        raise CaseFileError(f"{run_folder}: frame must be an integer (0..{len(frames) - 1}, or -1 "
-                            f"for the last), got {frame!r}")
-    if not -len(frames) <= frame < len(frames):
-        raise CaseFileError(f"{run_folder}: frame {frame} does not exist; the run wrote "
-                            f"{len(frames)} frames (0..{len(frames) - 1}, or -1 for the last)")
     time, body_file = frames[frame]
-    if time not in contact_frames:
-        raise CaseFileError(f"{run_folder / 'contacts.pvd'}: no frame at t = {time!r} s")
     frame_path = run_folder / body_file
     what = f"frame {frame % len(frames)} of bodies.pvd (t = {time:g} s)"
     bodies_mesh = _read_frame_mesh(frame_path, what)
@@ -338,9 +399,6 @@ def load_run_state(run_folder, *, frame: int = -1):
             raise CaseFileError(f"{run_folder / body_file}: body {b} has {len(world)} surface "
                                 f"nodes, its shape '{shape_names[k]}' {len(local)}")
         rotations[b], positions[b] = _fit_pose(local, world, centroids[k])
-    contacts = _read_contacts_vtu(run_folder / contact_frames[time],
-                                  f"the contacts frame at t = {time:g} s (contacts.pvd)")
-    return _layer_state(pack, positions=positions, rotations=rotations, contacts=contacts,
-                        time=time, source=f"{run_folder} frame {frame} (t = {time:g} s)")
+    return positions, rotations
 
 

@@ -7,12 +7,13 @@ In the output folder (every column and unit in ``docs/outputs.md``):
 - ``layer_summary.json``: the layer figures (``LayerAnalysis.layer``);
 - ``layer.vtu``: the units' surfaces with per-body ``body_id``, ``unit_id``,
   ``coordination_number``, ``max_contact_force``, ``factor_of_safety`` (and the sliding and
-  rocking ones) for ParaView; ``underlayer.vtu`` the rocks;
+  rocking ones), ``displacement``, ``displacement_over_dn`` and ``rotation_deg`` for ParaView;
+  ``underlayer.vtu`` the rocks;
 - ``stereonet.png``/``.svg``, ``layer_<field>.png``, ``slope_<field>.png``/``.svg``,
   ``histograms.png``/``.svg``;
 - ``report.html``: the summary table, the layer measured against design (:data:`DESIGN_TOLERANCES`),
-  the pictures, the units with the smallest factors of safety and what those factors mean, on one
-  page.
+  the pictures, the units that moved most since the reference state (frame 0 of a run), the units
+  with the smallest factors of safety and what those factors mean, on one page.
 
 :func:`write_comparison` puts several analysed layers side by side (``comparison.html``).
 """
@@ -59,7 +60,13 @@ SUMMARY_ROWS = (
     ("factor_of_safety_min", "smallest factor of safety", _factor_of_safety_text),
     ("factor_of_safety_median", "median factor of safety", _factor_of_safety_text),
     ("mean_distance_from_design_m", "mean distance from the design position (m)", "{:.3f}"),
+    ("max_displacement_m", "largest displacement since the reference state (m)", "{:.3f}"),
+    ("max_displacement_over_dn", "  in nominal diameters Dn", "{:.2f}"),
+    ("max_rotation_deg", "largest rotation since the reference state (degrees)", "{:.1f}"),
 )
+
+#: Rows of SUMMARY_ROWS left out when no layer has the key (no reference state to measure from).
+OPTIONAL_SUMMARY_KEYS = ("max_displacement_m", "max_displacement_over_dn", "max_rotation_deg")
 
 
 #: Tolerances of the verdict against design: (key of LayerAnalysis.layer, label, tolerance, kind);
@@ -184,6 +191,9 @@ def _write_paraview(out: Path, analysis) -> dict:
                                   ("factor_of_safety", "factor_of_safety"),
                                   ("factor_of_safety_sliding", "factor_of_safety_sliding"),
                                   ("factor_of_safety_rocking", "factor_of_safety_rocking"),
+                                  ("displacement_m", "displacement"),
+                                  ("displacement_over_dn", "displacement_over_dn"),
+                                  ("rotation_deg", "rotation_deg"),
                                   ("row", "row")):
                 values = analysis.body_values(column)[owners]
                 # ParaView colours inf badly; a large finite number reads as "no driving load".
@@ -199,6 +209,8 @@ def _summary_table(layers: list[dict], labels: list[str]) -> str:
     head = "".join(f"<th>{html.escape(label)}</th>" for label in labels)
     rows = []
     for key, label, fmt in SUMMARY_ROWS:
+        if key in OPTIONAL_SUMMARY_KEYS and all(key not in layer for layer in layers):
+            continue
         cells = []
         for layer in layers:
             value = layer.get(key)
@@ -308,6 +320,50 @@ def _factor_of_safety_notes(layer: dict, units: dict) -> str:
         "1e30 in ParaView).</p>")
 
 
+def _no_contacts_note(layer: dict) -> str:
+    if layer.get("contacts_recorded", True):
+        return ""
+    return ("<p class='outside'><b>This run recorded no contacts</b> (a coupled run writes no "
+            "<code>contacts.pvd</code>): coordination numbers, contact forces and factors of "
+            "safety are not known here and are left empty (NaN in <code>units.csv</code>). "
+            "Analyse the pack, or a dry run from it, for them.</p>")
+
+
+def _factor_of_safety_section(layer: dict, units: dict) -> str:
+    if not layer.get("contacts_recorded", True):
+        return ""
+    return (f"<h2>Units with the smallest factor of safety</h2>{_lowest_fos_table(units)}"
+            f"{_factor_of_safety_notes(layer, units)}")
+
+
+def _displacement_section(layer: dict, units: dict, count: int = 10) -> str:
+    """The units that moved most since the reference state, or why there is no reference."""
+    if "max_displacement_m" not in layer:
+        return ("<h2>Displacements</h2><p class='note'>Reference state: "
+                f"{html.escape(str(layer.get('displacement_reference', 'none')))}; the "
+                "displacement columns are empty. Analyse a run's later frame to see how far each "
+                "unit moved from frame 0.</p>")
+    order = np.argsort(-units["displacement_m"], kind="stable")[:count]
+    columns = (("unit_id", "{:d}".format), ("row", "{:d}".format),
+               ("displacement_m", "{:.3f}".format), ("displacement_over_dn", "{:.2f}".format),
+               ("displacement_along_slope_m", "{:+.3f}".format),
+               ("displacement_z_m", "{:+.3f}".format), ("rotation_deg", "{:.1f}".format))
+    head = "".join(f"<th>{name}</th>" for name, _ in columns)
+    rows = "".join("<tr>" + "".join(f"<td>{html.escape(fmt(units[name][k].item()))}</td>"
+                                    for name, fmt in columns) + "</tr>" for k in order)
+    moved = layer["units_moved"]
+    return (f"<h2>Displacements</h2><p>Since {html.escape(layer['displacement_reference'])}: "
+            f"{len(moved)} of {layer['units']} units moved more than "
+            f"{layer['moved_threshold_over_dn']:g} D<sub>n</sub>"
+            f"{' (' + ', '.join(map(str, moved[:30])) + (' ...' if len(moved) > 30 else '') + ')' if moved else ''}; "
+            f"largest {layer['max_displacement_m']:.3f} m ({layer['max_displacement_over_dn']:.2f} "
+            f"D<sub>n</sub>), largest rotation {layer['max_rotation_deg']:.1f}&deg;.</p>"
+            f"<table><tr>{head}</tr>{rows}</table>"
+            "<p class='note'>Displacement: the move of the unit's centroid; along the slope: "
+            "positive up the face; rotation: the angle of the rotation from the reference "
+            "orientation to the present one, about whatever axis.</p>")
+
+
 def write_analysis(out, analysis) -> dict:
     """Every file of one analysed layer in ``out``; returns ``{what: path}``."""
     from riprap.io import analysis_figures as figures
@@ -329,7 +385,7 @@ def write_analysis(out, analysis) -> dict:
                f"S3 {fabric.get('S3', float('nan')):.2f} (random: 0.33 each)"),
         slope_dip_direction_deg=(270.0, slope.angle_deg))
     outputs["stereonet"] = str(out / "stereonet.png")
-    for column in figures.PER_UNIT_FIELDS:
+    for column in figures.drawn_fields(units):
         outputs[f"layer_{column}"] = str(figures.layer_view_png(out / f"layer_{column}.png",
                                                                 analysis, column))
         figures.slope_view_figure(out / f"slope_{column}.png", analysis, column)
@@ -341,7 +397,7 @@ def write_analysis(out, analysis) -> dict:
 
 
 def _write_report(out: Path, analysis) -> Path:
-    from riprap.io.analysis_figures import PER_UNIT_FIELDS
+    from riprap.io.analysis_figures import PER_UNIT_FIELDS, drawn_fields
 
     layer, units = analysis.layer, analysis.units
     histogram = ", ".join(f"{k}: {v}" for k, v in layer["coordination_number_histogram"].items())
@@ -351,7 +407,7 @@ def _write_report(out: Path, analysis) -> Path:
         f"<h2>{html.escape(label[:1].upper() + label[1:])}</h2><div class='figures'>"
         f"<img src='layer_{column}.png' alt='layer, {html.escape(label)}'>"
         f"<img src='slope_{column}.svg' alt='face view, {html.escape(label)}'></div>"
-        for column, (label, _) in PER_UNIT_FIELDS.items())
+        for column, (label, _) in PER_UNIT_FIELDS.items() if column in drawn_fields(units))
     body = (
         f"<p class='note'>Analysed: {html.escape(str(layer['source']))}, t = {layer['time_s']:g} s. "
         f"{layer['units']} {html.escape(layer['unit'])} units (D<sub>n</sub> = "
@@ -359,6 +415,7 @@ def _write_report(out: Path, analysis) -> Path:
         "Tables: <a href='units.csv'>units.csv</a> (one row per unit), "
         "<a href='contacts.csv'>contacts.csv</a>, <a href='layer_summary.json'>layer_summary.json</a>; "
         "ParaView: <code>layer.vtu</code>, <code>underlayer.vtu</code>.</p>"
+        f"{_no_contacts_note(layer)}"
         f"<h2>Summary</h2>{_summary_table([layer], ['this layer'])}"
         f"<h2>Measured against design</h2>{_verdict_table(layer)}"
         "<p class='note'>Design values: the unit's design table (<code>layer.json</code>, "
@@ -374,8 +431,8 @@ def _write_report(out: Path, analysis) -> Path:
         "<img src='stereonet.svg' alt='stereonet of the nose axes'></div>"
         f"{fields}"
         "<h2>Distributions</h2><img class='wide' src='histograms.svg' alt='histograms'>"
-        f"<h2>Units with the smallest factor of safety</h2>{_lowest_fos_table(units)}"
-        f"{_factor_of_safety_notes(layer, units)}"
+        f"{_displacement_section(layer, units)}"
+        f"{_factor_of_safety_section(layer, units)}"
         "<p class='note'>Definitions. Coordination number: bodies and walls a unit touches. Largest "
         "contact force: magnitude of the normal plus friction force of the unit's most loaded "
         "contact. Factor of safety against sliding: sum of mu |N| over sum of |T| of the unit's "
