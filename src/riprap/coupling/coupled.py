@@ -25,6 +25,7 @@ One step of :meth:`CoupledSolver.step`:
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,7 +34,6 @@ from riprap.coupling.kernels import rigid_coupling
 from riprap.coupling.solid_volumes import merge_blocks, rigid_body_cell_volumes
 from riprap.errors import CaseFileError
 from riprap.fluid.solver import FluidSolver
-from riprap.solid.kernels import integrate
 from riprap.solid.solver import SolidSolver
 
 __all__ = ["CoupledSolver", "CoupledStepReport", "fluid_box_walls", "MINIMUM_CELLS_ACROSS"]
@@ -78,6 +78,31 @@ class CoupledStepReport:
     water_volume_error: float
     solid_substeps: int
     max_body_speed: float
+
+
+@dataclass(frozen=True)
+class _FaceSet:
+    """The faces the bodies touch in one step (``rigid_coupling.touched_faces``): every per-face
+    quantity of the coupling is an array over these F faces."""
+
+    axis: np.ndarray          # (F,) 0, 1, 2
+    index: np.ndarray         # (F, 3) index in the face array of its axis
+    phi: np.ndarray           # (F,) summed body fractions
+    capped: np.ndarray        # (F,) min(phi, 1)
+    interior: np.ndarray      # (F,) not a wall face
+    entries: tuple            # (entry_start (bodies + 1,), entry_face (E,), entry_half (E,))
+
+    def empty(self) -> np.ndarray:
+        return np.empty(len(self.axis))
+
+    def zeros(self) -> np.ndarray:
+        return np.zeros(len(self.axis))
+
+    def gather(self, arrays, out) -> None:
+        rigid_coupling.gather(self.axis, self.index, *arrays, out)
+
+    def scatter(self, values, arrays) -> None:
+        rigid_coupling.scatter(self.axis, self.index, values, *arrays)
 
 
 class CoupledSolver:
@@ -131,6 +156,15 @@ class CoupledSolver:
         self.fixed_body_loads = np.zeros((n, 6))
         self.viscous_loads = np.zeros((n, 6))
         self.pressure_loads = np.zeros((n, 6))
+        # A face's place in the step's face set while it is built (-1: none); kept between steps
+        # so that no grid-sized array is made per step.
+        self._slots = np.full(rigid_coupling.face_count(grid.cells), -1, dtype=np.int32)
+        #: Wall time (s) of the last step's parts beyond the fluid's own: solid volumes (clipping
+        #: the moved bodies and listing the faces they touch), the exchange on those faces
+        #: (blends, momentum systems, loads), and the bodies' contact sub-steps.
+        self.last_solid_volume_seconds = 0.0
+        self.last_exchange_seconds = 0.0
+        self.last_solid_seconds = 0.0
         self._check_bodies_in_grid()
 
     # ------------------------------------------------------------------ the run loop's view
@@ -235,6 +269,16 @@ class CoupledSolver:
         return motions
 
     # ------------------------------------------------------------------ the step
+    def _face_set(self) -> _FaceSet:
+        """The faces the bodies' cells touch at their present poses, with per body its entries."""
+        volumes = self._solid_volumes()
+        (axis, index, phi, interior, entry_start, entry_face,
+         entry_half) = rigid_coupling.touched_faces(volumes.origin, volumes.shape, volumes.offset,
+                                                    volumes.values, self.fluid.h ** 3, self._cells,
+                                                    self._slots)
+        return _FaceSet(axis=axis, index=index, phi=phi, capped=np.minimum(phi, 1.0),
+                        interior=interior, entries=(entry_start, entry_face, entry_half))
+
     def step(self, dt: float | None = None) -> CoupledStepReport:
         fluid, solids = self.fluid, self.solids
         dt, courant = fluid.begin_step(dt)
@@ -252,84 +296,87 @@ class CoupledSolver:
                                   solids.angular_momenta + dry[:, 3:] * dt, inertia)
         predicted[~free, :3] = fluid.gravity * dt
 
-        volumes = self._solid_volumes()
-        cell_volume = fluid.h ** 3
-        faces = [np.zeros_like(q) for q in (fluid.u, fluid.v, fluid.w)]
-        arguments = (volumes.origin, volumes.shape, volumes.offset, volumes.values, cell_volume,
-                     self._cells)
-        rigid_coupling.face_fractions(*arguments, *faces)
-        capped = [np.minimum(phi, 1.0) for phi in faces]
-
-        start_density = fluid.cell_density()
-        start_velocities = (fluid.u, fluid.v, fluid.w)
+        started = time.perf_counter()
+        faces = self._face_set()
+        self.last_solid_volume_seconds = time.perf_counter() - started
+        started = time.perf_counter()
+        # Only the faces the bodies touch are read and written: elsewhere the blends below leave
+        # the fluid's own values (phi = 0 there).
+        start_velocity, start_density = faces.empty(), faces.empty()
+        faces.gather((fluid.u, fluid.v, fluid.w), start_velocity)
+        rigid_coupling.face_mean_density(faces.axis, faces.index, faces.interior, fluid.fraction,
+                                         fluid.water.density, fluid.air.density, start_density)
+        exchange_seconds = time.perf_counter() - started
         u, v, w, fluid_densities = fluid.predict(dt)
-        velocities = (u, v, w)
-        fluid_part = [velocity.copy() for velocity in velocities]
+        started = time.perf_counter()
+        fluid_part, rho_fluid = faces.empty(), faces.empty()
+        faces.gather((u, v, w), fluid_part)
+        faces.gather(fluid_densities, rho_fluid)
         densities = np.where(free, self._densities, rigid_coupling.FOLLOWS_FLUID)
-        solid_density = [np.zeros_like(q) for q in velocities]
-        rigid_coupling.accumulate_density(*arguments, densities, *faces, *fluid_densities,
-                                          *solid_density)
+        solid_density = faces.zeros()
+        rigid_coupling.accumulate_density(*faces.entries, densities, faces.phi, rho_fluid,
+                                          solid_density)
         centres = solids.positions
         # What the predictor's fluxes (advection, viscous stress, surface tension) moved across
         # each body's surface is the body's: its faces' momentum change there, less gravity.
-        impulses = []
-        for a in range(3):
-            old = np.zeros_like(start_velocities[a])
-            index = [slice(None)] * 3
-            index[a] = slice(1, -1)
-            low, high = [slice(None)] * 3, [slice(None)] * 3
-            low[a], high[a] = slice(0, -1), slice(1, None)
-            old[tuple(index)] = 0.5 * (start_density[tuple(low)] + start_density[tuple(high)])
-            impulses.append(fluid_densities[a] * (velocities[a] - fluid.gravity[a] * dt)
-                            - old * start_velocities[a])
-        body_mass, transferred = self._transferred(arguments, centres, densities, faces, capped,
-                                                   fluid_densities, impulses)
+        impulses = (rho_fluid * (fluid_part - fluid.gravity[faces.axis] * dt)
+                    - start_density * start_velocity)
+        zero = faces.zeros()
+        matrices, body_matrices, transferred = self._momentum_systems(
+            faces, centres, densities, rho_fluid, [zero], [-impulses * np.maximum(faces.capped, 1e-300)],
+            with_matrices=True)
+        transferred = transferred[:, 0]
         predicted_dry = predicted.copy()
         for b in range(solids.n_bodies):
             if np.any(transferred[b]):
-                predicted[b] += np.linalg.lstsq(body_mass[b], transferred[b], rcond=None)[0]
-        blended_rigid = [np.zeros_like(q) for q in velocities]
-        rigid_momentum = [np.zeros_like(q) for q in velocities]
+                predicted[b] += np.linalg.lstsq(body_matrices[b], transferred[b], rcond=None)[0]
+        blended_rigid, rigid_momentum = faces.zeros(), faces.zeros()
         ones = np.ones(solids.n_bodies)
-        rigid_coupling.accumulate_rigid(*arguments, self._lower, fluid.h, centres, predicted, ones,
-                                        *faces, *fluid_densities, *blended_rigid)
-        rigid_coupling.accumulate_rigid(*arguments, self._lower, fluid.h, centres, predicted,
-                                        densities, *faces, *fluid_densities, *rigid_momentum)
-        mixture, unaccounted = [], []
-        for a in range(3):
-            velocities[a][...] = (1.0 - capped[a]) * fluid_part[a] + blended_rigid[a]
-            density = (1.0 - capped[a]) * fluid_densities[a] + solid_density[a]
-            mixture.append(density)
-            unaccounted.append(density * velocities[a] - (1.0 - capped[a]) * fluid_densities[a]
-                               * fluid_part[a] - rigid_momentum[a])
-        betas = fluid._face_coefficients(mixture)
-        blended = [velocity.copy() for velocity in velocities] if self.check_momentum else None
+        rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
+                                        fluid.h, centres, predicted, ones, faces.phi, rho_fluid,
+                                        blended_rigid)
+        rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
+                                        fluid.h, centres, predicted, densities, faces.phi,
+                                        rho_fluid, rigid_momentum)
+        fluid_share = 1.0 - faces.capped
+        blended = fluid_share * fluid_part + blended_rigid
+        mixture = fluid_share * rho_fluid + solid_density
+        unaccounted = mixture * blended - fluid_share * rho_fluid * fluid_part - rigid_momentum
+        faces.scatter(blended, (u, v, w))
+        # The predictor's face densities are not needed again: they become the mixture's.
+        faces.scatter(mixture, fluid_densities)
+        exchange_seconds += time.perf_counter() - started
+        betas = fluid._face_coefficients(fluid_densities)
         pressure, report = fluid.project(u, v, w, betas, dt)
 
-        n = solids.n_bodies
-        matrices = np.zeros((n, 6, 6))
-        body_matrices = np.zeros((n, 6, 6))
-        rhs = np.zeros((n, 6))
-        rigid_coupling.momentum_systems(*arguments, self._lower, fluid.h, centres, densities,
-                                        *faces, *fluid_densities, u, v, w, *unaccounted, matrices,
-                                        body_matrices, rhs)
-        final = np.zeros((n, 6))
+        started = time.perf_counter()
+        projected, pressure_force = faces.empty(), faces.empty()
+        faces.gather((u, v, w), projected)
+        rigid_coupling.face_pressure_force(faces.axis, faces.index, faces.interior, pressure,
+                                           fluid.h, pressure_force)
+        # The pressure's load rides along as a second right-hand side with no velocity: the
+        # momentum -grad p h^3 over the body's share of its faces (buoyancy and form drag).
+        _, _, rhs = self._momentum_systems(
+            faces, centres, densities, rho_fluid, [projected, zero],
+            [unaccounted, -pressure_force * np.maximum(faces.capped, 1e-300)])
+        rhs, pressure_rhs = rhs[:, 0], rhs[:, 1]
+        final = np.zeros((solids.n_bodies, 6))
         for b in np.flatnonzero(free):
             final[b] = np.linalg.solve(matrices[b], rhs[b])
         # The fluid's load: the body's own momentum change; for a fixed body what holding it
         # still takes (the momentum the fluid gave its faces, less the fall it was blended in with).
         loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted_dry)
                  - np.einsum("bij,bj->bi", matrices - body_matrices, final)) / dt
-        rigid = [np.zeros_like(q) for q in velocities]
-        rigid_coupling.accumulate_rigid(*arguments, self._lower, fluid.h, centres, final, ones,
-                                        *faces, *fluid_densities, *rigid)
-        projected = [velocity.copy() for velocity in velocities] if self.check_momentum else None
-        for a in range(3):
-            velocities[a][...] = (1.0 - capped[a]) * velocities[a] + rigid[a]
+        rigid = faces.zeros()
+        rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
+                                        fluid.h, centres, final, ones, faces.phi, rho_fluid, rigid)
+        after = fluid_share * projected + rigid
+        faces.scatter(after, (u, v, w))
         if self.check_momentum:
             self.last_exchange_balance = self._exchange_balance(
-                capped, fluid_densities, fluid_part, velocities, mixture, blended, projected,
+                faces, fluid_share * rho_fluid, fluid_part, after, mixture, blended, projected,
                 body_matrices, predicted, final, free)
+        exchange_seconds += time.perf_counter() - started
         fluid_report = fluid.finish_step(u, v, w, pressure, report, dt, courant)
 
         # The bodies then move over the step in contact sub-steps with the fluid's load held:
@@ -339,10 +386,12 @@ class CoupledSolver:
         #: The fluid's load on every body (fixed ones too) split into the pressure's (minus the
         #: pressure gradient over the body's share of every face) and the rest: viscous stress,
         #: with the momentum of the no-slip blend and advection (N, N m).
-        self.pressure_loads = self._pressure_loads(arguments, centres, densities, faces, capped,
-                                                   fluid_densities, pressure)
+        self.pressure_loads = pressure_rhs
         self.viscous_loads = loads - self.pressure_loads
+        self.last_exchange_seconds = exchange_seconds
+        started = time.perf_counter()
         substeps = self._advance_solids(dt)
+        self.last_solid_seconds = time.perf_counter() - started
         speeds = np.linalg.norm(solids.velocities[free], axis=1)
         return CoupledStepReport(time=fluid.time, time_step=dt, courant_number=courant,
                                  pressure_iterations=fluid_report.pressure_iterations,
@@ -350,45 +399,30 @@ class CoupledSolver:
                                  solid_substeps=substeps,
                                  max_body_speed=float(speeds.max(initial=0.0)))
 
-    def _transferred(self, arguments, centres, densities, faces, capped, fluid_densities,
-                     impulses):
-        """Each body's own grid mass matrix sum phi_b' rho_b J^T J h^3 (n, 6, 6), and the momentum
-        and angular momentum sum phi_b' J^T i_f h^3 that the face momenta ``impulses`` (per unit
-        volume) give it (n, 6): the momentum system with no velocity and C = -i phi."""
+    def _momentum_systems(self, faces, centres, densities, rho_fluid, velocities, unaccounted,
+                          with_matrices=False):
+        """(M, the body's own part of M, right-hand sides (bodies, r, 6)) of
+        ``rigid_coupling.momentum_systems`` for r right-hand sides at once."""
         n = self.solids.n_bodies
-        zeros = [np.zeros_like(phi) for phi in faces]
-        sources = [-impulse * np.maximum(cap, 1e-300) for impulse, cap in zip(impulses, capped)]
-        matrices, body, rhs = np.zeros((n, 6, 6)), np.zeros((n, 6, 6)), np.zeros((n, 6))
-        rigid_coupling.momentum_systems(*arguments, self._lower, self.fluid.h, centres, densities,
-                                        *faces, *fluid_densities, *zeros, *sources, matrices, body,
-                                        rhs)
-        return body, rhs
+        matrices, body, rhs = np.zeros((n, 6, 6)), np.zeros((n, 6, 6)), np.zeros((n, len(velocities), 6))
+        rigid_coupling.momentum_systems(*faces.entries, faces.axis, faces.index, self._lower,
+                                        self.fluid.h, centres, densities, faces.phi, rho_fluid,
+                                        np.array(velocities), np.array(unaccounted), with_matrices,
+                                        matrices, body, rhs)
+        return matrices, body, rhs
 
-    def _pressure_loads(self, arguments, centres, densities, faces, capped, fluid_densities,
-                        pressure) -> np.ndarray:
-        """-sum phi_b' J^T grad p h^3 for every body (n, 6): buoyancy and form drag."""
-        h = self.fluid.h
-        gradients = []
-        for a in range(3):
-            gradient = np.zeros_like(faces[a])
-            index = [slice(None)] * 3
-            index[a] = slice(1, -1)
-            gradient[tuple(index)] = -np.diff(pressure, axis=a) / h
-            gradients.append(gradient)
-        return self._transferred(arguments, centres, densities, faces, capped, fluid_densities,
-                                 gradients)[1]
-
-    def _exchange_balance(self, capped, fluid_densities, before, after, mixture, blended,
+    def _exchange_balance(self, faces, fluid_share, before, after, mixture, blended,
                           projected, body_matrices, predicted, final, free) -> np.ndarray:
         """Momentum of fluid and free bodies after the exchange, less before, less the pressure's
-        impulse (which only the walls do not return): zero to round-off (N s, per axis)."""
+        impulse (which only the walls do not return): zero to round-off (N s, per axis). Faces the
+        bodies do not touch add nothing (there the fluid's share is the whole face, and the blend
+        leaves the velocity as it was), so only the touched faces are summed."""
         volume = self.fluid.h ** 3
-        interior = (np.s_[1:-1], np.s_[:, 1:-1], np.s_[:, :, 1:-1])
         balance = np.zeros(3)
         for a in range(3):
-            fluid_share = ((1.0 - capped[a]) * fluid_densities[a])[interior[a]]
-            balance[a] = volume * (np.sum(fluid_share * (after[a] - before[a])[interior[a]])
-                                   - np.sum((mixture[a] * (projected[a] - blended[a]))[interior[a]]))
+            on = faces.interior & (faces.axis == a)
+            balance[a] = volume * (np.sum((fluid_share * (after - before))[on])
+                                   - np.sum((mixture * (projected - blended))[on]))
         bodies = np.einsum("bij,bj->bi", body_matrices[free], final[free] - predicted[free])
         return balance + bodies[:, :3].sum(axis=0)
 

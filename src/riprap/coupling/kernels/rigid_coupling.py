@@ -1,19 +1,28 @@
 """Kernels of the rigidity-constraint coupling: bodies as regions of the one-fluid velocity field.
 
 Every body is held on the staggered fluid grid as blocks of exact cell volumes
-(``tet_cell_volumes``). The solid fraction of a face's control volume (half of each neighbouring
-cell) is the mean of the two cells' fractions. With ``c`` a cell's solid fraction of one body, each
-of the cell's two faces along an axis receives ``c / 2``; sums over a body's faces are therefore
-done cell by cell, half to each face, which needs no face-sized block per body.
+(``tet_cell_volumes``, ``surface_cell_volumes``). The solid fraction of a face's control volume
+(half of each neighbouring cell) is the mean of the two cells' fractions. With ``c`` a cell's solid
+fraction of one body, each of the cell's two faces along an axis receives ``c / 2``.
+
+The coupling works on the faces the bodies touch only, never on the whole grid: ``touched_faces``
+lists them once per step (a compact face set), every per-face quantity of the coupling is an
+array over that set, gathered from and scattered to the grid's face arrays, and per body the
+(face, half cell fraction) entries say which faces are its own. So the coupling's cost follows the
+cells near the bodies, not the grid.
 
 Symbols (``docs/coupling.md``): phi the face's total solid fraction, capped at 1 (each body's share
 scaled down by the same factor where bodies overlap); ``x = (U, omega)`` a body's rigid motion;
 ``J = [e_a, rho x e_a]`` the map from x to the velocity component a at a face at ``rho = r - X``.
-Interior faces only: wall faces keep their boundary velocity.
+Body entries are interior faces only: wall faces keep their boundary velocity.
+
+Face set arrays: ``face_axis`` (F,), ``face_index`` (F, 3) the face's index in its axis's face
+array, ``entry_start`` (bodies + 1,), ``entry_face`` (E,) slots into the face set, ``entry_half``
+(E,) the half cell fraction a body's cell gives that face (once per cell and face).
 """
 import numpy as np
 
-from riprap._jit import kernel
+from riprap._jit import kernel, parallel_kernel, prange
 
 #: A body density that stands for the fluid's on each face: fixed bodies take it, so that water
 #: at rest around them stays exactly at rest (their own density never matters: they do not move).
@@ -21,166 +30,211 @@ FOLLOWS_FLUID = -1.0
 
 
 @kernel
-def face_fractions(origin, shape, offset, values, cell_volume, cells, phi_x, phi_y, phi_z):
-    """Add every body's solid fraction to the faces: phi_a (face arrays, zeroed by the caller)."""
-    for b in range(origin.shape[0]):
-        i0, j0, k0 = origin[b, 0], origin[b, 1], origin[b, 2]
+def _face_key(axis, i, j, k, cells):
+    """Position of face (axis, i, j, k) in one flat numbering of the three face arrays."""
+    nx, ny, nz = cells[0], cells[1], cells[2]
+    if axis == 0:
+        return (i * ny + j) * nz + k
+    base = (nx + 1) * ny * nz
+    if axis == 1:
+        return base + (i * (ny + 1) + j) * nz + k
+    return base + nx * (ny + 1) * nz + (i * ny + j) * (nz + 1) + k
+
+
+def face_count(cells) -> int:
+    """Number of faces of the three face arrays together (the size of ``touched_faces``' slots)."""
+    nx, ny, nz = (int(n) for n in cells)
+    return (nx + 1) * ny * nz + nx * (ny + 1) * nz + nx * ny * (nz + 1)
+
+
+@kernel
+def touched_faces(origin, shape, offset, values, cell_volume, cells, slots):
+    """The faces that any body's cells touch, and per body its entries.
+
+    ``slots`` (``face_count(cells)``,) int32, all -1 on entry and on return: a face's place in the
+    set while it is built (kept between steps so that no grid-sized array is made per step).
+    Returns face_axis (F,), face_index (F, 3), phi (F,) the faces' summed body fractions
+    (uncapped; wall faces too), interior (F,) bool, entry_start (bodies + 1,), entry_face (E,),
+    entry_half (E,). Bodies, cells (C order), axes and sides are visited in a fixed order, so
+    every sum is the same whatever the step.
+    """
+    bodies = origin.shape[0]
+    most = 0
+    for n in range(values.shape[0]):
+        if values[n] != 0.0:
+            most += 6
+    face_axis = np.empty(most, dtype=np.int64)
+    face_index = np.empty((most, 3), dtype=np.int64)
+    face_key = np.empty(most, dtype=np.int64)
+    phi = np.zeros(most)
+    interior = np.empty(most, dtype=np.bool_)
+    entry_start = np.zeros(bodies + 1, dtype=np.int64)
+    entry_face = np.empty(most, dtype=np.int64)
+    entry_half = np.empty(most)
+    n_faces = 0
+    n_entries = 0
+    for b in range(bodies):
         bi, bj, bk = shape[b, 0], shape[b, 1], shape[b, 2]
-        base = offset[b]
         for p in range(bi):
             for q in range(bj):
                 for s in range(bk):
-                    c = values[base + (p * bj + q) * bk + s] / cell_volume
+                    c = values[offset[b] + (p * bj + q) * bk + s] / cell_volume
                     if c == 0.0:
                         continue
-                    i, j, k = i0 + p, j0 + q, k0 + s
                     half = 0.5 * c
-                    phi_x[i, j, k] += half
-                    phi_x[i + 1, j, k] += half
-                    phi_y[i, j, k] += half
-                    phi_y[i, j + 1, k] += half
-                    phi_z[i, j, k] += half
-                    phi_z[i, j, k + 1] += half
+                    for axis in range(3):
+                        for side in range(2):
+                            i = origin[b, 0] + p + (side if axis == 0 else 0)
+                            j = origin[b, 1] + q + (side if axis == 1 else 0)
+                            k = origin[b, 2] + s + (side if axis == 2 else 0)
+                            key = _face_key(axis, i, j, k, cells)
+                            slot = slots[key]
+                            if slot < 0:
+                                slot = n_faces
+                                slots[key] = slot
+                                face_axis[slot] = axis
+                                face_index[slot, 0] = i
+                                face_index[slot, 1] = j
+                                face_index[slot, 2] = k
+                                face_key[slot] = key
+                                along = i if axis == 0 else (j if axis == 1 else k)
+                                interior[slot] = 0 < along < cells[axis]
+                                n_faces += 1
+                            phi[slot] += half
+                            if interior[slot]:
+                                entry_face[n_entries] = slot
+                                entry_half[n_entries] = half
+                                n_entries += 1
+        entry_start[b + 1] = n_entries
+    for f in range(n_faces):
+        slots[face_key[f]] = -1
+    return (face_axis[:n_faces], face_index[:n_faces], phi[:n_faces], interior[:n_faces],
+            entry_start, entry_face[:n_entries], entry_half[:n_entries])
 
 
 @kernel
-def _face_position(axis, i, j, k, lower, h, out):
-    out[0] = lower[0] + (i + (0.0 if axis == 0 else 0.5)) * h
-    out[1] = lower[1] + (j + (0.0 if axis == 1 else 0.5)) * h
-    out[2] = lower[2] + (k + (0.0 if axis == 2 else 0.5)) * h
+def gather(face_axis, face_index, on_x, on_y, on_z, out):
+    """out[f] = the value of face f in the face arrays of the three axes."""
+    for f in range(face_axis.shape[0]):
+        i, j, k = face_index[f, 0], face_index[f, 1], face_index[f, 2]
+        axis = face_axis[f]
+        if axis == 0:
+            out[f] = on_x[i, j, k]
+        elif axis == 1:
+            out[f] = on_y[i, j, k]
+        else:
+            out[f] = on_z[i, j, k]
 
 
 @kernel
-def _jacobian(axis, rho, out):
-    """J = [e_a, rho x e_a] (6,)."""
-    for m in range(6):
-        out[m] = 0.0
-    out[axis] = 1.0
+def scatter(face_axis, face_index, values, on_x, on_y, on_z):
+    """Face f of the face arrays of the three axes = values[f]."""
+    for f in range(face_axis.shape[0]):
+        i, j, k = face_index[f, 0], face_index[f, 1], face_index[f, 2]
+        axis = face_axis[f]
+        if axis == 0:
+            on_x[i, j, k] = values[f]
+        elif axis == 1:
+            on_y[i, j, k] = values[f]
+        else:
+            on_z[i, j, k] = values[f]
+
+
+@kernel
+def _cells_of_face(axis, index, cell_values):
+    """The cell values on the low and high side of the interior face (axis, index)."""
+    i, j, k = index[0], index[1], index[2]
+    high = cell_values[i, j, k]
     if axis == 0:
-        out[4] = rho[2]
-        out[5] = -rho[1]
-    elif axis == 1:
-        out[3] = -rho[2]
-        out[5] = rho[0]
-    else:
-        out[3] = rho[1]
-        out[4] = -rho[0]
-
-
-@kernel
-def _interior(axis, i, j, k, cells):
-    index = i if axis == 0 else (j if axis == 1 else k)
-    return 0 < index < cells[axis]
-
-
-@kernel
-def _pick(axis, i, j, k, on_x, on_y, on_z):
-    """The value of the face (axis, i, j, k) from the face arrays of the three axes."""
-    if axis == 0:
-        return on_x[i, j, k]
+        return cell_values[i - 1, j, k], high
     if axis == 1:
-        return on_y[i, j, k]
-    return on_z[i, j, k]
+        return cell_values[i, j - 1, k], high
+    return cell_values[i, j, k - 1], high
 
 
 @kernel
-def _add(axis, i, j, k, value, on_x, on_y, on_z):
-    """Add value to the face (axis, i, j, k) of the face arrays of the three axes."""
+def face_mean_density(face_axis, face_index, interior, fraction, water_density, air_density, out):
+    """Mean density of the two cells of each interior face from the water fraction (0 on walls):
+    the face density a fluid step starts from."""
+    for f in range(face_axis.shape[0]):
+        if not interior[f]:
+            out[f] = 0.0
+            continue
+        low, high = _cells_of_face(face_axis[f], face_index[f], fraction)
+        low_density = low * water_density + (1.0 - low) * air_density
+        high_density = high * water_density + (1.0 - high) * air_density
+        out[f] = 0.5 * (low_density + high_density)
+
+
+@kernel
+def face_pressure_force(face_axis, face_index, interior, pressure, h, out):
+    """-grad p on each interior face (0 on walls): the pressure's force per unit volume."""
+    for f in range(face_axis.shape[0]):
+        if not interior[f]:
+            out[f] = 0.0
+            continue
+        low, high = _cells_of_face(face_axis[f], face_index[f], pressure)
+        out[f] = -(high - low) / h
+
+
+@kernel
+def _face_jacobian(axis, index, lower, h, centre, jac):
+    """J = [e_a, rho x e_a] (6,) of the face (axis, index) for a body centred at ``centre``."""
+    rho = np.empty(3)
+    for a in range(3):
+        rho[a] = lower[a] + (index[a] + (0.0 if axis == a else 0.5)) * h - centre[a]
+    for m in range(6):
+        jac[m] = 0.0
+    jac[axis] = 1.0
     if axis == 0:
-        on_x[i, j, k] += value
+        jac[4] = rho[2]
+        jac[5] = -rho[1]
     elif axis == 1:
-        on_y[i, j, k] += value
+        jac[3] = -rho[2]
+        jac[5] = rho[0]
     else:
-        on_z[i, j, k] += value
+        jac[3] = rho[1]
+        jac[4] = -rho[0]
 
 
 @kernel
-def _body_faces(origin, shape, offset, values, cell_volume, cells, b):
-    """The interior faces that body b's cells touch, once per (cell, face): axes (m,), indices
-    (m, 3) and the half cell fraction each receives (m,)."""
-    bi, bj, bk = shape[b, 0], shape[b, 1], shape[b, 2]
-    count = 0
-    for n in range(bi * bj * bk):
-        if values[offset[b] + n] != 0.0:
-            count += 6
-    axes = np.empty(count, dtype=np.int64)
-    indices = np.empty((count, 3), dtype=np.int64)
-    halves = np.empty(count)
-    m = 0
-    for p in range(bi):
-        for q in range(bj):
-            for s in range(bk):
-                c = values[offset[b] + (p * bj + q) * bk + s] / cell_volume
-                if c == 0.0:
-                    continue
-                for axis in range(3):
-                    for side in range(2):
-                        i = origin[b, 0] + p + (side if axis == 0 else 0)
-                        j = origin[b, 1] + q + (side if axis == 1 else 0)
-                        k = origin[b, 2] + s + (side if axis == 2 else 0)
-                        if not _interior(axis, i, j, k, cells):
-                            continue
-                        axes[m] = axis
-                        indices[m, 0], indices[m, 1], indices[m, 2] = i, j, k
-                        halves[m] = 0.5 * c
-                        m += 1
-    return axes[:m], indices[:m], halves[:m]
-
-
-@kernel
-def _face_jacobian(axis, i, j, k, lower, h, centre, position, rho, jac):
-    _face_position(axis, i, j, k, lower, h, position)
-    for m in range(3):
-        rho[m] = position[m] - centre[m]
-    _jacobian(axis, rho, jac)
-
-
-@kernel
-def accumulate_rigid(origin, shape, offset, values, cell_volume, cells, lower, h, centres, motions,
-                     weights, phi_x, phi_y, phi_z, fluid_x, fluid_y, fluid_z, out_x, out_y, out_z):
-    """out_a += sum over bodies of weight_b phi_b' (J x_b)_a on interior faces, phi_b' the body's
+def accumulate_rigid(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
+                     motions, weights, phi, fluid_density, out):
+    """out[f] += sum over bodies of weight_b phi_b' (J x_b) on the set's faces, phi_b' the body's
     share scaled by 1 / max(1, phi): the rigid part of a blended velocity (weights 1) or of the
     momentum density (weights rho_b). A negative weight stands for the fluid's density on the face
     (``FOLLOWS_FLUID``)."""
-    position = np.empty(3)
-    rho = np.empty(3)
     jac = np.empty(6)
-    for b in range(origin.shape[0]):
+    for b in range(entry_start.shape[0] - 1):
         if weights[b] == 0.0:
             continue
-        axes, indices, halves = _body_faces(origin, shape, offset, values, cell_volume, cells, b)
-        for f in range(axes.shape[0]):
-            axis, i, j, k = axes[f], indices[f, 0], indices[f, 1], indices[f, 2]
-            share = halves[f] / max(1.0, _pick(axis, i, j, k, phi_x, phi_y, phi_z))
-            weight = (_pick(axis, i, j, k, fluid_x, fluid_y, fluid_z) if weights[b] < 0.0
-                      else weights[b])
-            _face_jacobian(axis, i, j, k, lower, h, centres[b], position, rho, jac)
+        for e in range(entry_start[b], entry_start[b + 1]):
+            f = entry_face[e]
+            share = entry_half[e] / max(1.0, phi[f])
+            weight = fluid_density[f] if weights[b] < 0.0 else weights[b]
+            _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac)
             value = 0.0
             for m in range(6):
                 value += jac[m] * motions[b, m]
             value *= weight * share
-            _add(axis, i, j, k, value, out_x, out_y, out_z)
+            out[f] += value
 
 
 @kernel
-def accumulate_density(origin, shape, offset, values, cell_volume, cells, densities, phi_x, phi_y,
-                       phi_z, fluid_x, fluid_y, fluid_z, out_x, out_y, out_z):
-    """out_a += sum over bodies of phi_b' rho_b on interior faces (the solid part of the mixture
+def accumulate_density(entry_start, entry_face, entry_half, densities, phi, fluid_density, out):
+    """out[f] += sum over bodies of phi_b' rho_b on the set's faces (the solid part of the mixture
     density); a negative density stands for the fluid's on the face (``FOLLOWS_FLUID``)."""
-    for b in range(origin.shape[0]):
-        axes, indices, halves = _body_faces(origin, shape, offset, values, cell_volume, cells, b)
-        for f in range(axes.shape[0]):
-            axis, i, j, k = axes[f], indices[f, 0], indices[f, 1], indices[f, 2]
-            rho = (_pick(axis, i, j, k, fluid_x, fluid_y, fluid_z) if densities[b] < 0.0
-                   else densities[b])
-            value = halves[f] * rho / max(1.0, _pick(axis, i, j, k, phi_x, phi_y, phi_z))
-            _add(axis, i, j, k, value, out_x, out_y, out_z)
+    for b in range(entry_start.shape[0] - 1):
+        for e in range(entry_start[b], entry_start[b + 1]):
+            f = entry_face[e]
+            rho = fluid_density[f] if densities[b] < 0.0 else densities[b]
+            out[f] += entry_half[e] * rho / max(1.0, phi[f])
 
 
-@kernel
-def momentum_systems(origin, shape, offset, values, cell_volume, cells, lower, h, centres,
-                     densities, phi_x, phi_y, phi_z, fluid_x, fluid_y, fluid_z, u, v, w, c_x, c_y,
-                     c_z, matrices, body_matrices, rhs):
+@parallel_kernel
+def momentum_systems(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
+                     densities, phi, fluid_density, velocities, unaccounted, with_matrices,
+                     matrices, body_matrices, rhs):
     """For every body the 6 x 6 system M x = r of its rigid motion after the projection:
 
         M = sum_f w_f J_f^T J_f,  r = sum_f J_f^T (w_f u_f - C_f phi_b' / phi),
@@ -190,37 +244,43 @@ def momentum_systems(origin, shape, offset, values, cell_volume, cells, lower, h
     of every face at the blended velocity, the body's at its rigid one) equal those before the
     coupling, up to the pressure's impulse on the walls (``docs/coupling.md``). ``C`` is the
     mixture's momentum density that the blending before the projection left unaccounted.
-    ``body_matrices``: the body's own part of M (weights phi_b' rho_b), whose product with a motion
-    is the body's momentum on the grid."""
-    position = np.empty(3)
-    rho = np.empty(3)
-    jac = np.empty(6)
+
+    ``velocities`` and ``unaccounted`` (r, F): r right-hand sides at once, ``rhs`` (bodies, r, 6).
+    With ``with_matrices``, also M and ``body_matrices``, the body's own part of M (weights
+    phi_b' rho_b), whose product with a motion is the body's momentum on the grid. Each body's sums
+    are its own (threads over bodies), in the order of its entries.
+    """
     volume = h * h * h
-    for b in range(origin.shape[0]):
-        for m in range(6):
-            rhs[b, m] = 0.0
-            for n in range(6):
-                matrices[b, m, n] = 0.0
-                body_matrices[b, m, n] = 0.0
-        axes, indices, halves = _body_faces(origin, shape, offset, values, cell_volume, cells, b)
-        for f in range(axes.shape[0]):
-            axis, i, j, k = axes[f], indices[f, 0], indices[f, 1], indices[f, 2]
-            phi = _pick(axis, i, j, k, phi_x, phi_y, phi_z)
-            rho_f = _pick(axis, i, j, k, fluid_x, fluid_y, fluid_z)
-            velocity = _pick(axis, i, j, k, u, v, w)
-            unaccounted = _pick(axis, i, j, k, c_x, c_y, c_z)
-            share = halves[f] / max(1.0, phi)
-            capped = min(phi, 1.0)
+    n_rhs = velocities.shape[0]
+    for b in prange(entry_start.shape[0] - 1):
+        jac = np.empty(6)
+        for r in range(n_rhs):
+            for m in range(6):
+                rhs[b, r, m] = 0.0
+        if with_matrices:
+            for m in range(6):
+                for n in range(6):
+                    matrices[b, m, n] = 0.0
+                    body_matrices[b, m, n] = 0.0
+        for e in range(entry_start[b], entry_start[b + 1]):
+            f = entry_face[e]
+            phi_f = phi[f]
+            rho_f = fluid_density[f]
+            share = entry_half[e] / max(1.0, phi_f)
+            capped = min(phi_f, 1.0)
             own = rho_f if densities[b] < 0.0 else densities[b]
             weight = share * ((1.0 - capped) * rho_f + own) * volume
             own_weight = share * own * volume
-            source = weight * velocity - unaccounted * volume * share / capped
-            _face_jacobian(axis, i, j, k, lower, h, centres[b], position, rho, jac)
-            for m in range(6):
-                if jac[m] == 0.0:
-                    continue
-                rhs[b, m] += jac[m] * source
-                for n in range(6):
-                    matrices[b, m, n] += weight * jac[m] * jac[n]
-                    body_matrices[b, m, n] += own_weight * jac[m] * jac[n]
-
+            _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac)
+            for r in range(n_rhs):
+                source = weight * velocities[r, f] - unaccounted[r, f] * volume * share / capped
+                for m in range(6):
+                    if jac[m] != 0.0:
+                        rhs[b, r, m] += jac[m] * source
+            if with_matrices:
+                for m in range(6):
+                    if jac[m] == 0.0:
+                        continue
+                    for n in range(6):
+                        matrices[b, m, n] += weight * jac[m] * jac[n]
+                        body_matrices[b, m, n] += own_weight * jac[m] * jac[n]
