@@ -25,45 +25,41 @@ from riprap.errors import CaseFileError, RiprapError
 
 def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> int:
     from riprap.case.build import build_simulation
+    from riprap.case.build_fluid import build_fluid_run
     from riprap.case.load import load_case
 
     case = load_case(path)
     _say_if_smoke()
-    if case.is_fluid:
-        return _run_fluid_case(case, path, out, restart, quiet)
     if case.is_placement:
         raise CaseFileError(f"{path} describes an armour placement: build the layer with "
                             f"'riprap place {path} --out DIR', then run DIR/pack.toml")
-    print(f"riprap: case {path}: {case.body_count} bodies, {len(case.shapes)} shapes, "
-          f"{len(case.walls)} wall entries")
-    print("riprap: contact pairs combine materials by the smaller friction coefficient, the smaller "
-          "restitution and the smaller contact_penalty")
-    sim = build_simulation(case, output_directory=out, progress=not quiet)
+    if case.is_fluid:
+        sim = build_fluid_run(case, output_directory=out, progress=not quiet)
+        grid = sim.fluid.grid
+        bodies = f", {sim.solver.n_bodies} bodies coupled to the flow" if sim.coupled else ""
+        print(f"riprap: fluid case {path}: {grid.cells[0]} x {grid.cells[1]} x {grid.cells[2]} "
+              f"cells of {grid.cell_size:.4g} m ({'2D' if grid.two_dimensional else '3D'}), water "
+              f"{sim.fluid.water_volume():.4g} m^3{bodies}")
+    else:
+        print(f"riprap: case {path}: {case.body_count} bodies, {len(case.shapes)} shapes, "
+              f"{len(case.walls)} wall entries")
+        sim = build_simulation(case, output_directory=out, progress=not quiet)
+    if sim.solver.n_bodies:
+        print("riprap: contact pairs combine materials by the smaller friction coefficient, the "
+              "smaller restitution and the smaller contact_penalty")
     summary = sim.run(restart_from=restart)
-    print(f"riprap: {summary.end_reason} at t = {summary.simulated_time:.4f} s after {summary.steps} "
-          f"steps of {summary.time_step:.3e} s in {summary.wall_time:.1f} s "
-          f"({summary.body_steps_per_second:,.0f} body-steps/s); {summary.contacts} contacts, "
-          f"max speed {summary.max_speed:.3g} m/s")
-    for key, value in summary.outputs.items():
-        print(f"riprap: {key}: {value}")
-    return 0
-
-
-def _run_fluid_case(case, path: Path, out: str | None, restart: str | None, quiet: bool) -> int:
-    from riprap.case.build_fluid import build_fluid_run
-
-    run = build_fluid_run(case, output_directory=out, progress=not quiet)
-    grid = run.fluid.grid
-    bodies = (f", {run.solver.solids.n_bodies} bodies coupled to the flow" if run.coupled else "")
-    print(f"riprap: fluid case {path}: {grid.cells[0]} x {grid.cells[1]} x {grid.cells[2]} cells of "
-          f"{grid.cell_size:.4g} m ({'2D' if grid.two_dimensional else '3D'}), water "
-          f"{run.fluid.water_volume():.4g} m^3{bodies}")
-    summary = run.run(restart_from=restart)
-    print(f"riprap: {summary.end_reason} at t = {summary.simulated_time:.4f} s after {summary.steps} "
-          f"steps ({summary.time_step_min:.2e}..{summary.time_step_max:.2e} s) in "
-          f"{summary.wall_time:.1f} s ({summary.cell_updates_per_second:,.0f} cell-updates/s); "
-          f"water volume error {summary.water_volume_error:.1e}, pressure iterations "
-          f"{summary.pressure_iterations_mean:.1f} (max {summary.pressure_iterations_max})")
+    print(f"riprap: {summary.end_reason} at t = {summary.simulated_time:.4f} s after "
+          f"{summary.steps} steps in {summary.wall_time:.1f} s")
+    if summary.cells is not None:
+        print(f"riprap: fluid: time steps {summary.time_step_min:.2e}..{summary.time_step_max:.2e} "
+              f"s, {summary.cell_updates_per_second:,.0f} cell-updates/s; water volume error "
+              f"{summary.water_volume_error:.1e}, pressure iterations "
+              f"{summary.pressure_iterations_mean:.1f} (max {summary.pressure_iterations_max})")
+    if summary.bodies is not None:
+        steps = (f"steps of {summary.time_step:.3e} s" if summary.time_step is not None
+                 else f"{summary.solid_substeps} contact sub-steps")
+        print(f"riprap: bodies: {steps} ({summary.body_steps_per_second:,.0f} body-steps/s); "
+              f"{summary.contacts} contacts, max speed {summary.max_speed:.3g} m/s")
     for key, value in summary.outputs.items():
         print(f"riprap: {key}: {value}")
     return 0

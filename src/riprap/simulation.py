@@ -1,12 +1,14 @@
-"""Simulation: the user-facing run of a rigid FEMDEM case.
+"""Simulation: the one user-facing run, of rigid bodies, of air and water, or of both coupled.
 
-It owns the clock and the schedule of periodic work (ParaView frames, checkpoints, progress, the
-rest check) around :class:`riprap.solid.solver.SolidSolver`, which owns the physics. A run that
-fails (non-finite state) writes a checkpoint of the last good state and says which body and when.
+It builds the bodies (shapes, materials, walls: :class:`riprap.solid.solver.SolidSolver`), takes
+a fluid (:class:`riprap.fluid.solver.FluidSolver`) when one is given, and runs them as one model
+(:mod:`riprap.models`): rigid bodies alone, the fluid alone, or the two coupled
+(:class:`riprap.coupling.coupled.CoupledSolver`). It owns the schedule of periodic work (frames,
+checkpoints, progress, the rest check) and the failure checkpoint; the models own the physics. A
+run that fails writes a checkpoint of the last good state and says what failed, where and when.
 """
 from __future__ import annotations
 
-import math
 import os
 import time as wallclock
 from dataclasses import dataclass, field
@@ -14,10 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from riprap.errors import CaseFileError, InstabilityError, RiprapError
+from riprap.errors import CaseFileError, InstabilityError, OverlapError, RiprapError
 from riprap.work_estimate import check_rigid_run
 from riprap.geometry.tetmesh import TetMesh
-from riprap.solid.kernels import interactions
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
 from riprap.solid.solver import SolidSolver
@@ -33,53 +34,59 @@ _RUNAWAY_SPEED = 1.0e3
 _MAX_STABILITY_RATIO = 0.5
 # A body rests when its net force is below this fraction of its weight (and it is slow).
 _REST_FORCE_RATIO = 0.1
-# Adaptive time step (``adaptive_time_step``): grow by _STEP_GROWTH while the measured stability
-# ratio stays below _GROW_BELOW_RATIO, cut by _STEP_CUT (from the last good state) when a chunk
-# goes above _MAX_STABILITY_RATIO or blows up; never above _MAX_STEP_OVER_ESTIMATE times the
-# automatic estimate nor below _MIN_STEP_OVER_ESTIMATE times it.
-_GROW_BELOW_RATIO = 0.2
-_STEP_GROWTH = 1.25
-_STEP_CUT = 0.5
-_MAX_STEP_OVER_ESTIMATE = 30.0
-_MIN_STEP_OVER_ESTIMATE = 1e-3
 _MAX_MOTION_PER_STEP = 0.1
 # Gravity above this (m/s^2) is named as the likely cause of a blow-up (a centrifuge model runs
 # at tens of g; more is a typo).
 _ABSURD_GRAVITY = 1000.0
-_ADAPT_CHUNK_STEPS = 50
-# Wall-clock seconds between progress updates (and rest checks).
-_PROGRESS_PERIOD = 0.25
 
 
 @dataclass
 class RunSummary:
-    """What a run did. Written as ``summary.json`` in the output directory."""
+    """What a run did. Written as ``summary.json`` in the output directory.
+
+    The fields every run has come first; the model's own figures follow and are None (and left
+    out of ``summary.json``) where a model has none: rigid runs report bodies, contacts and
+    body-steps/s, fluid runs cells, Courant numbers and the water volume error, coupled runs both.
+    """
 
     end_reason: str
     simulated_time: float
     steps: int
-    time_step: float
     wall_time: float
-    body_steps_per_second: float
-    bodies: int
-    contacts: int
-    kinetic_energy: float
-    max_speed: float
     frames: int
-    stability_ratio_max: float = 0.0
-    time_step_min: float = 0.0
-    time_step_max: float = 0.0
-    time_step_cuts: int = 0
+    model: str = "rigid"         # "rigid", "fluid" or "coupled"
     outputs: dict = field(default_factory=dict)
     case_file: str = ""          # the case file run (absolute), "" when built in Python
     smoke: bool = False          # RIPRAP_SMOKE=1 cut the run short: its figures are not results
+    # bodies (rigid and coupled runs)
+    bodies: int | None = None
+    contacts: int | None = None
+    time_step: float | None = None
+    body_steps_per_second: float | None = None
+    kinetic_energy: float | None = None
+    max_speed: float | None = None
+    stability_ratio_max: float | None = None
+    time_step_cuts: int | None = None
+    solid_substeps: int | None = None
+    # time steps taken (the contact step of a rigid run, the fluid's step of a fluid run)
+    time_step_min: float | None = None
+    time_step_max: float | None = None
+    # fluid (fluid and coupled runs)
+    cells: int | None = None
+    cell_updates_per_second: float | None = None
+    courant_number_max: float | None = None
+    water_volume_error: float | None = None
+    pressure_iterations_mean: float | None = None
+    pressure_iterations_max: int | None = None
+    pressure_time_share: float | None = None
 
     def as_dict(self) -> dict:
-        return dict(self.__dict__)
+        return {key: value for key, value in self.__dict__.items() if value is not None}
 
 
 class Simulation:
-    """A rigid-body run: shapes, materials, bodies, walls, a clock and outputs.
+    """A run: rigid bodies (shapes, materials, bodies, walls), air and water (``fluid``), or
+    bodies in the flow (both), with a clock and outputs.
 
     Parameters (keyword-only, SI units; the same names as the ``[simulation]`` and ``[output]``
     tables of a case file)
@@ -90,7 +97,7 @@ class Simulation:
         Time step (s); 0 means automatic: ``time_step_safety`` times the critical step estimated
         from body masses and contact stiffness.
     gravity : (3,) float
-        m/s^2.
+        m/s^2; left at its default (0, 0, -9.81) with a fluid given, the fluid's.
     output_interval : float
         Simulated seconds between ParaView frames.
     checkpoint_interval : float
@@ -112,6 +119,10 @@ class Simulation:
         Write a ``.pvd`` series / a PNG of the final state.
     progress : bool
         Show a progress bar on the terminal.
+    fluid : FluidSolver, optional
+        The flow: with no bodies the run is a fluid run; with bodies they move in it, two-way
+        coupled (``docs/coupling.md``), and ``time_step`` / ``time_step_safety`` set the contact
+        sub-step inside each fluid step (the fluid's own step follows its Courant number).
     """
 
     def __init__(self, *, end_time: float, time_step: float = 0.0, time_step_safety: float = 0.2,
@@ -119,7 +130,7 @@ class Simulation:
                  checkpoint_interval: float = 0.0, local_damping: float = 0.0,
                  rest_speed: float = 0.0, output_directory="riprap-out", paraview: bool = True,
                  picture: bool = True, progress: bool = True, rest_kinetic_energy: float = 0.0,
-                 adaptive_time_step: bool = False):
+                 adaptive_time_step: bool = False, fluid=None):
         _require(end_time > 0, "end_time", end_time, "> 0 s")
         _require(time_step >= 0, "time_step", time_step, ">= 0 s (0 = automatic)")
         _require(0 < time_step_safety <= 1, "time_step_safety", time_step_safety, "in (0, 1]")
@@ -143,13 +154,20 @@ class Simulation:
         # summary.json so that `riprap analyse RUN` finds the pack a run started from.
         self.case_file = ""
         self.progress = bool(progress)
+        if fluid is not None and tuple(np.asarray(gravity, dtype=float)) == (0.0, 0.0, -9.81):
+            gravity = fluid.gravity
         self.solver = SolidSolver(gravity=gravity, local_damping=local_damping)
         self._shape_names: dict[str, int] = {}
         self._meshes: list[TetMesh] = []
         self.container_box = None
-        self._frame_index = 0
-        self._checkpoint_index = 1
+        self._frame_index = 0            # frames written on the schedule (next at index * interval)
+        self._checkpoints_written = 0    # periodic checkpoints (next at (count + 1) * interval)
         self._restarted = False
+        self._model = None
+        #: The flow the bodies move in (:meth:`add_fluid`), or None for a dry run.
+        self.fluid = None
+        if fluid is not None:
+            self.add_fluid(fluid)
         # Pairs allowed to overlap at the start, up to a depth (m): a pack's resting contacts.
         self.accepted_overlaps: dict[tuple[int, int], float] = {}
 
@@ -191,8 +209,56 @@ class Simulation:
             self.container_box = container_box
 
     # ------------------------------------------------------------------ running
+    def add_fluid(self, fluid) -> None:
+        """Put the run in a flow: a :class:`riprap.fluid.solver.FluidSolver` (the bodies, if any,
+        are coupled to it when the run starts) or a ready
+        :class:`riprap.coupling.coupled.CoupledSolver`."""
+        if self._model is not None:
+            raise RiprapError("add_fluid: the run is already prepared; add the fluid first")
+        self.fluid = fluid
+
+    @property
+    def model(self):
+        """What the run loop advances (:mod:`riprap.models`), built on first use: the rigid
+        bodies, the fluid, or both coupled."""
+        if self._model is None:
+            self._model = self._build_model()
+        return self._model
+
+    @property
+    def coupled(self) -> bool:
+        """Whether bodies move in a fluid."""
+        return self.fluid is not None and (hasattr(self.fluid, "solids") or self.solver.n_bodies > 0)
+
+    def _build_model(self):
+        from riprap.models.fluid import CoupledModel, FluidModel
+        from riprap.models.rigid import RigidModel
+
+        if self.fluid is None:
+            return RigidModel(self)
+        if hasattr(self.fluid, "solids"):            # a CoupledSolver built by the caller
+            self.solver = self.fluid.solids
+            return CoupledModel(self.fluid)
+        if self.solver.n_bodies == 0:
+            return FluidModel(self.fluid)
+        from riprap.coupling.coupled import CoupledSolver
+        from riprap.coupling.obstacles import add_obstacle_bodies, name_obstacles_in_overlap
+
+        # The fluid's obstacles are walls for the bodies too: fixed bodies of the same cells.
+        boxes = getattr(self.fluid, "obstacle_boxes", [])
+        obstacle_bodies = add_obstacle_bodies(self, boxes)
+        try:
+            self._prepare_bodies()
+        except OverlapError as error:
+            raise name_obstacles_in_overlap(error, obstacle_bodies, boxes) from None
+        return CoupledModel(CoupledSolver(self.fluid, self.solver, obstacle_bodies=obstacle_bodies))
+
     def prepare(self) -> None:
-        """Choose the time step, evaluate initial forces and check that nothing overlaps."""
+        """Build the model, choose time steps, evaluate initial forces and check the start state
+        (nothing overlaps; bodies inside the fluid box and wide enough for its cells)."""
+        self.model.prepare(restarted=self._restarted)
+
+    def _prepare_bodies(self) -> None:
         solver = self.solver
         if solver._ready:
             return
@@ -238,129 +304,100 @@ class Simulation:
         solver.finalize()
 
     def run(self, *, restart_from=None, after_chunk=None) -> RunSummary:
-        """Run to ``end_time`` (or rest); write frames, checkpoints, picture and summary.
+        """Run to ``end_time`` (or rest); write frames, checkpoints, pictures and the summary.
 
-        ``after_chunk(simulation)``, if given, is called after every chunk of steps (a few per
-        second of wall time) and may change the state (e.g. fix bodies); the run stops with
-        end reason "done" when it returns True.
+        The one run loop for every model (rigid bodies, air and water, bodies in the flow): it
+        advances the model towards the next scheduled time (frame, checkpoint, end), writes what
+        is due, shows progress, and stops with a failure checkpoint of the last good state when
+        the model reports an instability. ``after_chunk(simulation)``, if given, is called after
+        every chunk of work (a few per second of wall time) and may change the state (e.g. fix
+        bodies); the run stops with end reason "done" when it returns True.
         """
-        from riprap.io import checkpoint as checkpoint_io
-        from riprap.io import vtk
         from riprap.io.output_folder import prepare_output_folder
+        from riprap.io.summary import write_json
 
         out = self.output_directory
         prepare_output_folder(out)
         if restart_from is not None:
             self.restart(restart_from)
         self.prepare()
-        solver = self.solver
-        series = contact_series = None
-        if self.paraview:
-            series = vtk.ParaViewSeries(out, "bodies", append=self._restarted)
-            contact_series = vtk.ParaViewSeries(out, "contacts", append=self._restarted)
-            if not self._restarted:
-                self._write_frame(series, contact_series)
-        estimate = solver.time_step
-        smallest_step = largest_step = solver.time_step
-        cuts = 0
+        model = self.model
+        model.open_outputs(out, append=self._restarted, paraview=self.paraview,
+                           picture=self.picture)
+        last_frame_time = model.time
+        if not self._restarted:
+            self._write_scheduled_frame(model)
         start_wall = wallclock.perf_counter()
-        start_steps = solver.step_count
+        start_steps = model.step_count
         end_reason = "end_time"
-        good = solver.state_arrays()
-        chunk = 10
-        with _Progress(self.progress, self.end_time) as progress:
-            while solver.step_count < self._steps_at(self.end_time):
-                next_frame = self._steps_at(self._frame_index * self.output_interval)
-                targets = [self._steps_at(self.end_time), next_frame]
-                if self.checkpoint_interval > 0:
-                    targets.append(self._steps_at(self._checkpoint_index * self.checkpoint_interval))
-                target = min(t for t in targets if t > solver.step_count)
-                n = min(target - solver.step_count, chunk)
-                tick = wallclock.perf_counter()
+        good = model.state_arrays()
+        with _Progress(self.progress, self.end_time, model.name) as progress:
+            while not model.reached(self.end_time):
+                until = min(time for time in self._scheduled_times() if not model.reached(time))
                 try:
-                    solver.advance(n)
-                    self._check_runaway()
-                    self._check_contact_stability()
+                    model.advance(until)
                 except InstabilityError as error:
-                    if self.adaptive_time_step and (solver.time_step * _STEP_CUT
-                                                    >= _MIN_STEP_OVER_ESTIMATE * estimate):
-                        cut = solver.time_step * _STEP_CUT
-                        solver.load_state_arrays(good)
-                        solver.set_time_step(cut)
-                        smallest_step = min(smallest_step, cut)
-                        cuts += 1
+                    if model.recover(good):
                         continue
-                    path = self._write_checkpoint(checkpoint_io, good, "failure_checkpoint.npz")
-                    raise InstabilityError(f"{error}\nThe last good state (t = {good['clock'][0]:.6g} s) "
-                                           f"was written to {path}. {self._blow_up_advice(good)}"
-                                           ) from None
-                elapsed = wallclock.perf_counter() - tick
-                if self.adaptive_time_step:
-                    # Time step decisions at fixed step counts, not wall-clock ones, so that a
-                    # run is reproducible.
-                    chunk = _ADAPT_CHUNK_STEPS
-                else:
-                    chunk = max(1, min(100000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
-                good = solver.state_arrays()
-                if solver.step_count >= next_frame and series is not None:
-                    self._write_frame(series, contact_series)
-                elif solver.step_count >= next_frame:
-                    self._frame_index += 1
-                if (self.checkpoint_interval > 0 and solver.step_count
-                        >= self._steps_at(self._checkpoint_index * self.checkpoint_interval)):
-                    self._checkpoint_index += 1
-                    self._write_checkpoint(checkpoint_io, good, "checkpoint.npz")
-                progress.update(solver, start_wall, start_steps)
-                if after_chunk is not None and after_chunk(self):
-                    end_reason = "done"
-                    break
-                good = solver.state_arrays()
-                if self.rest_speed > 0 and self.at_rest():
+                    model.load_state_arrays(good)
+                    path = self._save_checkpoint("failure_checkpoint.npz", good)
+                    raise InstabilityError(
+                        f"{error}\nThe last good state (t = {float(good['clock'][0]):.6g} s) was "
+                        f"written to {path}. {model.failure_advice(good)}") from None
+                good = model.state_arrays()
+                if model.reached(self._frame_index * self.output_interval):
+                    self._write_scheduled_frame(model)
+                    last_frame_time = model.time
+                if (self.checkpoint_interval > 0 and model.reached(
+                        (self._checkpoints_written + 1) * self.checkpoint_interval)):
+                    while model.reached((self._checkpoints_written + 1) * self.checkpoint_interval):
+                        self._checkpoints_written += 1
+                    self._save_checkpoint("checkpoint.npz", good)
+                progress.update(model, start_wall, start_steps)
+                if after_chunk is not None:
+                    if after_chunk(self):
+                        end_reason = "done"
+                        break
+                    good = model.state_arrays()
+                if model.at_rest():
                     end_reason = "at_rest"
                     break
-                if (self.adaptive_time_step and self._last_stability_ratio < _GROW_BELOW_RATIO
-                        and solver.time_step * _STEP_GROWTH <= _MAX_STEP_OVER_ESTIMATE * estimate
-                        and self._step_keeps_motion_small(solver.time_step * _STEP_GROWTH)):
-                    solver.set_time_step(solver.time_step * _STEP_GROWTH)
-                    largest_step = max(largest_step, solver.time_step)
+                model.after_good_chunk()
         wall = wallclock.perf_counter() - start_wall
-        dt = solver.time_step
-        if series is not None and series.frames and series.frames[-1][0] < solver.time - 0.5 * dt:
-            self._write_frame(series, contact_series)
-        outputs = {"checkpoint": str(self._write_checkpoint(checkpoint_io, solver.state_arrays(),
-                                                            "checkpoint.npz"))}
-        if series is not None:
-            outputs["paraview"] = str(out / "bodies.pvd")
-            outputs["contacts"] = str(out / "contacts.pvd")
-        if self.picture:
-            outputs["picture"] = str(self.write_picture(out / "final_state.png"))
-        steps = solver.step_count - start_steps
-        summary = RunSummary(end_reason=end_reason, simulated_time=solver.time, steps=steps,
-                             time_step=dt, wall_time=wall,
-                             body_steps_per_second=steps * solver.n_bodies / max(wall, 1e-9),
-                             bodies=solver.n_bodies, contacts=len(solver.contacts),
-                             kinetic_energy=solver.kinetic_energy(), max_speed=self.max_speed(),
-                             frames=self._frame_index,
-                             stability_ratio_max=getattr(self, "_max_stability_ratio", 0.0),
-                             time_step_min=smallest_step, time_step_max=largest_step,
-                             time_step_cuts=cuts, outputs=outputs, case_file=self.case_file,
-                             smoke=os.environ.get("RIPRAP_SMOKE", "") == "1")
-        from riprap.io.summary import write_json
+        frames = self._frame_index
+        if model.time - last_frame_time > 0.5 * model.last_time_step():
+            # The run ended between frame times (at rest, or an end time off the schedule): its
+            # last state is a frame too, outside the schedule a restart counts on.
+            model.write_frame(frames)
+            frames += 1
+        outputs = {"checkpoint": str(self._save_checkpoint("checkpoint.npz", model.state_arrays()))}
+        outputs.update(model.close_outputs())
+        steps = model.step_count - start_steps
+        summary = RunSummary(model=model.name, end_reason=end_reason, simulated_time=model.time,
+                             steps=steps, wall_time=wall, frames=frames, outputs=outputs,
+                             case_file=self.case_file,
+                             smoke=os.environ.get("RIPRAP_SMOKE", "") == "1",
+                             **model.summary_fields(wall, steps))
         write_json(out / "summary.json", summary.as_dict())
         return summary
+
+    def _scheduled_times(self) -> list[float]:
+        times = [self.end_time, self._frame_index * self.output_interval]
+        if self.checkpoint_interval > 0:
+            times.append((self._checkpoints_written + 1) * self.checkpoint_interval)
+        return times
+
+    def _write_scheduled_frame(self, model) -> None:
+        model.write_frame(self._frame_index)
+        self._frame_index += 1
+        while model.reached(self._frame_index * self.output_interval) and not model.reached(self.end_time):
+            self._frame_index += 1      # a chunk longer than a frame interval: no frame twice
 
     def _step_keeps_motion_small(self, time_step: float) -> bool:
         """No body moves more than _MAX_MOTION_PER_STEP of the smallest boundary sub-tet height in
         one step, so that a contact cannot go from nothing to a deep overlap in one step."""
         smallest = min(shape.min_subtet_height for shape in self.solver.shapes)
         return self.max_speed() * time_step <= _MAX_MOTION_PER_STEP * smallest
-
-    def _steps_at(self, time: float) -> int:
-        """The step count at which the clock reaches ``time`` (at the current time step)."""
-        s = self.solver
-        if s._time_origin is None:
-            return int(math.ceil(time / s.time_step - 1e-9))
-        return s._step_origin + int(math.ceil((time - s._time_origin) / s.time_step - 1e-9))
 
     def _check_runaway(self) -> None:
         speeds = np.linalg.norm(self.solver.velocities, axis=1)
@@ -498,7 +535,6 @@ class Simulation:
                            point_data={"normal_force": c.normal_forces,
                                        "tangential_force": c.tangential_forces,
                                        "body_i": c.body_i, "body_j": c.body_j})
-        self._frame_index += 1
 
     def write_picture(self, path, *, show_fixed: bool = False, planes=None, view=(25, -60),
                       title: str | None = None) -> Path:
@@ -528,56 +564,43 @@ class Simulation:
                                  walls_box=box)
 
     # ------------------------------------------------------------------ checkpoints
-    def _write_checkpoint(self, checkpoint_io, state: dict, name: str) -> Path:
-        arrays = dict(state)
-        s = self.solver
-        arrays["shape_index"] = s.shape_index
-        arrays["material_index"] = s.material_index_of_body
-        arrays["fixed"] = s.fixed
-        for k, mesh in enumerate(self._meshes):
-            arrays[f"shape_{k}_nodes"] = mesh.nodes
-            arrays[f"shape_{k}_tets"] = mesh.tets
-        metadata = {"kind": "riprap rigid run", "frame_index": self._frame_index,
-                    "checkpoint_index": self._checkpoint_index, "n_bodies": int(s.n_bodies),
-                    "shapes": list(self._shape_names), "time": float(state["clock"][0])}
-        return checkpoint_io.save_checkpoint(self.output_directory / name, arrays=arrays,
-                                             metadata=metadata)
+    def _save_checkpoint(self, name: str, state: dict) -> Path:
+        from riprap.io.checkpoint import save_checkpoint
+
+        model = self.model
+        arrays, metadata = model.checkpoint_content(state)
+        metadata.update({"kind": model.kind, "frame_index": self._frame_index,
+                         "checkpoints_written": self._checkpoints_written,
+                         "time": float(state["clock"][0])})
+        return save_checkpoint(self.output_directory / name, arrays=arrays, metadata=metadata)
 
     def restart(self, path) -> None:
         """Continue from a checkpoint written by a run of the same case."""
-        from riprap.io import checkpoint as checkpoint_io
+        from riprap.io.checkpoint import load_checkpoint
 
-        arrays, metadata = checkpoint_io.load_checkpoint(path)
-        s = self.solver
-        s._build_arrays()
-        problems = []
-        if metadata.get("n_bodies") != s.n_bodies:
-            problems.append(f"it has {metadata.get('n_bodies')} bodies, the case {s.n_bodies}")
-        if metadata.get("shapes") != list(self._shape_names):
-            problems.append(f"its shapes {metadata.get('shapes')} differ from the case's {list(self._shape_names)}")
-        else:
-            for k, mesh in enumerate(self._meshes):
-                if not (np.array_equal(arrays[f"shape_{k}_nodes"], mesh.nodes)
-                        and np.array_equal(arrays[f"shape_{k}_tets"], mesh.tets)):
-                    problems.append(f"shape '{list(self._shape_names)[k]}' was meshed differently")
-        if problems:
-            raise RiprapError(f"{path}: cannot restart this case from that checkpoint: "
-                              + "; ".join(problems))
-        s.time_step = float(arrays["clock"][2])
-        s._ready = True
-        s.load_state_arrays(arrays)
-        if not self.adaptive_time_step:
-            # The case's time step wins over the checkpoint's (the same case gives the same step, so
-            # a restart stays bit for bit): after a blow-up a smaller step is the usual fix.
-            step = (self.requested_time_step if self.requested_time_step > 0
-                    else s.stable_time_step(self.time_step_safety))
-            if step != s.time_step:
-                s.set_time_step(step)
-        s._last = (np.zeros((0, interactions.C_SIZE)), np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64))
-        s._contacts = None
+        arrays, metadata = load_checkpoint(path)
+        self._restarted = True          # before the model is built: a restart's overlaps are its own
+        model = self.model
+        kind = metadata.get("kind")
+        if kind not in _ACCEPTED_KINDS[model.kind]:
+            raise RiprapError(f"{path}: a checkpoint of a {kind!r} run; this case is a "
+                              f"{model.name} run ({model.kind!r})")
+        model.check_checkpoint(path, arrays, metadata)
+        model.restore(arrays)
         self._frame_index = int(metadata["frame_index"])
-        self._checkpoint_index = int(metadata["checkpoint_index"])
-        self._restarted = True
+        if "checkpoints_written" in metadata:
+            self._checkpoints_written = int(metadata["checkpoints_written"])
+        else:
+            # Checkpoints of riprap before the one run loop: a rigid run stored the index of the
+            # next checkpoint (from 1), a fluid run the number written.
+            self._checkpoints_written = (int(metadata["checkpoint_index"])
+                                         - (1 if kind == "riprap rigid run" else 0))
+
+
+# Checkpoint kinds a model restarts from: coupled runs were "fluid runs" before the one run loop.
+_ACCEPTED_KINDS = {"riprap rigid run": ("riprap rigid run",),
+                   "riprap fluid run": ("riprap fluid run",),
+                   "riprap coupled run": ("riprap coupled run", "riprap fluid run")}
 
 
 def _require(ok: bool, key: str, value, expected: str) -> None:
@@ -586,11 +609,12 @@ def _require(ok: bool, key: str, value, expected: str) -> None:
 
 
 class _Progress:
-    """A rich progress bar: simulated time, steps/s, kinetic energy, contacts."""
+    """A rich progress bar: simulated time, steps/s and the model's own figures."""
 
-    def __init__(self, enabled: bool, end_time: float):
+    def __init__(self, enabled: bool, end_time: float, name: str):
         self.enabled = enabled
         self.end_time = end_time
+        self.name = name
         self._progress = None
 
     def __enter__(self):
@@ -599,21 +623,20 @@ class _Progress:
 
             self._progress = Progress(
                 TextColumn("[bold]t = {task.completed:.4f} / {task.total:.4f} s"), BarColumn(),
-                TextColumn("{task.fields[rate]} steps/s"), TextColumn("KE {task.fields[energy]} J"),
-                TextColumn("{task.fields[contacts]} contacts"), TimeRemainingColumn(),
-                transient=False)
+                TextColumn("{task.fields[rate]} steps/s"), TextColumn("{task.fields[figures]}"),
+                TimeRemainingColumn(), transient=False)
             self._progress.__enter__()
-            self._task = self._progress.add_task("run", total=self.end_time, rate="-",
-                                                 energy="-", contacts="-")
+            self._task = self._progress.add_task(self.name, total=self.end_time, rate="-",
+                                                 figures="")
         return self
 
-    def update(self, solver, start_wall, start_steps):
+    def update(self, model, start_wall, start_steps):
         if self._progress is None:
             return
-        rate = (solver.step_count - start_steps) / max(wallclock.perf_counter() - start_wall, 1e-9)
-        self._progress.update(self._task, completed=min(solver.time, self.end_time),
-                              rate=f"{rate:,.0f}", energy=f"{solver.kinetic_energy():.3g}",
-                              contacts=str(len(solver.contacts)))
+        rate = (model.step_count - start_steps) / max(wallclock.perf_counter() - start_wall, 1e-9)
+        self._progress.update(self._task, completed=min(model.time, self.end_time),
+                              rate=f"{rate:,.1f}" if rate < 100 else f"{rate:,.0f}",
+                              figures=model.progress_text())
 
     def __exit__(self, *exc):
         if self._progress is not None:

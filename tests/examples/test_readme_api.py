@@ -30,3 +30,17 @@ def test_readme_fluid_example_runs(tmp_path, monkeypatch):
     report = namespace["report"]
     assert report.time_step > 0 and abs(report.water_volume_error) < 1e-10
     assert namespace["fluid"].solid.any()
+
+
+def test_readme_coupled_example_runs(tmp_path, monkeypatch):
+    """The README's bodies-in-the-flow example, shortened to 0.02 s of simulated time."""
+    monkeypatch.chdir(tmp_path)
+    block = next(b for b in _blocks() if "fluid=water" in b)
+    assert "end_time=0.5" in block
+    code = block.replace("end_time=0.5", "end_time=0.02").replace(
+        'output_directory="tank"', 'output_directory="tank", progress=False')
+    namespace = {}
+    exec(compile(code, str(README), "exec"), namespace)
+    summary = namespace["summary"]
+    assert summary.model == "coupled" and summary.bodies == 1 and summary.steps > 0
+    assert (tmp_path / "tank" / "run.pvd").is_file() and (tmp_path / "tank" / "body_forces.csv").is_file()

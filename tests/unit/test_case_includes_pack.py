@@ -58,7 +58,7 @@ def test_a_pack_put_in_water_runs_coupled(pack):
     # The pack's floor is the fluid box's floor too: one wall, not two pushing twice.
     from riprap.case.build_fluid import build_fluid_run
 
-    walls = build_fluid_run(load_case(path), output_directory=out, progress=False).solver.solids.walls
+    walls = build_fluid_run(load_case(path), output_directory=out, progress=False).solver.walls
     floors = [w for w in walls if tuple(w.normal) == (0.0, 0.0, 1.0) and w.point[2] == 0.0]
     assert len(floors) == 1 and len(walls) == 5          # open top: 5 box sides, the floor once
     assert json.loads((out / "summary.json").read_text())["simulated_time"] == pytest.approx(0.02)

@@ -38,12 +38,12 @@ def test_restart_reproduces_the_unbroken_run(tmp_path):
     second, summary = _run(tmp_path, "first", end_time=0.02,
                            restart=tmp_path / "first" / "checkpoint.npz")
     for name in ("fraction", "u", "w", "pressure"):
-        assert np.array_equal(getattr(second.solver, name), getattr(unbroken.solver, name)), name
-    assert second.solver.step_count == unbroken.solver.step_count
+        assert np.array_equal(getattr(second.fluid, name), getattr(unbroken.fluid, name)), name
+    assert second.fluid.step_count == unbroken.fluid.step_count
     # The series continues: frames at 0, 0.01, 0.02 s.
     assert (tmp_path / "first" / "fluid.pvd").read_text().count("<DataSet") == 3
     frame = read_vti(tmp_path / "whole" / "fluid_000002.vti")
-    assert np.allclose(frame["water_fraction"], unbroken.solver.fraction, atol=1e-6)
+    assert np.allclose(frame["water_fraction"], unbroken.fluid.fraction, atol=1e-6)
     assert frame["velocity"].shape == (20, 1, 12, 3)
     assert summary.water_volume_error < 1e-10
 

@@ -144,3 +144,41 @@ def test_bad_input_is_named():
         body_cell_volumes(grid, nodes, [[0, 1, 2, 3]], [0, 1])
     with pytest.raises(CaseFileError, match="tets refer to nodes"):
         body_cell_volumes(grid, nodes[:3], [[0, 1, 2, 3]], [0, 1])
+
+
+def test_surface_integration_equals_clipping_tetrahedra():
+    """The boundary-only integration (what the coupling uses) against the tet-by-tet clipping,
+    cell by cell, for non-convex bodies in random orientations, partly outside the grid."""
+    from scipy.spatial.transform import Rotation
+    from riprap.coupling.solid_volumes import surface_cell_volumes
+    grid = FluidGrid(lower=(0, 0, 0), upper=(0.4, 0.4, 0.3), cells=(16, 16, 12))
+    meshes = [rr.shapes.random_rock(size=0.15, seed=3), rr.shapes.l_shape(length=0.16, width=0.1, thickness=0.05),
+              rr.shapes.tetrapod(height=0.2), rr.shapes.random_rock(size=0.12, seed=4)]
+    rng = np.random.default_rng(11)
+    nodes, tets, triangles, tet_start, triangle_start = [], [], [], [0], [0]
+    count = 0
+    for i, mesh in enumerate(meshes):
+        shape = rr.RigidShape.from_mesh(mesh)
+        rotation = Rotation.random(random_state=i).as_matrix()
+        centre = rng.uniform(0.0, 0.3, 3) if i < 3 else np.array([0.39, 0.01, 0.15])
+        nodes.append((mesh.nodes - mesh.nodes.mean(axis=0)) @ rotation.T + centre)
+        tets.append(mesh.tets + count)
+        triangles.append(shape.triangles + count)
+        count += len(mesh.nodes)
+        tet_start.append(tet_start[-1] + len(mesh.tets))
+        triangle_start.append(triangle_start[-1] + len(shape.triangles))
+    nodes = np.concatenate(nodes)
+    clipped = body_cell_volumes(grid, nodes, np.concatenate(tets), tet_start)
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        single = surface_cell_volumes(grid, nodes, np.concatenate(triangles), triangle_start)
+    finally:
+        numba.set_num_threads(threads)
+    surface = surface_cell_volumes(grid, nodes, np.concatenate(triangles), triangle_start)
+    assert np.array_equal(single.values, surface.values)
+    assert np.array_equal(clipped.offset, surface.offset)
+    cell = grid.cell_size ** 3
+    assert np.abs(clipped.values - surface.values).max() < 1e-12 * cell
+    assert (surface.values >= 0).all()
+    assert 0 < surface.body_volume(3) < meshes[3].volumes().sum()

@@ -15,7 +15,6 @@ static force equilibrium"; a static state stays where it is. Checks:
   pack's own analysis gives (nothing came apart, nothing new touched).
 """
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -1,4 +1,5 @@
-"""Build a fluid run (:class:`riprap.fluid.run.FluidRun`) from a case with a ``[fluid]`` table."""
+"""Build the fluid of a case with a ``[fluid]`` table, and its run (a
+:class:`riprap.simulation.Simulation` of the fluid alone, or of the case's bodies in it)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -7,7 +8,6 @@ from riprap.case.build import SMOKE_END_TIME, smoke_mode
 from riprap.errors import CaseFileError
 from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.phases import Phase
-from riprap.fluid.run import FluidRun
 from riprap.fluid.solver import FluidSolver
 
 __all__ = ["build_fluid_run", "build_fluid_solver"]
@@ -52,31 +52,27 @@ def build_fluid_solver(case) -> FluidSolver:
     return solver
 
 
-def build_fluid_run(case, *, output_directory=None, progress: bool = True) -> FluidRun:
-    """A :class:`FluidRun` of ``case`` (``[simulation]`` end time, output and checkpoint intervals);
-    with bodies, they move in the flow and push it (two-way coupling, ``docs/coupling.md``)."""
-    settings = case.simulation
-    end_time = min(settings.end_time, SMOKE_END_TIME) if smoke_mode() else settings.end_time
-    source = Path(case.source)
-    model = build_fluid_solver(case)
-    if case.body_count > 0:
-        model = _coupled(case, model)
-    return FluidRun(model, end_time=end_time,
-                    output_interval=settings.output_interval,
-                    checkpoint_interval=settings.checkpoint_interval,
-                    output_directory=output_directory or case.output.directory,
-                    paraview=case.output.paraview, picture=case.output.picture, progress=progress,
-                    case_file=str(source.resolve()) if source.is_file() else "")
-
-
-def _coupled(case, fluid):
-    """The case's bodies (as ``riprap run`` builds them for a dry run) coupled to ``fluid``; the
-    fluid box's sides are walls for them, of the first material."""
+def build_fluid_run(case, *, output_directory=None, progress: bool = True):
+    """The run of ``case``: its fluid alone, or, with bodies, the bodies moving in the flow and
+    pushing it (two-way coupling, ``docs/coupling.md``); a :class:`riprap.simulation.Simulation`
+    with the ``[simulation]`` end time, output and checkpoint intervals. The coupled model is
+    built here, so that its checks (bodies inside the box, wide enough for the cells, not
+    overlapping) run before anything else."""
     from riprap.case.build import build_simulation
-    from riprap.coupling.coupled import CoupledSolver
+    from riprap.simulation import Simulation
 
-    simulation = build_simulation(case, progress=False)
-    solids = simulation.solver
-    simulation.build_without_checks()
-    simulation.check_start_overlaps()
-    return CoupledSolver(fluid, solids)
+    fluid = build_fluid_solver(case)
+    if case.body_count > 0:
+        simulation = build_simulation(case, output_directory=output_directory, progress=progress)
+        simulation.add_fluid(fluid)
+        simulation.prepare()
+        return simulation
+    settings = case.simulation
+    source = Path(case.source)
+    simulation = Simulation(
+        end_time=min(settings.end_time, SMOKE_END_TIME) if smoke_mode() else settings.end_time,
+        output_interval=settings.output_interval, checkpoint_interval=settings.checkpoint_interval,
+        output_directory=output_directory or case.output.directory, paraview=case.output.paraview,
+        picture=case.output.picture, progress=progress, fluid=fluid)
+    simulation.case_file = str(source.resolve()) if source.is_file() else ""
+    return simulation

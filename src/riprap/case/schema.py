@@ -244,7 +244,9 @@ TABLES: tuple[Table, ...] = (
     Table("water_regions", True, 0, "type",
           "Water at the start: boxes, or everything below a still-water level (`[fluid]` cases)."),
     Table("obstacles", True, 0, "type",
-          "Fixed solid boxes in the fluid (every cell whose centre is inside; `[fluid]` cases)."),
+          "Fixed solid boxes in the fluid (every cell whose centre is inside; `[fluid]` cases). "
+          "With bodies, each box is also a fixed body of the same cells, so that bodies meet it "
+          "(contact, with the first material); a body may not start inside one."),
     Table("output", False, 1, None, "Where and what riprap writes."),
 )
 

@@ -121,10 +121,14 @@ class CoupledSolver:
     check_momentum : bool
         Measure every step how far the exchange is from conserving momentum
         (``last_exchange_balance``; a few whole-grid passes, so off unless asked for).
+    obstacle_bodies : sequence of int
+        Fixed bodies that stand for the fluid's obstacles (``riprap.coupling.obstacles``): the
+        fluid already holds their cells still, so the exchange leaves them out.
     """
 
     def __init__(self, fluid: FluidSolver, solids: SolidSolver, *, solid_time_step: float | None = None,
-                 wall_material: str | None = "", check_momentum: bool = False):
+                 wall_material: str | None = "", check_momentum: bool = False,
+                 obstacle_bodies=()):
         if not np.allclose(fluid.gravity, solids.gravity):
             raise CaseFileError(f"coupling: the fluid's gravity {fluid.gravity.tolist()} differs from "
                                 f"the bodies' {solids.gravity.tolist()}")
@@ -152,6 +156,9 @@ class CoupledSolver:
                                     for m in solids.material_index_of_body], dtype=np.float64)
         self._blocks = None
         self._block_poses = None
+        self.obstacle_bodies = np.asarray(obstacle_bodies, dtype=np.int64)
+        if len(self.obstacle_bodies) and not solids.fixed[self.obstacle_bodies].all():
+            raise CaseFileError("coupling: obstacle bodies must be fixed")
         self.last_clipped_bodies = 0
         self.fixed_body_loads = np.zeros((n, 6))
         self.viscous_loads = np.zeros((n, 6))
@@ -216,16 +223,18 @@ class CoupledSolver:
         solids = self.solids
         poses = np.concatenate([solids.positions, solids.quaternions], axis=1)
         if self._blocks is None:
-            stale = np.arange(solids.n_bodies)
+            # an obstacle body holds no cells of the exchange: the fluid's own obstacle does
+            self._blocks = [None] * solids.n_bodies
+            for body in self.obstacle_bodies:
+                self._blocks[body] = (np.zeros(3, dtype=np.int64), np.zeros((0, 0, 0)))
+            stale = np.setdiff1d(np.arange(solids.n_bodies), self.obstacle_bodies)
         else:
             stale = np.flatnonzero(np.any(poses != self._block_poses, axis=1))
         if len(stale):
             fresh = rigid_body_cell_volumes(self.fluid.grid, solids, bodies=stale)
-            if self._blocks is None:
-                self._blocks = [None] * solids.n_bodies
             for k, body in enumerate(stale):
                 self._blocks[body] = fresh.block(k)
-            self._block_poses = poses.copy()
+        self._block_poses = poses.copy()
         self.last_clipped_bodies = len(stale)
         return merge_blocks(self.fluid.grid, self._blocks)
 

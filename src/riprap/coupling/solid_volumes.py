@@ -2,11 +2,14 @@
 
 The seed paper finds the solid volume fraction of each fluid element from a supermesh of the solid
 and fluid meshes (Xiang et al., section 2.3; it is what the drag source terms of their eqs. 4, 11
-and 12 are weighted by). Here the fluid elements are the cells of a :class:`FluidGrid`, and each
-body's tetrahedra are clipped against them exactly
-(``riprap/coupling/kernels/tet_cell_volumes.py``). The result keeps each body apart, as a block of
-cells around it, since the coupling needs both the solid fraction of every cell and, per body, the
-cells whose fluid force acts on it.
+and 12 are weighted by). Here the fluid elements are the cells of a :class:`FluidGrid`. Two exact
+ways, equal to round-off (``tests/unit/test_solid_cell_volumes.py``): :func:`body_cell_volumes`
+clips every tetrahedron against the cells (``riprap/coupling/kernels/tet_cell_volumes.py``, the
+reference); :func:`surface_cell_volumes` integrates the boundary triangles over each column of cells
+(``riprap/coupling/kernels/surface_cell_volumes.py``), so the interior tetrahedra never enter: 50 to
+200 times faster, and what the coupling uses (:func:`rigid_body_cell_volumes`). The result keeps
+each body apart, as a block of cells around it, since the coupling needs both the solid fraction of
+every cell and, per body, the cells whose fluid force acts on it.
 """
 from __future__ import annotations
 
@@ -14,11 +17,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from riprap.coupling.kernels import surface_cell_volumes as surface_kernels
 from riprap.coupling.kernels import tet_cell_volumes
 from riprap.errors import CaseFileError
 from riprap.fluid.grid import FluidGrid
 
-__all__ = ["BodyCellVolumes", "body_cell_volumes", "rigid_body_cell_volumes", "merge_blocks"]
+__all__ = ["BodyCellVolumes", "body_cell_volumes", "surface_cell_volumes", "rigid_body_cell_volumes",
+           "merge_blocks"]
 
 
 @dataclass(frozen=True)
@@ -64,60 +69,87 @@ class BodyCellVolumes:
         return np.minimum(self.solid_volume() / self.grid.cell_size ** 3, 1.0)
 
 
+def _checked_cells(nodes, cells, cell_start, corners: int, what: str):
+    """``nodes``, ``cells`` (m, corners) and ``cell_start`` as contiguous arrays, or an error that
+    names what is wrong."""
+    nodes = np.ascontiguousarray(nodes, dtype=np.float64)
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    cell_start = np.ascontiguousarray(cell_start, dtype=np.int64)
+    if nodes.ndim != 2 or nodes.shape[1] != 3 or cells.ndim != 2 or cells.shape[1] != corners:
+        raise CaseFileError(f"solid volumes: nodes must be (n, 3) and {what} (m, {corners}), got "
+                            f"{nodes.shape} and {cells.shape}")
+    if len(cells) and (cells.min() < 0 or cells.max() >= len(nodes)):
+        raise CaseFileError(f"solid volumes: {what} refer to nodes 0..{cells.max()}, but there are "
+                            f"{len(nodes)} nodes")
+    if cell_start[0] != 0 or cell_start[-1] != len(cells) or np.any(np.diff(cell_start) < 0):
+        raise CaseFileError(f"solid volumes: the start of each body's {what} must rise from 0 to "
+                            f"the number of {what}")
+    if not np.isfinite(nodes).all():
+        bad = int(np.argwhere(~np.isfinite(nodes))[0, 0])
+        body = int(np.searchsorted(cell_start, np.argmax((cells == bad).any(axis=1)), side="right")) - 1
+        raise CaseFileError(f"solid volumes: node {bad} (body {body}) is not finite")
+    return nodes, cells, cell_start
+
+
+def _fill(grid: FluidGrid, fill, nodes, cells, cell_start) -> BodyCellVolumes:
+    lower = np.asarray(grid.lower, dtype=np.float64)
+    h = float(grid.cell_size)
+    origin, shape, offset = tet_cell_volumes.body_blocks(nodes, cells, cell_start, lower, h,
+                                                         grid.cells)
+    values = np.zeros(offset[-1])
+    fill(nodes, cells, cell_start, lower, h, origin, shape, offset, values)
+    return BodyCellVolumes(grid=grid, origin=origin, shape=shape, offset=offset, values=values)
+
+
 def body_cell_volumes(grid: FluidGrid, nodes, tets, tet_start) -> BodyCellVolumes:
-    """Exact volumes of tetrahedral bodies in the cells of ``grid``.
+    """Exact volumes of tetrahedral bodies in the cells of ``grid``, by clipping every tetrahedron.
 
     ``nodes`` (n, 3): world positions (m) of all bodies' nodes; ``tets`` (m, 4): node indices of
     all tetrahedra; ``tet_start`` (bodies + 1,): body b owns tets[tet_start[b]:tet_start[b + 1]].
     """
-    nodes = np.ascontiguousarray(nodes, dtype=np.float64)
-    tets = np.ascontiguousarray(tets, dtype=np.int64)
-    tet_start = np.ascontiguousarray(tet_start, dtype=np.int64)
-    if nodes.ndim != 2 or nodes.shape[1] != 3 or tets.ndim != 2 or tets.shape[1] != 4:
-        raise CaseFileError(f"solid volumes: nodes must be (n, 3) and tets (m, 4), got "
-                            f"{nodes.shape} and {tets.shape}")
-    if len(tets) and (tets.min() < 0 or tets.max() >= len(nodes)):
-        raise CaseFileError(f"solid volumes: tets refer to nodes 0..{tets.max()}, but there are "
-                            f"{len(nodes)} nodes")
-    if tet_start[0] != 0 or tet_start[-1] != len(tets) or np.any(np.diff(tet_start) < 0):
-        raise CaseFileError("solid volumes: tet_start must rise from 0 to the number of tets")
-    if not np.isfinite(nodes).all():
-        bad = int(np.argwhere(~np.isfinite(nodes))[0, 0])
-        body = int(np.searchsorted(tet_start, np.argmax((tets == bad).any(axis=1)), side="right")) - 1
-        raise CaseFileError(f"solid volumes: node {bad} (body {body}) is not finite")
-    lower = np.asarray(grid.lower, dtype=np.float64)
-    h = float(grid.cell_size)
-    origin, shape, offset = tet_cell_volumes.body_blocks(nodes, tets, tet_start, lower, h,
-                                                         grid.cells)
-    values = np.zeros(offset[-1])
-    tet_cell_volumes.fill_blocks(nodes, tets, tet_start, lower, h, origin, shape, offset, values)
-    return BodyCellVolumes(grid=grid, origin=origin, shape=shape, offset=offset, values=values)
+    nodes, tets, tet_start = _checked_cells(nodes, tets, tet_start, 4, "tets")
+    return _fill(grid, tet_cell_volumes.fill_blocks, nodes, tets, tet_start)
+
+
+def surface_cell_volumes(grid: FluidGrid, nodes, triangles, triangle_start) -> BodyCellVolumes:
+    """Exact volumes of closed bodies in the cells of ``grid`` from their boundary triangles
+    (outward by the right-hand rule): the same as :func:`body_cell_volumes` of any
+    tetrahedralisation of the same bodies, to round-off.
+
+    ``nodes`` (n, 3): world positions (m); ``triangles`` (m, 3): node indices of all bodies'
+    boundary triangles; ``triangle_start`` (bodies + 1,): body b owns
+    triangles[triangle_start[b]:triangle_start[b + 1]].
+    """
+    nodes, triangles, triangle_start = _checked_cells(nodes, triangles, triangle_start, 3,
+                                                      "triangles")
+    return _fill(grid, surface_kernels.fill_blocks, nodes, triangles, triangle_start)
 
 
 def rigid_body_cell_volumes(grid: FluidGrid, solver, bodies=None) -> BodyCellVolumes:
-    """:func:`body_cell_volumes` of the bodies of a :class:`riprap.solid.solver.SolidSolver` at
-    their present position and orientation: all of them, or those listed in ``bodies`` (the
-    result's blocks are then in that order)."""
+    """The cell volumes of the bodies of a :class:`riprap.solid.solver.SolidSolver` at their
+    present position and orientation (:func:`surface_cell_volumes` of their boundary triangles):
+    all of them, or those listed in ``bodies`` (the result's blocks are then in that order)."""
     if not solver._ready:
         solver.finalize()
     table = solver.table
     rotations = solver.rotation_matrices()
-    node_parts, tet_parts, tet_start = [], [], [0]
+    node_parts, triangle_parts, triangle_start = [], [], [0]
     node_count = 0
     chosen = range(solver.n_bodies) if bodies is None else [int(b) for b in bodies]
     for body in chosen:
         s = solver.shape_index[body]
         local = table.nodes[table.node_offset[s]:table.node_offset[s + 1]]
         node_parts.append(local @ rotations[body].T + solver.positions[body])
-        tet_parts.append(table.tets[table.tet_offset[s]:table.tet_offset[s + 1]] + node_count)
+        triangle_parts.append(table.triangles[table.triangle_offset[s]:table.triangle_offset[s + 1]]
+                              + node_count)
         node_count += len(local)
-        tet_start.append(tet_start[-1] + len(tet_parts[-1]))
+        triangle_start.append(triangle_start[-1] + len(triangle_parts[-1]))
     if not node_parts:
         empty = np.zeros((0, 3), dtype=np.int64)
         return BodyCellVolumes(grid=grid, origin=empty, shape=empty.copy(),
                                offset=np.zeros(1, dtype=np.int64), values=np.zeros(0))
-    return body_cell_volumes(grid, np.concatenate(node_parts), np.concatenate(tet_parts),
-                             np.array(tet_start))
+    return surface_cell_volumes(grid, np.concatenate(node_parts), np.concatenate(triangle_parts),
+                                np.array(triangle_start))
 
 
 def merge_blocks(grid: FluidGrid, parts) -> BodyCellVolumes:

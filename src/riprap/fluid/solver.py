@@ -118,6 +118,9 @@ class FluidSolver:
         self.w = np.zeros((nx, ny, nz + 1))
         self.pressure = np.zeros((nx, ny, nz))
         self.solid = np.zeros((nx, ny, nz), dtype=bool)
+        #: The boxes of ``add_obstacle_box`` as the cells they fill ((lower, upper) snapped to the
+        #: cell faces, m): bodies coupled to this fluid meet them as fixed bodies.
+        self.obstacle_boxes: list[tuple[np.ndarray, np.ndarray]] = []
         self.time = 0.0
         self.step_count = 0
         self.time_step = 0.0
@@ -174,6 +177,14 @@ class FluidSolver:
                                 f"centre (cells are {self.h:g} m)")
         self.solid |= mask
         self.fraction[mask] = 0.0
+        first = [int(np.argmax(inside[a])) for a in range(3)]
+        last = [len(inside[a]) - int(np.argmax(inside[a][::-1])) for a in range(3)]
+        origin = np.asarray(g.lower, dtype=np.float64)
+        box_lower = origin + np.array(first) * self.h
+        box_upper = np.minimum(origin + np.array(last) * self.h, g.upper)
+        if g.two_dimensional:
+            box_lower[1], box_upper[1] = g.lower[1], g.upper[1]
+        self.obstacle_boxes.append((box_lower, box_upper))
 
     # ------------------------------------------------------------------ properties
     def water_volume(self) -> float:

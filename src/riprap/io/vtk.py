@@ -359,3 +359,28 @@ class ParaViewSeries:
         text = ElementTree.tostring(root, encoding="utf-8", xml_declaration=True)
         with _atomic_target(self.pvd_path) as temporary:
             temporary.write_bytes(text + b"\n")
+
+
+class CombinedSeries:
+    """One ``.pvd`` that lists the frames of several series as parts of one data set per time
+    (e.g. ``run.pvd``: the fluid's grid as part 0 and the bodies' surfaces as part 1), so that
+    ParaView opens them together from one file. Rewritten, atomically, after every frame."""
+
+    def __init__(self, path, series: list[ParaViewSeries]):
+        self.path = Path(path)
+        self.series = list(series)
+
+    def write(self) -> Path:
+        root = ElementTree.Element(
+            "VTKFile", type="Collection", version="0.1", byte_order="LittleEndian"
+        )
+        collection = ElementTree.SubElement(root, "Collection")
+        for part, series in enumerate(self.series):
+            for time, file_name in series.frames:
+                ElementTree.SubElement(collection, "DataSet", timestep=repr(time), group="",
+                                       part=str(part), file=file_name)
+        ElementTree.indent(root)
+        text = ElementTree.tostring(root, encoding="utf-8", xml_declaration=True)
+        with _atomic_target(self.path) as temporary:
+            temporary.write_bytes(text + b"\n")
+        return self.path

@@ -180,21 +180,21 @@ def face_pressure_force(face_axis, face_index, interior, pressure, h, out):
 @kernel
 def _face_jacobian(axis, index, lower, h, centre, jac):
     """J = [e_a, rho x e_a] (6,) of the face (axis, index) for a body centred at ``centre``."""
-    rho = np.empty(3)
-    for a in range(3):
-        rho[a] = lower[a] + (index[a] + (0.0 if axis == a else 0.5)) * h - centre[a]
+    rho_x = lower[0] + (index[0] + (0.0 if axis == 0 else 0.5)) * h - centre[0]
+    rho_y = lower[1] + (index[1] + (0.0 if axis == 1 else 0.5)) * h - centre[1]
+    rho_z = lower[2] + (index[2] + (0.0 if axis == 2 else 0.5)) * h - centre[2]
     for m in range(6):
         jac[m] = 0.0
     jac[axis] = 1.0
     if axis == 0:
-        jac[4] = rho[2]
-        jac[5] = -rho[1]
+        jac[4] = rho_z
+        jac[5] = -rho_y
     elif axis == 1:
-        jac[3] = -rho[2]
-        jac[5] = rho[0]
+        jac[3] = -rho_z
+        jac[5] = rho_x
     else:
-        jac[3] = rho[1]
-        jac[4] = -rho[0]
+        jac[3] = rho_y
+        jac[4] = -rho_x
 
 
 @kernel

@@ -1,0 +1,282 @@
+"""Air and water (:class:`riprap.fluid.solver.FluidSolver`), and bodies in the flow
+(:class:`riprap.coupling.coupled.CoupledSolver`), as models of the run loop.
+
+Frames: ``fluid.pvd`` of ``.vti`` files (``water_fraction``, ``pressure`` in Pa, ``velocity`` in
+m/s at cell centres, ``solid``) and free-surface pictures (``free_surface/free_surface_NNNN.png``);
+with bodies also ``bodies.pvd`` at the same times, ``run.pvd`` that opens both together in
+ParaView, and ``body_forces.csv``. The fluid takes the step its Courant number allows, cut to land
+on the scheduled times.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from riprap.errors import InstabilityError, RiprapError
+from riprap.models.base import Model
+
+__all__ = ["FluidModel", "CoupledModel"]
+
+# A remaining interval shorter than this fraction of the time is not worth a step of its own.
+_TIME_SLACK = 1e-9
+# A body faster than this (m/s) has blown up even if its numbers are still finite.
+_RUNAWAY_SPEED = 1.0e3
+
+
+class FluidModel(Model):
+    """Air and water on a Cartesian grid."""
+
+    kind = "riprap fluid run"
+    name = "fluid"
+
+    def __init__(self, solver):
+        #: The solver stepped: a FluidSolver, or a CoupledSolver for :class:`CoupledModel`.
+        self.solver = solver
+        self._series = None
+        self._picture = False
+        self._directory = None
+        self._last_dt = 0.0
+        self.smallest_step, self.largest_step, self.courant_max = np.inf, 0.0, 0.0
+        self.iterations: list[int] = []
+        self.pressure_seconds = 0.0
+        self._report = None
+
+    @property
+    def fluid(self):
+        return getattr(self.solver, "fluid", self.solver)
+
+    # ------------------------------------------------------------------ clock
+    @property
+    def time(self) -> float:
+        return self.solver.time
+
+    @property
+    def step_count(self) -> int:
+        return self.fluid.step_count
+
+    def reached(self, time: float) -> bool:
+        return self.solver.time >= time * (1.0 - _TIME_SLACK)
+
+    def last_time_step(self) -> float:
+        return self._last_dt
+
+    def advance(self, until: float) -> None:
+        s = self.solver
+        dt = min(s.stable_time_step(), until - s.time)
+        report = s.step(dt)
+        self._after_step(dt, report)
+
+    def _after_step(self, dt: float, report) -> None:
+        self._report = report
+        self._last_dt = dt
+        self.pressure_seconds += self.solver.last_pressure_seconds
+        self.smallest_step, self.largest_step = min(self.smallest_step, dt), max(self.largest_step, dt)
+        self.courant_max = max(self.courant_max, report.courant_number)
+        self.iterations.append(report.pressure_iterations)
+
+    # ------------------------------------------------------------------ state
+    def state_arrays(self) -> dict:
+        return self.solver.state_arrays()
+
+    def load_state_arrays(self, arrays: dict) -> None:
+        self.solver.load_state_arrays(arrays)
+
+    def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
+        return dict(state), {"cells": list(self.fluid.grid.cells), "cell_size": self.fluid.h,
+                             "bodies": self._bodies()}
+
+    def _bodies(self) -> int:
+        return 0
+
+    def check_checkpoint(self, path, arrays: dict, metadata: dict) -> None:
+        if list(metadata.get("cells", [])) != list(self.fluid.grid.cells):
+            raise RiprapError(f"{path}: written for a grid of {metadata.get('cells')} cells, this "
+                              f"case has {list(self.fluid.grid.cells)}")
+        if int(metadata.get("bodies", 0)) != self._bodies():
+            raise RiprapError(f"{path}: written for {metadata.get('bodies', 0)} bodies, this case "
+                              f"has {self._bodies()}")
+
+    # ------------------------------------------------------------------ outputs
+    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
+        from riprap.io import vtk
+
+        self._directory = directory
+        self._picture = picture
+        if paraview:
+            self._series = vtk.ParaViewSeries(directory, "fluid", append=append)
+
+    def _body_fraction(self):
+        return None
+
+    def write_frame(self, frame_index: int) -> None:
+        s = self.fluid
+        velocity = s.cell_velocity()
+        if self._series is not None:
+            self._series.add_image(s.time, origin=s.grid.lower, spacing=s.h, cells=s.grid.cells,
+                                   cell_data={"water_fraction": s.fraction, "pressure": s.pressure,
+                                              "velocity": velocity, "solid": s.solid.astype(float)})
+        if self._picture:
+            from riprap.io.fluid_picture import free_surface_png
+
+            free_surface_png(self._directory / "free_surface" / f"free_surface_{frame_index:04d}.png",
+                             grid=s.grid, fraction=s.fraction, velocity=velocity, solid=s.solid,
+                             time=s.time, bodies=self._body_fraction())
+
+    def close_outputs(self) -> dict:
+        outputs = {}
+        if self._series is not None:
+            outputs["paraview"] = str(self._series.pvd_path)
+        if self._picture:
+            outputs["pictures"] = str(self._directory / "free_surface")
+        return outputs
+
+    def progress_text(self) -> str:
+        r = self._report
+        if r is None:
+            return ""
+        return (f"dt {r.time_step:.2e}  CFL {r.courant_number:.2f}  water volume error "
+                f"{r.water_volume_error:.1e}  pressure iterations {r.pressure_iterations}")
+
+    def summary_fields(self, wall_time: float, steps: int) -> dict:
+        cells = self.fluid.grid.n_cells
+        report = self.fluid.last_report
+        return {"cells": cells,
+                "cell_updates_per_second": steps * cells / max(wall_time, 1e-9),
+                "time_step_min": float(self.smallest_step if steps else 0.0),
+                "time_step_max": float(self.largest_step),
+                "courant_number_max": float(self.courant_max),
+                "water_volume_error": float(report.water_volume_error if report else 0.0),
+                "pressure_iterations_mean": float(np.mean(self.iterations)) if self.iterations else 0.0,
+                "pressure_iterations_max": int(max(self.iterations, default=0)),
+                "pressure_time_share": float(self.pressure_seconds / max(wall_time, 1e-9))}
+
+    def failure_advice(self, good: dict) -> str:
+        return ("Likely cause: a flow the grid or the time step cannot carry; lower [fluid] "
+                "courant_number or max_time_step, or refine the grid, and restart from the "
+                "checkpoint with --restart.")
+
+
+class CoupledModel(FluidModel):
+    """Bodies in the flow, two-way coupled (``docs/coupling.md``): the fluid's step, with the
+    bodies' contact sub-steps inside it."""
+
+    kind = "riprap coupled run"
+    name = "coupled"
+
+    def __init__(self, coupled):
+        super().__init__(coupled)
+        self._body_series = None
+        self._forces = None
+        self._combined = None
+        self.substeps = 0
+        self.fastest = 0.0
+
+    @property
+    def solids(self):
+        return self.solver.solids
+
+    def _bodies(self) -> int:
+        return self.solids.n_bodies
+
+    def advance(self, until: float) -> None:
+        super().advance(until)
+        self.substeps += self._report.solid_substeps
+        self.fastest = max(self.fastest, self._report.max_body_speed)
+        self._check_bodies()
+
+    def _check_bodies(self) -> None:
+        """A body whose state is not finite, or that moves absurdly fast, stops the run naming the
+        body, the cell it is in and the time."""
+        solids = self.solids
+        speeds = np.linalg.norm(solids.velocities, axis=1)
+        finite = np.isfinite(solids.positions).all(axis=1) & np.isfinite(speeds)
+        bad = np.flatnonzero(~finite | (speeds > _RUNAWAY_SPEED))
+        if len(bad):
+            body = int(bad[0])
+            grid = self.fluid.grid
+            where = "no cell (its position is not finite)"
+            if finite[body]:
+                cell = np.floor((solids.positions[body] - np.asarray(grid.lower)) / grid.cell_size)
+                where = f"cell {tuple(int(c) for c in cell)}"
+            raise InstabilityError(
+                f"body {body} moves at {speeds[body]:.3g} m/s in {where} at t = {self.time:.6g} s "
+                f"(more than {_RUNAWAY_SPEED:g} m/s, or not finite)")
+
+    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
+        from riprap.io import vtk
+        from riprap.io.body_forces import BodyForceTable
+
+        super().open_outputs(directory, append=append, paraview=paraview, picture=picture)
+        if paraview:
+            self._body_series = vtk.ParaViewSeries(directory, "bodies", append=append)
+            self._combined = vtk.CombinedSeries(directory / "run.pvd",
+                                                [self._series, self._body_series])
+        self._forces = BodyForceTable(directory / "body_forces.csv", append=append)
+
+    def _body_fraction(self):
+        return self.solver.body_fraction()
+
+    def write_frame(self, frame_index: int) -> None:
+        if self._body_series is not None:
+            self._write_bodies()
+        super().write_frame(frame_index)
+        if self._combined is not None:
+            self._combined.write()
+        self._forces.append(self._body_force_rows())
+
+    def _write_bodies(self) -> None:
+        """The bodies' surfaces with velocity, the fluid's force on each body and the contact
+        force, at the fluid frame's time."""
+        from riprap.solid.surfaces import surface_arrays
+
+        coupled, solids = self.solver, self.solids
+        points, triangles, owners = surface_arrays(solids)
+        fluid_force = coupled.fluid_loads[:, :3] + coupled.fixed_body_loads[:, :3]
+        contact = solids.contact_forces()
+        self._body_series.add(coupled.time, points=points, cells=triangles, cell_type="triangle",
+                              cell_data={"body_id": owners, "velocity": solids.velocities[owners],
+                                         "speed": np.linalg.norm(solids.velocities, axis=1)[owners],
+                                         "fluid_force": fluid_force[owners],
+                                         "contact_force": contact[owners],
+                                         "fixed": solids.fixed[owners].astype(np.int64)})
+
+    def _body_force_rows(self) -> list[str]:
+        """Rows of ``body_forces.csv`` for the present time (one per body)."""
+        coupled, solids = self.solver, self.solids
+        contact = solids.contact_forces()
+        rows = []
+        for b in range(solids.n_bodies):
+            values = [coupled.time, *solids.positions[b], *solids.velocities[b],
+                      *coupled.pressure_loads[b, :3], *coupled.viscous_loads[b, :3], *contact[b]]
+            rows.append(f"{b}," + ",".join(repr(float(v)) for v in values))
+        return rows
+
+    def close_outputs(self) -> dict:
+        outputs = super().close_outputs()
+        if self._body_series is not None:
+            outputs["bodies"] = str(self._body_series.pvd_path)
+            outputs["fluid_and_bodies"] = str(self._combined.path)
+        outputs["body_forces"] = str(self._forces.path)
+        return outputs
+
+    def progress_text(self) -> str:
+        r = self._report
+        if r is None:
+            return ""
+        return (super().progress_text() + f"  bodies: {r.solid_substeps} sub-steps, fastest "
+                f"{r.max_body_speed:.3g} m/s")
+
+    def summary_fields(self, wall_time: float, steps: int) -> dict:
+        fields = super().summary_fields(wall_time, steps)
+        solids = self.solids
+        free = ~solids.fixed
+        speeds = np.linalg.norm(solids.velocities[free], axis=1)
+        fields.update({"bodies": solids.n_bodies, "contacts": len(solids.contacts),
+                       "solid_substeps": self.substeps, "max_speed": float(speeds.max(initial=0.0)),
+                       "body_steps_per_second": self.substeps * solids.n_bodies / max(wall_time, 1e-9)})
+        return fields
+
+    def failure_advice(self, good: dict) -> str:
+        return ("Likely cause: the flow or a body moved more than the steps can carry; lower "
+                "[fluid] courant_number or max_time_step, or [simulation] time_step_safety for "
+                "the contacts, and restart from the checkpoint with --restart.")
+
