@@ -1,24 +1,30 @@
 """Cost of two-way coupling: the fluid step with bodies in it against the same fluid without them.
 
-Default case: a tank (64 x 64 x 64 cells, 0.8 m, water 0.6 m deep) with a grid of moving spheres
-(4 x 4 x 2, D = 8 cells) falling into the water; the same water without bodies as the baseline.
-``--full``: issue 13's case instead, a small placed layer of Core-Loc-like units (3 rows of 5,
-H = 8 cm, 4.8 cells across by V^(1/3), all free) and a fixed toe of 5 cubes in a dam-break wave
-(0.6 m column) on 200 x 64 x 80 = 1.02 M cells; the same wave without bodies as the baseline.
+Default: issue 13's case, the small placed layer (``examples/06_layer_in_wave``: 25 Core-Loc-like
+units of H = 1 m on 135 fixed rocks and the core, the pack committed there) in the dam-break wave of
+that example, on cells of half its size (0.05 m: 140 x 90 x 72 = 0.91 M cells, 11 across a unit's
+Dn); both runs are first carried to ``--start`` s (the bore is on the layer then), and the baseline
+is the same water without any body. ``--spheres``: a tank (64^3 cells, water 0.6 m deep) with a grid
+of moving spheres (D = 8 cells) falling into still water (a still fluid needs no pressure
+iterations, so the ratio there is larger). ``--synthetic``: the earlier synthetic layer (15
+Core-Loc-like units of H = 8 cm in rows and a fixed toe, 1.02 M cells of 1 cm).
 
 Both take the same fixed time step, in the same process, fluid-only and coupled windows
 alternating ``repeats`` times; the best window of each counts (the machine is shared). Prints the
 time per step of each, the coupled step's parts beyond the fluid's (solid volumes: clipping the
 moved bodies and listing the faces they touch; exchange: blends, momentum systems and loads on
 those faces; the pressure solve's extra time with the mixture density; contact sub-steps), the
-load average, and, last line, ``METRIC coupling_overhead <coupled step / fluid step - 1> ratio``
+load average, then (unless ``--no-ten-cate``) the wall time of ten Cate's case E2 end to end at 4
+and 6 cells per diameter, and last ``METRIC coupling_overhead <coupled step / fluid step - 1> ratio``
 (issue 13's target: at most 0.5).
 
-    python bench/coupled.py [cells] [spheres per side] [steps] [--repeats N] [--full]
+    python bench/coupled.py [--steps N] [--repeats N] [--start T] [--spheres | --synthetic]
 """
 import argparse
+import dataclasses
 import os
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -30,6 +36,8 @@ from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
 from riprap.solid.solver import SolidSolver
 
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "06_layer_in_wave" / "case.toml"
+PLACED_CELLS = (140, 90, 72)         # 0.05 m cells over the example's 7 x 4.5 x 3.6 m box
 LENGTH = 0.8
 LEVEL = 0.6
 TIME_STEP = 1.0e-3
@@ -100,13 +108,24 @@ def armour_layer(fluid):
     return CoupledSolver(fluid, solids)
 
 
-def window(solver, steps):
+def placed_layer():
+    """(fluid alone, the same fluid coupled to the placed layer) of example 06 at PLACED_CELLS."""
+    from riprap.case.build_fluid import build_fluid_run, build_fluid_solver
+    from riprap.case.load import load_case
+
+    case = load_case(EXAMPLE)
+    case = dataclasses.replace(case, fluid=dataclasses.replace(case.fluid, cells=PLACED_CELLS))
+    simulation = build_fluid_run(case, output_directory="/tmp/riprap_bench_coupled", progress=False)
+    return build_fluid_solver(case), simulation.model.solver
+
+
+def window(solver, steps, time_step):
     """(seconds per step, pressure seconds per step, parts per step) over ``steps`` steps."""
     parts = np.zeros(3)
     pressure = 0.0
     started = time.perf_counter()
     for _ in range(steps):
-        solver.step(TIME_STEP)
+        solver.step(time_step)
         pressure += solver.last_pressure_seconds
         if isinstance(solver, CoupledSolver):
             parts += (solver.last_solid_volume_seconds, solver.last_exchange_seconds,
@@ -114,42 +133,74 @@ def window(solver, steps):
     return (time.perf_counter() - started) / steps, pressure / steps, parts / steps
 
 
-def measure(baseline, coupled, steps, repeats):
-    baseline.step(TIME_STEP)            # compile and first steps outside the timing
-    coupled.step(TIME_STEP)
+def measure(baseline, coupled, steps, repeats, time_step):
+    baseline.step(time_step)            # compile and first steps outside the timing
+    coupled.step(time_step)
     fluid_windows, coupled_windows = [], []
     for _ in range(repeats):
-        fluid_windows.append(window(baseline, steps))
-        coupled_windows.append(window(coupled, steps))
+        fluid_windows.append(window(baseline, steps, time_step))
+        coupled_windows.append(window(coupled, steps, time_step))
     return min(fluid_windows, key=lambda w: w[0]), min(coupled_windows, key=lambda w: w[0])
+
+
+def carry_to(solver, end_time):
+    """Step ``solver`` with its own stable steps until ``end_time`` is passed (not landing on
+    it: a short last step would hold the next ones short); returns the wall seconds."""
+    started = time.perf_counter()
+    while solver.time < end_time:
+        solver.step(solver.stable_time_step())
+    return time.perf_counter() - started
+
+
+def ten_cate_wall_times():
+    from riprap.benchmarks.ten_cate import run_ten_cate_e2
+
+    for cells_per_diameter in (4, 6):
+        run = run_ten_cate_e2(cells_per_diameter)
+        print(f"ten Cate E2 end to end at {run.cells_per_diameter:.2f} cells per diameter: "
+              f"{run.wall_time:.1f} s wall, {run.steps} steps")
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("cells", nargs="?", type=int, default=64)
-    parser.add_argument("per_side", nargs="?", type=int, default=4)
-    parser.add_argument("steps", nargs="?", type=int, default=20)
+    parser.add_argument("--steps", type=int, default=10)
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--full", action="store_true",
-                        help="the issue's case: a placed Core-Loc-like layer in a dam-break wave, 1 M cells")
+    parser.add_argument("--start", type=float, default=0.5,
+                        help="simulated time (s) both runs reach before the timing (placed layer)")
+    case = parser.add_mutually_exclusive_group()
+    case.add_argument("--spheres", action="store_true", help="spheres falling into still water")
+    case.add_argument("--synthetic", action="store_true",
+                      help="the synthetic Core-Loc-like rows in a dam break on 1 cm cells")
+    parser.add_argument("--no-ten-cate", action="store_true", help="skip ten Cate E2 end to end")
     args = parser.parse_args()
     load_before = os.getloadavg()
-    if args.full:
-        baseline = dam_break()
-        coupled = armour_layer(dam_break())
+    time_step = TIME_STEP
+    if args.spheres:
+        baseline, coupled = tank(64), spheres(tank(64), 4)
+        print(f"64^3 = {64 ** 3:,} cells, {coupled.solids.n_bodies} moving spheres of 8 cells "
+              f"across, dt = {time_step} s, {args.steps} steps x {args.repeats}")
+    elif args.synthetic:
+        baseline, coupled = dam_break(), armour_layer(dam_break())
         solids = coupled.solids
         print(f"dam break on {np.prod(DAM_CELLS):,} cells ({' x '.join(map(str, DAM_CELLS))}, "
               f"{DAM_CELL} m), {int((~solids.fixed).sum())} free Core-Loc-like units "
-              f"(H = {UNIT_HEIGHT} m, {solids.table.tets.shape[0]:,} tets of both shapes), "
-              f"{int(solids.fixed.sum())} fixed toe cubes, dt = {TIME_STEP} s, {args.steps} steps "
-              f"x {args.repeats}")
+              f"(H = {UNIT_HEIGHT} m), {int(solids.fixed.sum())} fixed toe cubes, dt = {time_step} s, "
+              f"{args.steps} steps x {args.repeats}")
     else:
-        baseline = tank(args.cells)
-        coupled = spheres(tank(args.cells), args.per_side)
-        print(f"{args.cells}^3 = {args.cells ** 3:,} cells, {coupled.solids.n_bodies} moving "
-              f"spheres of 8 cells across, dt = {TIME_STEP} s, {args.steps} steps x {args.repeats}")
+        baseline, coupled = placed_layer()
+        solids = coupled.solids
+        print(f"placed layer (examples/06_layer_in_wave) on {np.prod(PLACED_CELLS):,} cells "
+              f"({' x '.join(map(str, PLACED_CELLS))}, {baseline.h:g} m): "
+              f"{int((~solids.fixed).sum())} free units, {int(solids.fixed.sum())} fixed bodies, "
+              f"{solids.table.tets.shape[0]:,} tets of all shapes")
+        fluid_seconds, coupled_seconds = carry_to(baseline, args.start), carry_to(coupled, args.start)
+        # half the stable step: the flow speeds up over the windows (splash on the layer)
+        time_step = 0.5 * min(baseline.stable_time_step(), coupled.stable_time_step())
+        print(f"carried to t = {args.start} s: fluid alone {fluid_seconds:.0f} s wall, coupled "
+              f"{coupled_seconds:.0f} s wall ({coupled_seconds / fluid_seconds - 1:+.2f}); then "
+              f"dt = {time_step:.2e} s, {args.steps} steps x {args.repeats}")
     (fluid_step, fluid_pressure, _), (coupled_step, coupled_pressure, parts) = measure(
-        baseline, coupled, args.steps, args.repeats)
+        baseline, coupled, args.steps, args.repeats, time_step)
     print(f"fluid only: {fluid_step * 1e3:.1f} ms/step (pressure solve {fluid_pressure * 1e3:.1f}); "
           f"with the bodies: {coupled_step * 1e3:.1f} ms/step (pressure solve "
           f"{coupled_pressure * 1e3:.1f}, {coupled.last_report.pressure_iterations} iterations in "
@@ -162,6 +213,8 @@ def main():
     print(f"last step: {coupled.last_clipped_bodies} bodies clipped; largest body speed "
           f"{np.linalg.norm(coupled.solids.velocities, axis=1).max():.3f} m/s")
     print(f"load average before {load_before[0]:.2f}, after {os.getloadavg()[0]:.2f}")
+    if not args.no_ten_cate:
+        ten_cate_wall_times()
     print(f"METRIC coupling_overhead {coupled_step / fluid_step - 1.0:.3f} ratio")
 
 

@@ -109,12 +109,21 @@ def _analyse(paths: list[Path], out: str | None, frame: int, labels: list[str] |
         layer = analysis.layer
         print(f"riprap: analysed {layer['source']}: {layer['units']} {layer['unit']} units on "
               f"{layer['underlayer_bodies']} underlayer bodies")
-        print(f"riprap: coordination number {layer['coordination_number_min']}..."
-              f"{layer['coordination_number_max']} (mean {layer['coordination_number_mean']:.2f}); "
-              f"largest contact force {layer['max_contact_force_N']:.4g} N "
-              f"({layer['max_contact_force_N'] / max(layer['unit_weight_N'], 1e-300):.2f} unit "
-              f"weights); smallest factor of safety {layer['factor_of_safety_min']:.3f}, "
-              f"{len(layer['units_below_factor_of_safety_1'])} unit(s) below 1")
+        if layer.get("coordination_number_mean") is not None:
+            print(f"riprap: coordination number {layer['coordination_number_min']}..."
+                  f"{layer['coordination_number_max']} (mean {layer['coordination_number_mean']:.2f}); "
+                  f"largest contact force {layer['max_contact_force_N']:.4g} N "
+                  f"({layer['max_contact_force_N'] / max(layer['unit_weight_N'], 1e-300):.2f} unit "
+                  f"weights); smallest factor of safety {layer['factor_of_safety_min']:.3f}, "
+                  f"{len(layer['units_below_factor_of_safety_1'])} unit(s) below 1")
+        else:
+            print("riprap: no contacts were recorded (a coupled run): no coordination numbers, "
+                  "contact forces or factors of safety")
+        if "max_displacement_m" in layer:
+            print(f"riprap: displacements since {layer['displacement_reference']}: largest "
+                  f"{layer['max_displacement_m']:.3g} m ({layer['max_displacement_over_dn']:.2f} Dn), "
+                  f"mean {layer['mean_displacement_m']:.3g} m; {len(layer['units_moved'])} unit(s) "
+                  "moved more than 0.1 Dn")
         print(f"riprap: packing density coefficient {layer['packing_density_coefficient']:.3f} "
               f"(design {layer['design_packing_density_coefficient']:.3f}), porosity "
               f"{layer['porosity']:.3f}, layer thickness {layer['layer_thickness_m']:.3f} m")

@@ -36,6 +36,13 @@ from riprap.errors import CaseFileError
 from riprap.fluid.solver import FluidSolver
 from riprap.solid.solver import SolidSolver
 
+#: A cell counts as filled by fixed bodies when they hold all but this share of it.
+_FULL_SLACK = 1e-9
+#: A cell and its six face neighbours.
+_FACE_NEIGHBOURS = np.array([[[0, 0, 0], [0, 1, 0], [0, 0, 0]],
+                             [[0, 1, 0], [1, 1, 1], [0, 1, 0]],
+                             [[0, 0, 0], [0, 1, 0], [0, 0, 0]]], dtype=bool)
+
 __all__ = ["CoupledSolver", "CoupledStepReport", "fluid_box_walls", "MINIMUM_CELLS_ACROSS"]
 
 #: A moving body must span at least this many cells (by its nominal diameter, V^(1/3)): at 3
@@ -157,6 +164,12 @@ class CoupledSolver:
         self._blocks = None
         self._block_poses = None
         self.obstacle_bodies = np.asarray(obstacle_bodies, dtype=np.int64)
+        #: The last step's projected (divergence-free) velocity on its faces: (axis, index,
+        #: values), or None before the first step.
+        self._carried = None
+        #: Faces between fixed bodies' cells and their deep cells (made obstacle cells of the
+        #: fluid): (body, axis, face index, half cell fraction) arrays; None: none.
+        self._shut = None
         if len(self.obstacle_bodies) and not solids.fixed[self.obstacle_bodies].all():
             raise CaseFileError("coupling: obstacle bodies must be fixed")
         self.last_clipped_bodies = 0
@@ -173,6 +186,7 @@ class CoupledSolver:
         self.last_exchange_seconds = 0.0
         self.last_solid_seconds = 0.0
         self._check_bodies_in_grid()
+        self._close_fixed_interiors()
 
     # ------------------------------------------------------------------ the run loop's view
     # (riprap.fluid.run.FluidRun drives a CoupledSolver as it drives a FluidSolver)
@@ -193,7 +207,14 @@ class CoupledSolver:
         return self.fluid.last_report
 
     def stable_time_step(self) -> float:
-        return self.fluid.stable_time_step()
+        """The fluid's stable step, held to its Courant number by the field that carries the
+        water too (``_carriers``)."""
+        step = self.fluid.stable_time_step()
+        if self._carried is not None:
+            speed = float(np.abs(self._carried[2]).max(initial=0.0))
+            if speed > 0.0:
+                step = min(step, self.fluid.courant_number * self.fluid.h / speed)
+        return step
 
     def state_arrays(self) -> dict:
         """Fluid and bodies, and the loads held between them: a restart continues bit for bit."""
@@ -202,6 +223,9 @@ class CoupledSolver:
             arrays[f"bodies_{name}"] = value
         arrays["bodies_fluid_loads"] = self.fluid_loads.copy()
         arrays["bodies_external_loads"] = self.solids.external_loads.copy()
+        if self._carried is not None:
+            for name, value in zip(("axis", "index", "values"), self._carried):
+                arrays[f"coupling_carried_{name}"] = value.copy()
         return arrays
 
     def load_state_arrays(self, arrays: dict) -> None:
@@ -211,6 +235,9 @@ class CoupledSolver:
         self.fluid_loads = np.array(arrays["bodies_fluid_loads"], dtype=np.float64)
         self.solids.external_loads[:] = arrays["bodies_external_loads"]
         self._blocks = self._block_poses = None
+        self._carried = (tuple(np.array(arrays[f"coupling_carried_{name}"])
+                               for name in ("axis", "index", "values"))
+                         if "coupling_carried_axis" in arrays else None)
 
     def body_fraction(self) -> np.ndarray:
         """Solid fraction of every cell held by the bodies, at their present poses (nx, ny, nz)."""
@@ -238,6 +265,90 @@ class CoupledSolver:
         self.last_clipped_bodies = len(stale)
         return merge_blocks(self.fluid.grid, self._blocks)
 
+
+    def _close_fixed_interiors(self) -> None:
+        """Make the deep inside of the fixed bodies obstacle cells of the fluid: cells that fixed
+        bodies fill, whose six neighbours they fill too. Nothing moves there, yet a core or a
+        mound would otherwise put hundreds of thousands of faces into every step's exchange and
+        cells into every pressure solve. The cells at their surface stay in the exchange, so the
+        water sees the same solid, and the pressure load on a fixed body still sums to the
+        pressure on its surface (``rigid_coupling.touched_faces``). Water that the case put
+        inside a fixed body is taken out (before the first step, so the water-volume error
+        counts from what is left)."""
+        from scipy.ndimage import binary_erosion
+
+        fixed = np.setdiff1d(np.flatnonzero(self.solids.fixed), self.obstacle_bodies)
+        if not len(fixed):
+            return
+        volumes = self._solid_volumes()
+        cells = tuple(int(n) for n in self._cells)
+        filled = np.zeros(cells)
+        for body in fixed:
+            (i, j, k), block = volumes.block(body)
+            bi, bj, bk = block.shape
+            filled[i:i + bi, j:j + bj, k:k + bk] += block
+        full = filled >= (1.0 - _FULL_SLACK) * self.fluid.h ** 3
+        deep = binary_erosion(full, structure=_FACE_NEIGHBOURS, border_value=1)
+        if deep.any():
+            self.fluid.add_obstacle_mask(deep | self.fluid.solid)
+            self._shut_faces_of(fixed, volumes, deep)
+
+    def _carriers(self):
+        """The fluid's velocity with the last projected field on the faces the bodies touched:
+        what carries the water and the mass (None before the first step: the velocity itself)."""
+        if self._carried is None:
+            return None
+        axis, index, values = self._carried
+        carriers = (self.fluid.u.copy(), self.fluid.v.copy(), self.fluid.w.copy())
+        rigid_coupling.scatter(axis, index, values, *carriers)
+        return carriers
+
+    def _shut_faces_of(self, fixed, volumes, deep) -> None:
+        """Per fixed body, the faces between its cells and the deep cells (each with the half
+        cell fraction every cell beside it gives it), for ``_shut_face_loads``."""
+        body_parts, axis_parts, index_parts, weight_parts = [], [], [], []
+        cells = self._cells
+        for body in fixed:
+            (i, j, k), block = volumes.block(body)
+            fraction = block / self.fluid.h ** 3
+            for axis in range(3):
+                for side in (0, 1):
+                    where = np.argwhere(fraction > 0.0)
+                    if not len(where):
+                        continue
+                    cell = where + (i, j, k)
+                    other = cell.copy()
+                    other[:, axis] += 1 if side else -1
+                    inside = (other[:, axis] >= 0) & (other[:, axis] < cells[axis])
+                    cell, other, where = cell[inside], other[inside], where[inside]
+                    across = deep[tuple(cell.T)] != deep[tuple(other.T)]
+                    face = (cell if side == 0 else other)[across]
+                    body_parts.append(np.full(len(face), body))
+                    axis_parts.append(np.full(len(face), axis))
+                    index_parts.append(face)
+                    weight_parts.append(0.5 * fraction[tuple(where[across].T)])
+        self._shut = (np.concatenate(body_parts), np.concatenate(axis_parts),
+                      np.concatenate(index_parts), np.concatenate(weight_parts))
+
+    def _shut_face_loads(self, pressure) -> np.ndarray:
+        """Force and torque (bodies, 6) of the pressure on the faces that close the deep cells:
+        half a cell fraction times (p below - p above) h^2 on each, the deep cell's pressure
+        being 0 (the same on every such face, so that a body's sum still telescopes to the
+        pressure on its surface)."""
+        body, axis, index, weight = self._shut
+        low = index.copy()
+        low[np.arange(len(low)), axis] -= 1
+        force = weight * (pressure[tuple(low.T)] - pressure[tuple(index.T)]) * self.fluid.h ** 2
+        centre = np.asarray(self.grid.lower) + (index + 0.5) * self.fluid.h
+        centre[np.arange(len(centre)), axis] -= 0.5 * self.fluid.h
+        vectors = np.zeros((len(force), 3))
+        vectors[np.arange(len(force)), axis] = force
+        moments = np.cross(centre - self.solids.positions[body], vectors)
+        loads = np.zeros((self.solids.n_bodies, 6))
+        for a in range(3):
+            loads[:, a] = np.bincount(body, vectors[:, a], minlength=len(loads))
+            loads[:, 3 + a] = np.bincount(body, moments[:, a], minlength=len(loads))
+        return loads
 
     def _check_bodies_in_grid(self) -> None:
         """Refuse a body that reaches outside the fluid box, or a moving body narrower than
@@ -284,13 +395,13 @@ class CoupledSolver:
         (axis, index, phi, interior, entry_start, entry_face,
          entry_half) = rigid_coupling.touched_faces(volumes.origin, volumes.shape, volumes.offset,
                                                     volumes.values, self.fluid.h ** 3, self._cells,
-                                                    self._slots)
+                                                    self._slots, self.fluid.solid.reshape(-1))
         return _FaceSet(axis=axis, index=index, phi=phi, capped=np.minimum(phi, 1.0),
                         interior=interior, entries=(entry_start, entry_face, entry_half))
 
     def step(self, dt: float | None = None) -> CoupledStepReport:
         fluid, solids = self.fluid, self.solids
-        dt, courant = fluid.begin_step(dt)
+        dt, courant = fluid.begin_step(self.stable_time_step() if dt is None else dt)
         free = ~solids.fixed
         inertia = self._world_inertia()
         # Every body is blended in with the motion it would have after falling freely for dt
@@ -316,7 +427,7 @@ class CoupledSolver:
         rigid_coupling.face_mean_density(faces.axis, faces.index, faces.interior, fluid.fraction,
                                          fluid.water.density, fluid.air.density, start_density)
         exchange_seconds = time.perf_counter() - started
-        u, v, w, fluid_densities = fluid.predict(dt)
+        u, v, w, fluid_densities = fluid.predict(dt, advecting=self._carriers())
         started = time.perf_counter()
         fluid_part, rho_fluid = faces.empty(), faces.empty()
         faces.gather((u, v, w), fluid_part)
@@ -376,11 +487,18 @@ class CoupledSolver:
         # still takes (the momentum the fluid gave its faces, less the fall it was blended in with).
         loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted_dry)
                  - np.einsum("bij,bj->bi", matrices - body_matrices, final)) / dt
+        if self._shut is not None:
+            shut = self._shut_face_loads(pressure)
+            loads += shut
+            pressure_rhs = pressure_rhs + shut
         rigid = faces.zeros()
         rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
                                         fluid.h, centres, final, ones, faces.phi, rho_fluid, rigid)
         after = fluid_share * projected + rigid
         faces.scatter(after, (u, v, w))
+        # The projected field is divergence free; the water and the mass of the next step move
+        # with it (FluidSolver.predict's advecting), not with the rigid motion written above.
+        self._carried = (faces.axis.copy(), faces.index.copy(), projected.copy())
         if self.check_momentum:
             self.last_exchange_balance = self._exchange_balance(
                 faces, fluid_share * rho_fluid, fluid_part, after, mixture, blended, projected,

@@ -227,10 +227,11 @@ class FluidSolver:
         return step
 
     # ------------------------------------------------------------------ stepping
-    def _advect_water(self, dt: float):
+    def _advect_water(self, dt: float, velocities=None):
         from riprap.fluid.kernels import plic
 
-        return plic.advect(self.fraction, self.u, self.v, self.w, dt, self.h, self.step_count)
+        u, v, w = velocities or (self.u, self.v, self.w)
+        return plic.advect(self.fraction, u, v, w, dt, self.h, self.step_count)
 
     def _face_coefficients(self, densities):
         """1/rho on every face: transported densities inside, walls 0, the open top 1/rho of the
@@ -276,18 +277,24 @@ class FluidSolver:
                                    f"(dt = {dt:.3e} s, largest speed {self.max_speed():.3g} m/s)")
         return dt, courant
 
-    def predict(self, dt: float):
+    def predict(self, dt: float, advecting=None):
         """The step up to the pressure: water moved (PLIC), momentum moved with the mass fluxes,
         viscosity, gravity, surface tension, obstacle faces zeroed. Returns (u*, v*, w*, the
-        transported face densities per axis); ``fraction`` is already at the new time."""
+        transported face densities per axis); ``fraction`` is already at the new time.
+
+        ``advecting``: (u, v, w) that carry the water and the mass instead of the velocity itself;
+        the coupling passes the last divergence-free field there, since its own velocity, made
+        rigid inside the bodies after the projection, is not divergence free in the cells the
+        bodies cut, and water carried by it is not conserved."""
         h = self.h
         density_start = self.cell_density()
         viscosity_start = self.cell_viscosity()
-        water_fluxes = self._advect_water(dt)
+        carriers = advecting or (self.u, self.v, self.w)
+        water_fluxes = self._advect_water(dt, carriers)
         area = h * h
         masses = [momentum.mass_fluxes(water_fluxes[a], velocity, dt, area, self.water.density,
                                        self.air.density)
-                  for a, velocity in enumerate((self.u, self.v, self.w))]
+                  for a, velocity in enumerate(carriers)]
         velocities = (self.u, self.v, self.w)
         new_velocities, densities = [], []
         two_d = self.grid.two_dimensional

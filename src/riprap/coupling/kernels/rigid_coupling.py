@@ -48,11 +48,30 @@ def face_count(cells) -> int:
 
 
 @kernel
-def touched_faces(origin, shape, offset, values, cell_volume, cells, slots):
+def _solid_cell(solid, i, j, k, cells):
+    """Whether cell (i, j, k) is an obstacle cell of the fluid (outside the grid is not)."""
+    if i < 0 or j < 0 or k < 0 or i >= cells[0] or j >= cells[1] or k >= cells[2]:
+        return False
+    return solid[(i * cells[1] + j) * cells[2] + k]
+
+
+@kernel
+def _shut(solid, axis, i, j, k, cells):
+    """Whether face (axis, i, j, k) has an obstacle cell on either side (the fluid holds it shut)."""
+    return (_solid_cell(solid, i, j, k, cells)
+            or _solid_cell(solid, i - (axis == 0), j - (axis == 1), k - (axis == 2), cells))
+
+
+@kernel
+def touched_faces(origin, shape, offset, values, cell_volume, cells, slots, solid):
     """The faces that any body's cells touch, and per body its entries.
 
     ``slots`` (``face_count(cells)``,) int32, all -1 on entry and on return: a face's place in the
     set while it is built (kept between steps so that no grid-sized array is made per step).
+    ``solid`` (cells, C order) bool: the fluid's obstacle cells. A face beside one is shut by the
+    fluid (zero velocity, no pressure coupling through it) and is left out; the pressure on the
+    faces that close the deep inside of fixed bodies reaches those bodies apart
+    (``CoupledSolver._shut_face_loads``).
     Returns face_axis (F,), face_index (F, 3), phi (F,) the faces' summed body fractions
     (uncapped; wall faces too), interior (F,) bool, entry_start (bodies + 1,), entry_face (E,),
     entry_half (E,). Bodies, cells (C order), axes and sides are visited in a fixed order, so
@@ -60,9 +79,16 @@ def touched_faces(origin, shape, offset, values, cell_volume, cells, slots):
     """
     bodies = origin.shape[0]
     most = 0
-    for n in range(values.shape[0]):
-        if values[n] != 0.0:
-            most += 6
+    for b in range(bodies):
+        bi, bj, bk = shape[b, 0], shape[b, 1], shape[b, 2]
+        for p in range(bi):
+            for q in range(bj):
+                for s in range(bk):
+                    if values[offset[b] + (p * bj + q) * bk + s] == 0.0:
+                        continue
+                    if not _solid_cell(solid, origin[b, 0] + p, origin[b, 1] + q,
+                                       origin[b, 2] + s, cells):
+                        most += 6
     face_axis = np.empty(most, dtype=np.int64)
     face_index = np.empty((most, 3), dtype=np.int64)
     face_key = np.empty(most, dtype=np.int64)
@@ -82,11 +108,16 @@ def touched_faces(origin, shape, offset, values, cell_volume, cells, slots):
                     if c == 0.0:
                         continue
                     half = 0.5 * c
+                    if _solid_cell(solid, origin[b, 0] + p, origin[b, 1] + q, origin[b, 2] + s,
+                                   cells):
+                        continue
                     for axis in range(3):
                         for side in range(2):
                             i = origin[b, 0] + p + (side if axis == 0 else 0)
                             j = origin[b, 1] + q + (side if axis == 1 else 0)
                             k = origin[b, 2] + s + (side if axis == 2 else 0)
+                            if _shut(solid, axis, i, j, k, cells):
+                                continue
                             key = _face_key(axis, i, j, k, cells)
                             slot = slots[key]
                             if slot < 0:
