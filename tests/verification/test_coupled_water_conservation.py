@@ -9,7 +9,6 @@ pressure solver's tolerance), and carrying it by the rigid-corrected field does 
 fails without the fix). Measured: 1.6e-12 with the divergence-free carrier, −3.3 % without.
 """
 import numpy as np
-import pytest
 
 from riprap import FluidGrid, FluidSolver
 from riprap.coupling.coupled import CoupledSolver
