@@ -189,7 +189,7 @@ class CoupledSolver:
         self._close_fixed_interiors()
 
     # ------------------------------------------------------------------ the run loop's view
-    # (riprap.fluid.run.FluidRun drives a CoupledSolver as it drives a FluidSolver)
+    # (riprap.models.fluid.CoupledModel drives a CoupledSolver as FluidModel drives a FluidSolver)
     @property
     def time(self) -> float:
         return self.fluid.time
@@ -311,11 +311,12 @@ class CoupledSolver:
         for body in fixed:
             (i, j, k), block = volumes.block(body)
             fraction = block / self.fluid.h ** 3
+            filled = np.argwhere(fraction > 0.0)
+            if not len(filled):
+                continue
             for axis in range(3):
                 for side in (0, 1):
-                    where = np.argwhere(fraction > 0.0)
-                    if not len(where):
-                        continue
+                    where = filled
                     cell = where + (i, j, k)
                     other = cell.copy()
                     other[:, axis] += 1 if side else -1
