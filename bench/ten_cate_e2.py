@@ -32,7 +32,10 @@ def main(resolutions):
               f"peak {errors['peak_speed_m_per_s']:.4f} m/s vs {errors['record_peak_speed_m_per_s']:.4f} "
               f"({100 * errors['peak_speed_error']:+.1f} %), plateau L2 "
               f"{100 * errors['plateau_velocity_l2']:.1f} %, contact at {errors['contact_time_s']:.3f} s "
-              f"vs {errors['record_contact_time_s']:.3f} s ({errors['contact_time_error']:+.3f} s)")
+              f"vs {errors['record_contact_time_s']:.3f} s ({errors['contact_time_error']:+.3f} s); "
+              f"speed by gap L2 {100 * errors['velocity_by_gap_l2']:.1f} %, steady fall (7 D to 2 D) "
+              f"{errors['steady_speed_m_per_s']:.4f} vs {errors['record_steady_speed_m_per_s']:.4f} m/s "
+              f"({100 * errors['steady_speed_error']:+.1f} %)")
         last = (run, errors)
     run, errors = last
     print(f"METRIC ten_cate_e2_peak_speed_error {100 * abs(errors['peak_speed_error']):.2f} percent")

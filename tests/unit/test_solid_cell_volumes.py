@@ -182,3 +182,36 @@ def test_surface_integration_equals_clipping_tetrahedra():
     assert np.abs(clipped.values - surface.values).max() < 1e-12 * cell
     assert (surface.values >= 0).all()
     assert 0 < surface.body_volume(3) < meshes[3].volumes().sum()
+
+
+def test_half_cell_volumes_of_a_box_are_products_of_overlaps():
+    """The halves of every cell along each axis (the faces' control volumes of the coupling) for
+    an axis-aligned box body: products of 1D overlaps, and the cells as their sums."""
+    from riprap.coupling.solid_volumes import rigid_body_half_cell_volumes
+
+    h = 0.1
+    grid = FluidGrid(lower=(0, 0, 0), upper=(1.0, 0.8, 0.6), cells=(10, 8, 6))
+    solver = rr.SolidSolver(gravity=(0, 0, 0))
+    solver.add_shape(rr.RigidShape.from_mesh(rr.shapes.box(lengths=(0.33, 0.27, 0.21)),
+                                             name="box"))
+    solver.add_material(rr.Material(name="concrete"))
+    centre = np.array([0.217, 0.131, 0.052]) + 0.5 * np.array([0.33, 0.27, 0.21])
+    solver.add_body(shape=0, material="concrete", position=centre)
+    [(origin, cells, halves)] = rigid_body_half_cell_volumes(grid, solver)
+    lower, upper = centre - [0.165, 0.135, 0.105], centre + [0.165, 0.135, 0.105]
+    edges = [np.arange(n + 1) * h for n in grid.cells]
+    for axis in range(3):
+        for side in range(2):
+            overlaps = []
+            for a in range(3):
+                first, last = edges[a][:-1], edges[a][1:]
+                if a == axis:   # the lower or the upper half of each cell along this axis
+                    first, last = (first, first + h / 2) if side == 0 else (first + h / 2, last)
+                overlaps.append(_overlap_1d(first, last, lower[a], upper[a]))
+            exact = overlaps[0][:, None, None] * overlaps[1][None, :, None] * overlaps[2][None, None, :]
+            bi, bj, bk = cells.shape
+            block = exact[origin[0]:origin[0] + bi, origin[1]:origin[1] + bj, origin[2]:origin[2] + bk]
+            assert np.abs(halves[..., axis, side] - block).max() < 1e-12 * h ** 3
+            assert exact.sum() == pytest.approx(block.sum(), rel=1e-12)   # the block holds it all
+        assert np.abs(halves[..., axis, :].sum(axis=-1) - cells).max() < 1e-12 * h ** 3
+    assert cells.sum() == pytest.approx(0.33 * 0.27 * 0.21, rel=1e-12)

@@ -2,8 +2,10 @@
 
 A cube of half water's density (0.1 m, 8 cells across, ``riprap.benchmarks.floating_box``) is
 released 2 cm above its floating position in a 0.4 m tank, heaves, and settles: its mean draught over
-the third second lies within ``DRAUGHT_TOLERANCE`` of Archimedes' (half its height; measured −1.2 %,
-−0.5 % over the sixth second), the heave dies down, and the water is conserved.
+the third and fourth seconds lies within ``DRAUGHT_TOLERANCE`` of Archimedes' (half its height;
+measured −1.3 %; −0.2 % over the third to sixth, −0.7 % over the sixth), the heave dies down, and
+the water is conserved. The heave (±7 mm in the third second) is slow to die, so a window of one
+second reads a part of a period too many or too few: over the third second alone −2.2 %.
 """
 import numpy as np
 import pytest
@@ -15,7 +17,7 @@ DRAUGHT_TOLERANCE = 0.02
 
 @pytest.fixture(scope="module")
 def run():
-    return run_floating_box(cells=32, seconds=3.0, start_above=0.02)
+    return run_floating_box(cells=32, seconds=4.0, start_above=0.02)
 
 
 def test_the_cube_floats_at_the_archimedes_draught(run):

@@ -34,9 +34,12 @@ class TenCateRun:
     steps: int
 
 
-def run_ten_cate_e2(cells_per_diameter: int, *, end_time: float = 3.0, progress=None) -> TenCateRun:
+def run_ten_cate_e2(cells_per_diameter: int, *, end_time: float = 3.0, progress=None,
+                    shift=(0.0, 0.0)) -> TenCateRun:
     """Run case E2 with ``cells_per_diameter`` cells across the sphere (the box is cut into whole
-    cells: 100 mm / h must be an integer, so the allowed values make 100/15 x n whole)."""
+    cells: 100 mm / h must be an integer, so the allowed values make 100/15 x n whole).
+    ``shift``: the sphere's start moved off the box's vertical axis by these fractions of a cell
+    along x and y (to see how much the result depends on where the cells cut the sphere)."""
     import time
 
     from riprap.coupling.coupled import CoupledSolver
@@ -44,6 +47,7 @@ def run_ten_cate_e2(cells_per_diameter: int, *, end_time: float = 3.0, progress=
     from riprap.fluid.phases import Phase
     from riprap.fluid.solver import FluidSolver
     from riprap.geometry import shapes
+    from riprap.geometry.tetmesh import TetMesh
     from riprap.solid.materials import Material
     from riprap.solid.shape import RigidShape
     from riprap.solid.solver import SolidSolver
@@ -63,13 +67,19 @@ def run_ten_cate_e2(cells_per_diameter: int, *, end_time: float = 3.0, progress=
                         gravity=(0.0, 0.0, -case["gravity"]), surface_tension=0.0)
     fluid.set_still_water_level(upper[2])
     solids = SolidSolver(gravity=(0.0, 0.0, -case["gravity"]))
-    shape = solids.add_shape(RigidShape.from_mesh(shapes.sphere(radius=0.5 * d,
-                                                                 mesh_size=d / 8)))
+    # The polyhedron inscribed in the sphere lacks 2 % of its volume at this mesh size; grown to
+    # the sphere's volume, it has the experiment's weight and buoyancy.
+    mesh = shapes.sphere(radius=0.5 * d, mesh_size=d / 8)
+    exact = np.pi * d ** 3 / 6.0
+    mesh = TetMesh(nodes=mesh.nodes * (exact / mesh.volumes().sum()) ** (1.0 / 3.0), tets=mesh.tets,
+                   name=mesh.name)
+    shape = solids.add_shape(RigidShape.from_mesh(mesh))
     # A soft contact: the sphere meets the floor only at the very end (no rebound, ten Cate).
     solids.add_material(Material(name="nylon", density=case["sphere_density"], restitution=0.1,
                                  friction_coefficient=0.3, contact_penalty=1.0e6))
     solids.add_body(shape=shape, material="nylon",
-                    position=(0.5 * upper[0], 0.5 * upper[1], case["start_gap"] + 0.5 * d))
+                    position=(0.5 * upper[0] + shift[0] * h, 0.5 * upper[1] + shift[1] * h,
+                              case["start_gap"] + 0.5 * d))
     coupled = CoupledSolver(fluid, solids)
     times, velocities, gaps = [0.0], [0.0], [case["start_gap"] / d]
     started = time.perf_counter()
@@ -85,11 +95,19 @@ def run_ten_cate_e2(cells_per_diameter: int, *, end_time: float = 3.0, progress=
                       steps=fluid.step_count)
 
 
+def _diameter() -> float:
+    return TEN_CATE_E2["diameter"]
+
+
 def compare_with_experiment(run: TenCateRun, velocity_record, gap_record) -> dict:
     """Errors of a run against the digitised record: ``peak_speed_error`` (relative),
     ``plateau_velocity_l2`` (relative L2 over the plateau, 0.5 s to the last time the record's
     speed exceeds 90 % of its peak), ``contact_time_error`` (s: when the gap falls to the record's
-    last value). ``velocity_record`` (t, u_z) and ``gap_record`` (t, gap/D) are arrays (n, 2)."""
+    last value); and, free of any time offset, ``velocity_by_gap_l2`` (relative L2 of the speed
+    at the gaps the record passes from 7 D down to D/4, the record's gap taken from its gap
+    series at the speed record's times) and ``steady_speed_error`` (the mean speed from a gap of
+    7 D to 2 D, against the gap record's). ``velocity_record`` (t, u_z) and ``gap_record``
+    (t, gap/D) are arrays (n, 2)."""
     record_t, record_u = velocity_record[:, 0], velocity_record[:, 1]
     peak_record = np.abs(record_u).max()
     peak_run = np.abs(run.velocities).max()
@@ -102,7 +120,22 @@ def compare_with_experiment(run: TenCateRun, velocity_record, gap_record) -> dic
     record_contact = float(np.interp(-final_gap, -gap_record[:, 1], gap_record[:, 0]))
     below = np.flatnonzero(run.gaps <= final_gap)
     run_contact = float(run.times[below[0]]) if len(below) else float("inf")
+    # The same run against both records at equal gaps rather than equal times: the two
+    # digitised series disagree by about 2 % in speed over the steady fall (the speed record
+    # integrated travels 8.3 D before contact; the box gives 8), and a time offset between
+    # run and record shows up in the time-aligned L2 and contact time but not here.
+    record_gap_at = np.interp(record_t, gap_record[:, 0], gap_record[:, 1])
+    by_gap = (record_gap_at <= 7.0) & (record_gap_at >= 0.25)
+    run_speed = np.interp(-record_gap_at[by_gap], -run.gaps, run.velocities)
+    by_gap_l2 = float(np.sqrt(np.mean((run_speed - record_u[by_gap]) ** 2))
+                      / np.sqrt(np.mean(record_u[by_gap] ** 2)))
+    record_steady = 5.0 * _diameter() / float(np.diff(np.interp([-7.0, -2.0], -gap_record[:, 1],
+                                                                 gap_record[:, 0]))[0])
+    run_steady = 5.0 * _diameter() / float(np.diff(np.interp([-7.0, -2.0], -run.gaps, run.times))[0])
     return {"peak_speed_error": float((peak_run - peak_record) / peak_record),
+            "velocity_by_gap_l2": by_gap_l2,
+            "steady_speed_m_per_s": run_steady, "record_steady_speed_m_per_s": record_steady,
+            "steady_speed_error": (run_steady - record_steady) / record_steady,
             "peak_speed_m_per_s": float(peak_run), "record_peak_speed_m_per_s": float(peak_record),
             "plateau_velocity_l2": plateau, "contact_time_s": run_contact,
             "record_contact_time_s": record_contact,

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from riprap.coupling.kernels import rigid_coupling
-from riprap.coupling.solid_volumes import merge_blocks, rigid_body_cell_volumes
+from riprap.coupling.solid_volumes import merge_blocks, rigid_body_half_cell_volumes
 from riprap.errors import CaseFileError
 from riprap.fluid.solver import FluidSolver
 from riprap.solid.solver import SolidSolver
@@ -253,14 +253,15 @@ class CoupledSolver:
             # an obstacle body holds no cells of the exchange: the fluid's own obstacle does
             self._blocks = [None] * solids.n_bodies
             for body in self.obstacle_bodies:
-                self._blocks[body] = (np.zeros(3, dtype=np.int64), np.zeros((0, 0, 0)))
+                self._blocks[body] = (np.zeros(3, dtype=np.int64), np.zeros((0, 0, 0)),
+                                      np.zeros((0, 0, 0, 3, 2)))
             stale = np.setdiff1d(np.arange(solids.n_bodies), self.obstacle_bodies)
         else:
             stale = np.flatnonzero(np.any(poses != self._block_poses, axis=1))
         if len(stale):
-            fresh = rigid_body_cell_volumes(self.fluid.grid, solids, bodies=stale)
-            for k, body in enumerate(stale):
-                self._blocks[body] = fresh.block(k)
+            fresh = rigid_body_half_cell_volumes(self.fluid.grid, solids, bodies=stale)
+            for body, block in zip(stale, fresh):
+                self._blocks[body] = block
         self._block_poses = poses.copy()
         self.last_clipped_bodies = len(stale)
         return merge_blocks(self.fluid.grid, self._blocks)
@@ -310,8 +311,9 @@ class CoupledSolver:
         cells = self._cells
         for body in fixed:
             (i, j, k), block = volumes.block(body)
-            fraction = block / self.fluid.h ** 3
-            filled = np.argwhere(fraction > 0.0)
+            half_fractions = volumes.halves[6 * volumes.offset[body]:6 * volumes.offset[body + 1]]
+            half_fractions = half_fractions.reshape(block.shape + (3, 2)) / self.fluid.h ** 3
+            filled = np.argwhere(block > 0.0)
             if not len(filled):
                 continue
             for axis in range(3):
@@ -327,7 +329,7 @@ class CoupledSolver:
                     body_parts.append(np.full(len(face), body))
                     axis_parts.append(np.full(len(face), axis))
                     index_parts.append(face)
-                    weight_parts.append(0.5 * fraction[tuple(where[across].T)])
+                    weight_parts.append(half_fractions[tuple(where[across].T) + (axis, side)])
         self._shut = (np.concatenate(body_parts), np.concatenate(axis_parts),
                       np.concatenate(index_parts), np.concatenate(weight_parts))
 
@@ -395,7 +397,8 @@ class CoupledSolver:
         volumes = self._solid_volumes()
         (axis, index, phi, interior, entry_start, entry_face,
          entry_half) = rigid_coupling.touched_faces(volumes.origin, volumes.shape, volumes.offset,
-                                                    volumes.values, self.fluid.h ** 3, self._cells,
+                                                    volumes.values, volumes.halves,
+                                                    self.fluid.h ** 3, self._cells,
                                                     self._slots, self.fluid.solid.reshape(-1))
         return _FaceSet(axis=axis, index=index, phi=phi, capped=np.minimum(phi, 1.0),
                         interior=interior, entries=(entry_start, entry_face, entry_half))
@@ -482,8 +485,12 @@ class CoupledSolver:
             [unaccounted, -pressure_force * np.maximum(faces.capped, 1e-300)])
         rhs, pressure_rhs = rhs[:, 0], rhs[:, 1]
         final = np.zeros((solids.n_bodies, 6))
+        entry_start = faces.entries[0]
         for b in np.flatnonzero(free):
-            final[b] = np.linalg.solve(matrices[b], rhs[b])
+            if entry_start[b + 1] > entry_start[b]:
+                final[b] = np.linalg.solve(matrices[b], rhs[b])
+            else:   # no face in the fluid (thrown out of the box): it flies on by itself
+                final[b] = predicted[b]
         # The fluid's load: the body's own momentum change; for a fixed body what holding it
         # still takes (the momentum the fluid gave its faces, less the fall it was blended in with).
         loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted_dry)

@@ -184,22 +184,26 @@ class CoupledModel(FluidModel):
         self._check_bodies()
 
     def _check_bodies(self) -> None:
-        """A body whose state is not finite, or that moves absurdly fast, stops the run naming the
-        body, the cell it is in and the time."""
+        """A body whose state is not finite, that moves absurdly fast, or whose centre has left
+        the fluid box, stops the run naming the body, the cell it is in and the time."""
         solids = self.solids
+        grid = self.fluid.grid
         speeds = np.linalg.norm(solids.velocities, axis=1)
         finite = np.isfinite(solids.positions).all(axis=1) & np.isfinite(speeds)
-        bad = np.flatnonzero(~finite | (speeds > _RUNAWAY_SPEED))
+        outside = np.zeros(len(speeds), dtype=bool)
+        outside[finite] = np.any((solids.positions[finite] < np.asarray(grid.lower))
+                                 | (solids.positions[finite] > np.asarray(grid.upper)), axis=1)
+        bad = np.flatnonzero(~finite | (speeds > _RUNAWAY_SPEED) | outside)
         if len(bad):
             body = int(bad[0])
-            grid = self.fluid.grid
             where = "no cell (its position is not finite)"
             if finite[body]:
                 cell = np.floor((solids.positions[body] - np.asarray(grid.lower)) / grid.cell_size)
                 where = f"cell {tuple(int(c) for c in cell)}"
-            raise InstabilityError(
-                f"body {body} moves at {speeds[body]:.3g} m/s in {where} at t = {self.time:.6g} s "
-                f"(more than {_RUNAWAY_SPEED:g} m/s, or not finite)")
+            why = ("its centre has left the fluid box" if outside[body]
+                   else f"more than {_RUNAWAY_SPEED:g} m/s, or not finite")
+            raise InstabilityError(f"body {body} moves at {speeds[body]:.3g} m/s in {where} at "
+                                   f"t = {self.time:.6g} s ({why})")
 
     def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
         from riprap.io import vtk

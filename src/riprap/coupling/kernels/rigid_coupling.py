@@ -1,9 +1,9 @@
 """Kernels of the rigidity-constraint coupling: bodies as regions of the one-fluid velocity field.
 
-Every body is held on the staggered fluid grid as blocks of exact cell volumes
-(``tet_cell_volumes``, ``surface_cell_volumes``). The solid fraction of a face's control volume
-(half of each neighbouring cell) is the mean of the two cells' fractions. With ``c`` a cell's solid
-fraction of one body, each of the cell's two faces along an axis receives ``c / 2``.
+Every body is held on the staggered fluid grid as blocks of exact cell volumes and half-cell
+volumes (``solid_volumes.rigid_body_half_cell_volumes``). The solid fraction of a face's control
+volume (the upper half of the cell below it and the lower half of the cell above it) is exact: each
+half cell gives its face its solid volume over h^3.
 
 The coupling works on the faces the bodies touch only, never on the whole grid: ``touched_faces``
 lists them once per step (a compact face set), every per-face quantity of the coupling is an
@@ -63,11 +63,14 @@ def _shut(solid, axis, i, j, k, cells):
 
 
 @kernel
-def touched_faces(origin, shape, offset, values, cell_volume, cells, slots, solid):
+def touched_faces(origin, shape, offset, values, halves, cell_volume, cells, slots, solid):
     """The faces that any body's cells touch, and per body its entries.
 
     ``slots`` (``face_count(cells)``,) int32, all -1 on entry and on return: a face's place in the
     set while it is built (kept between steps so that no grid-sized array is made per step).
+    ``halves`` (6 per block cell, after ``values``): the solid volume in the lower and upper half
+    of each cell along each axis (``solid_volumes.rigid_body_half_cell_volumes``): a face's
+    fraction is the solid share of its own control volume, the two half cells beside it.
     ``solid`` (cells, C order) bool: the fluid's obstacle cells. A face beside one is shut by the
     fluid (zero velocity, no pressure coupling through it) and is left out; the pressure on the
     faces that close the deep inside of fixed bodies reaches those bodies apart
@@ -104,15 +107,17 @@ def touched_faces(origin, shape, offset, values, cell_volume, cells, slots, soli
         for p in range(bi):
             for q in range(bj):
                 for s in range(bk):
-                    c = values[offset[b] + (p * bj + q) * bk + s] / cell_volume
-                    if c == 0.0:
+                    cell = offset[b] + (p * bj + q) * bk + s
+                    if values[cell] == 0.0:
                         continue
-                    half = 0.5 * c
                     if _solid_cell(solid, origin[b, 0] + p, origin[b, 1] + q, origin[b, 2] + s,
                                    cells):
                         continue
                     for axis in range(3):
                         for side in range(2):
+                            half = halves[6 * cell + 2 * axis + side] / cell_volume
+                            if half == 0.0:
+                                continue
                             i = origin[b, 0] + p + (side if axis == 0 else 0)
                             j = origin[b, 1] + q + (side if axis == 1 else 0)
                             k = origin[b, 2] + s + (side if axis == 2 else 0)
