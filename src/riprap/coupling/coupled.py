@@ -173,9 +173,10 @@ class CoupledSolver:
         if len(self.obstacle_bodies) and not solids.fixed[self.obstacle_bodies].all():
             raise CaseFileError("coupling: obstacle bodies must be fixed")
         self.last_clipped_bodies = 0
-        self.fixed_body_loads = np.zeros((n, 6))
-        self.viscous_loads = np.zeros((n, 6))
-        self.pressure_loads = np.zeros((n, 6))
+        # loads for the outputs (``fixed_body_loads``, ``pressure_loads``, ``viscous_loads``)
+        self._free_pressure_loads = np.zeros((n, 6))
+        self._pending_fixed_loads = None
+        self._loads_for_output = (np.zeros((n, 6)), np.zeros((n, 6)))
         # A face's place in the step's face set while it is built (-1: none); kept between steps
         # so that no grid-sized array is made per step.
         self._slots = np.full(rigid_coupling.face_count(grid.cells), -1, dtype=np.int32)
@@ -252,6 +253,7 @@ class CoupledSolver:
         if self._blocks is None:
             # an obstacle body holds no cells of the exchange: the fluid's own obstacle does
             self._blocks = [None] * solids.n_bodies
+            self._cell_lists = [(np.zeros(0, dtype=np.int64), np.zeros((0, 6)))] * solids.n_bodies
             for body in self.obstacle_bodies:
                 self._blocks[body] = (np.zeros(3, dtype=np.int64), np.zeros((0, 0, 0)),
                                       np.zeros((0, 0, 0, 3, 2)))
@@ -262,10 +264,24 @@ class CoupledSolver:
             fresh = rigid_body_half_cell_volumes(self.fluid.grid, solids, bodies=stale)
             for body, block in zip(stale, fresh):
                 self._blocks[body] = block
+                self._cell_lists[body] = self._cell_list(block)
         self._block_poses = poses.copy()
         self.last_clipped_bodies = len(stale)
         return merge_blocks(self.fluid.grid, self._blocks)
 
+
+    def _cell_list(self, block):
+        """(flat grid index of every cell of a body's block that holds solid and is not an
+        obstacle cell of the fluid, their half-cell volumes (n, 6)): what the face set reads, so
+        that it visits the cells at a body's surface, not its whole bounding block."""
+        (i, j, k), volumes, halves = block
+        local = np.flatnonzero(volumes)
+        if not len(local):
+            return np.zeros(0, dtype=np.int64), np.zeros((0, 6))
+        p, q, r = np.unravel_index(local, volumes.shape)
+        flat = np.ravel_multi_index((p + i, q + j, r + k), tuple(int(n) for n in self._cells))
+        keep = ~self.fluid.solid.reshape(-1)[flat]
+        return flat[keep], halves.reshape(-1, 6)[local[keep]]
 
     def _close_fixed_interiors(self) -> None:
         """Make the deep inside of the fixed bodies obstacle cells of the fluid: cells that fixed
@@ -293,6 +309,8 @@ class CoupledSolver:
         if deep.any():
             self.fluid.add_obstacle_mask(deep | self.fluid.solid)
             self._shut_faces_of(fixed, volumes, deep)
+            for body in fixed:     # their cell lists without the cells just closed
+                self._cell_lists[body] = self._cell_list(self._blocks[body])
 
     def _carriers(self):
         """The fluid's velocity with the last projected field on the faces the bodies touched:
@@ -394,10 +412,14 @@ class CoupledSolver:
     # ------------------------------------------------------------------ the step
     def _face_set(self) -> _FaceSet:
         """The faces the bodies' cells touch at their present poses, with per body its entries."""
-        volumes = self._solid_volumes()
+        self._solid_volumes()
+        lists = self._cell_lists
+        counts = [len(index) for index, _ in lists]
+        cell_start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        cell_index = np.concatenate([index for index, _ in lists]).astype(np.int64)
+        cell_halves = np.concatenate([halves for _, halves in lists]).reshape(-1, 6)
         (axis, index, phi, interior, entry_start, entry_face,
-         entry_half) = rigid_coupling.touched_faces(volumes.origin, volumes.shape, volumes.offset,
-                                                    volumes.values, volumes.halves,
+         entry_half) = rigid_coupling.touched_faces(cell_start, cell_index, cell_halves,
                                                     self.fluid.h ** 3, self._cells,
                                                     self._slots, self.fluid.solid.reshape(-1))
         return _FaceSet(axis=axis, index=index, phi=phi, capped=np.minimum(phi, 1.0),
@@ -455,13 +477,9 @@ class CoupledSolver:
             if np.any(transferred[b]):
                 predicted[b] += np.linalg.lstsq(body_matrices[b], transferred[b], rcond=None)[0]
         blended_rigid, rigid_momentum = faces.zeros(), faces.zeros()
-        ones = np.ones(solids.n_bodies)
-        rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
-                                        fluid.h, centres, predicted, ones, faces.phi, rho_fluid,
-                                        blended_rigid)
         rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
                                         fluid.h, centres, predicted, densities, faces.phi,
-                                        rho_fluid, rigid_momentum)
+                                        rho_fluid, blended_rigid, rigid_momentum, True)
         fluid_share = 1.0 - faces.capped
         blended = fluid_share * fluid_part + blended_rigid
         mixture = fluid_share * rho_fluid + solid_density
@@ -480,9 +498,10 @@ class CoupledSolver:
                                            fluid.h, pressure_force)
         # The pressure's load rides along as a second right-hand side with no velocity: the
         # momentum -grad p h^3 over the body's share of its faces (buoyancy and form drag).
+        pressure_unaccounted = -pressure_force * np.maximum(faces.capped, 1e-300)
         _, _, rhs = self._momentum_systems(
             faces, centres, densities, rho_fluid, [projected, zero],
-            [unaccounted, -pressure_force * np.maximum(faces.capped, 1e-300)])
+            [unaccounted, pressure_unaccounted], bodies=free)
         rhs, pressure_rhs = rhs[:, 0], rhs[:, 1]
         final = np.zeros((solids.n_bodies, 6))
         entry_start = faces.entries[0]
@@ -491,17 +510,13 @@ class CoupledSolver:
                 final[b] = np.linalg.solve(matrices[b], rhs[b])
             else:   # no face in the fluid (thrown out of the box): it flies on by itself
                 final[b] = predicted[b]
-        # The fluid's load: the body's own momentum change; for a fixed body what holding it
-        # still takes (the momentum the fluid gave its faces, less the fall it was blended in with).
+        # The fluid's load on a free body: its own momentum change (fixed bodies': _output_loads).
         loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted_dry)
                  - np.einsum("bij,bj->bi", matrices - body_matrices, final)) / dt
-        if self._shut is not None:
-            shut = self._shut_face_loads(pressure)
-            loads += shut
-            pressure_rhs = pressure_rhs + shut
         rigid = faces.zeros()
         rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
-                                        fluid.h, centres, final, ones, faces.phi, rho_fluid, rigid)
+                                        fluid.h, centres, final, densities, faces.phi, rho_fluid,
+                                        rigid, rigid, False)
         after = fluid_share * projected + rigid
         faces.scatter(after, (u, v, w))
         # The projected field is divergence free; the water and the mass of the next step move
@@ -517,12 +532,10 @@ class CoupledSolver:
         # The bodies then move over the step in contact sub-steps with the fluid's load held:
         # without contacts they end with exactly the motion the projection gave them.
         self.fluid_loads = np.where(free[:, None], loads, 0.0)
-        self.fixed_body_loads = np.where(free[:, None], 0.0, loads)
-        #: The fluid's load on every body (fixed ones too) split into the pressure's (minus the
-        #: pressure gradient over the body's share of every face) and the rest: viscous stress,
-        #: with the momentum of the no-slip blend and advection (N, N m).
-        self.pressure_loads = pressure_rhs
-        self.viscous_loads = loads - self.pressure_loads
+        self._free_pressure_loads = np.where(free[:, None], pressure_rhs, 0.0)
+        self._pending_fixed_loads = (faces, centres.copy(), densities, rho_fluid, projected,
+                                     unaccounted, pressure_unaccounted, body_matrices,
+                                     predicted_dry, dt, pressure)
         self.last_exchange_seconds = exchange_seconds
         started = time.perf_counter()
         substeps = self._advance_solids(dt)
@@ -535,16 +548,61 @@ class CoupledSolver:
                                  max_body_speed=float(speeds.max(initial=0.0)))
 
     def _momentum_systems(self, faces, centres, densities, rho_fluid, velocities, unaccounted,
-                          with_matrices=False):
+                          with_matrices=False, bodies=None):
         """(M, the body's own part of M, right-hand sides (bodies, r, 6)) of
-        ``rigid_coupling.momentum_systems`` for r right-hand sides at once."""
+        ``rigid_coupling.momentum_systems`` for r right-hand sides at once; ``bodies`` (bool per
+        body, default all): the bodies summed, the others left 0."""
         n = self.solids.n_bodies
         matrices, body, rhs = np.zeros((n, 6, 6)), np.zeros((n, 6, 6)), np.zeros((n, len(velocities), 6))
+        chosen = np.ones(n, dtype=np.bool_) if bodies is None else np.asarray(bodies, dtype=np.bool_)
         rigid_coupling.momentum_systems(*faces.entries, faces.axis, faces.index, self._lower,
                                         self.fluid.h, centres, densities, faces.phi, rho_fluid,
                                         np.array(velocities), np.array(unaccounted), with_matrices,
-                                        matrices, body, rhs)
+                                        chosen, matrices, body, rhs)
         return matrices, body, rhs
+
+    # ------------------------------------------------------------------ loads for the outputs
+    # The loads on fixed bodies (and the pressure/viscous split) only go to the outputs: they are
+    # summed from the last step's face values when first asked for, not on every step.
+    @property
+    def fixed_body_loads(self) -> np.ndarray:
+        """What holding each fixed body still took over the last step (N, N m); 0 for free ones."""
+        return self._output_loads()[0]
+
+    @property
+    def pressure_loads(self) -> np.ndarray:
+        """The pressure's part of the fluid's load on every body, fixed ones too (minus the
+        pressure gradient over the body's share of every face: buoyancy and form drag)."""
+        return self._output_loads()[1]
+
+    @property
+    def viscous_loads(self) -> np.ndarray:
+        """The rest of the fluid's load on every body: viscous stress, with the momentum of the
+        no-slip blend and advection (N, N m)."""
+        fixed, pressure = self._output_loads()
+        return self.fluid_loads + fixed - pressure
+
+    def _output_loads(self):
+        if self._pending_fixed_loads is not None:
+            (faces, centres, densities, rho_fluid, projected, unaccounted, pressure_unaccounted,
+             body_matrices, predicted_dry, dt, pressure) = self._pending_fixed_loads
+            self._pending_fixed_loads = None
+            fixed = self.solids.fixed
+            _, _, rhs = self._momentum_systems(
+                faces, centres, densities, rho_fluid, [projected, faces.zeros()],
+                [unaccounted, pressure_unaccounted], bodies=fixed)
+            # a fixed body ends at rest: its load is the momentum its faces were given, less the
+            # fall it was blended in with
+            loads = (rhs[:, 0] - np.einsum("bij,bj->bi", body_matrices, predicted_dry)) / dt
+            pressure_part = rhs[:, 1]
+            if self._shut is not None:
+                shut = self._shut_face_loads(pressure)
+                loads += shut
+                pressure_part = pressure_part + shut
+            self._loads_for_output = (np.where(fixed[:, None], loads, 0.0),
+                                      np.where(fixed[:, None], pressure_part,
+                                               self._free_pressure_loads))
+        return self._loads_for_output
 
     def _exchange_balance(self, faces, fluid_share, before, after, mixture, blended,
                           projected, body_matrices, predicted, final, free) -> np.ndarray:

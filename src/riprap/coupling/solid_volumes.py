@@ -170,16 +170,13 @@ def rigid_body_half_cell_volumes(grid: FluidGrid, solver, bodies=None) -> list:
     for body in range(fine.n_bodies):
         fine_origin, volumes = fine.block(body)
         origin = fine_origin // 2
-        below = fine_origin - 2 * origin
-        above = (below + np.asarray(volumes.shape)) % 2
-        padded = np.pad(volumes, [(int(b), int(a)) for b, a in zip(below, above)])
-        bi, bj, bk = (np.asarray(padded.shape) // 2).tolist()
-        children = padded.reshape(bi, 2, bj, 2, bk, 2)
-        halves = np.empty((bi, bj, bk, 3, 2))
-        halves[..., 0, :] = children.sum(axis=(3, 5)).transpose(0, 2, 3, 1)
-        halves[..., 1, :] = children.sum(axis=(1, 5)).transpose(0, 1, 3, 2)
-        halves[..., 2, :] = children.sum(axis=(1, 3))
-        blocks.append((origin, halves[..., 0, :].sum(axis=-1), halves))
+        shape = (fine_origin + np.asarray(volumes.shape) + 1) // 2 - origin
+        if volumes.size == 0:
+            shape = np.zeros(3, dtype=np.int64)
+        cells = np.zeros(tuple(int(n) for n in shape))
+        halves = np.zeros(cells.shape + (3, 2))
+        surface_kernels.halve_block(fine_origin, volumes, origin, cells, halves)
+        blocks.append((origin, cells, halves))
     return blocks
 
 

@@ -63,35 +63,26 @@ def _shut(solid, axis, i, j, k, cells):
 
 
 @kernel
-def touched_faces(origin, shape, offset, values, halves, cell_volume, cells, slots, solid):
+def touched_faces(cell_start, cell_index, cell_halves, cell_volume, cells, slots, solid):
     """The faces that any body's cells touch, and per body its entries.
 
+    Per body b its cells holding solid: ``cell_index[cell_start[b]:cell_start[b + 1]]`` (flat
+    grid index, C order) with ``cell_halves`` (n, 6): the solid volume in the lower and upper half
+    of the cell along each axis (``solid_volumes.rigid_body_half_cell_volumes``). A face's
+    fraction is the solid share of its own control volume, the two half cells beside it.
     ``slots`` (``face_count(cells)``,) int32, all -1 on entry and on return: a face's place in the
     set while it is built (kept between steps so that no grid-sized array is made per step).
-    ``halves`` (6 per block cell, after ``values``): the solid volume in the lower and upper half
-    of each cell along each axis (``solid_volumes.rigid_body_half_cell_volumes``): a face's
-    fraction is the solid share of its own control volume, the two half cells beside it.
     ``solid`` (cells, C order) bool: the fluid's obstacle cells. A face beside one is shut by the
     fluid (zero velocity, no pressure coupling through it) and is left out; the pressure on the
     faces that close the deep inside of fixed bodies reaches those bodies apart
     (``CoupledSolver._shut_face_loads``).
     Returns face_axis (F,), face_index (F, 3), phi (F,) the faces' summed body fractions
     (uncapped; wall faces too), interior (F,) bool, entry_start (bodies + 1,), entry_face (E,),
-    entry_half (E,). Bodies, cells (C order), axes and sides are visited in a fixed order, so
-    every sum is the same whatever the step.
+    entry_half (E,). Bodies, their cells, axes and sides are visited in a fixed order, so every
+    sum is the same whatever the step.
     """
-    bodies = origin.shape[0]
-    most = 0
-    for b in range(bodies):
-        bi, bj, bk = shape[b, 0], shape[b, 1], shape[b, 2]
-        for p in range(bi):
-            for q in range(bj):
-                for s in range(bk):
-                    if values[offset[b] + (p * bj + q) * bk + s] == 0.0:
-                        continue
-                    if not _solid_cell(solid, origin[b, 0] + p, origin[b, 1] + q,
-                                       origin[b, 2] + s, cells):
-                        most += 6
+    bodies = cell_start.shape[0] - 1
+    most = 6 * cell_index.shape[0]
     face_axis = np.empty(most, dtype=np.int64)
     face_index = np.empty((most, 3), dtype=np.int64)
     face_key = np.empty(most, dtype=np.int64)
@@ -102,45 +93,43 @@ def touched_faces(origin, shape, offset, values, halves, cell_volume, cells, slo
     entry_half = np.empty(most)
     n_faces = 0
     n_entries = 0
+    plane = cells[1] * cells[2]
     for b in range(bodies):
-        bi, bj, bk = shape[b, 0], shape[b, 1], shape[b, 2]
-        for p in range(bi):
-            for q in range(bj):
-                for s in range(bk):
-                    cell = offset[b] + (p * bj + q) * bk + s
-                    if values[cell] == 0.0:
+        for c in range(cell_start[b], cell_start[b + 1]):
+            flat = cell_index[c]
+            ci = flat // plane
+            cj = (flat // cells[2]) % cells[1]
+            ck = flat % cells[2]
+            if _solid_cell(solid, ci, cj, ck, cells):
+                continue
+            for axis in range(3):
+                for side in range(2):
+                    half = cell_halves[c, 2 * axis + side] / cell_volume
+                    if half == 0.0:
                         continue
-                    if _solid_cell(solid, origin[b, 0] + p, origin[b, 1] + q, origin[b, 2] + s,
-                                   cells):
+                    i = ci + (side if axis == 0 else 0)
+                    j = cj + (side if axis == 1 else 0)
+                    k = ck + (side if axis == 2 else 0)
+                    if _shut(solid, axis, i, j, k, cells):
                         continue
-                    for axis in range(3):
-                        for side in range(2):
-                            half = halves[6 * cell + 2 * axis + side] / cell_volume
-                            if half == 0.0:
-                                continue
-                            i = origin[b, 0] + p + (side if axis == 0 else 0)
-                            j = origin[b, 1] + q + (side if axis == 1 else 0)
-                            k = origin[b, 2] + s + (side if axis == 2 else 0)
-                            if _shut(solid, axis, i, j, k, cells):
-                                continue
-                            key = _face_key(axis, i, j, k, cells)
-                            slot = slots[key]
-                            if slot < 0:
-                                slot = n_faces
-                                slots[key] = slot
-                                face_axis[slot] = axis
-                                face_index[slot, 0] = i
-                                face_index[slot, 1] = j
-                                face_index[slot, 2] = k
-                                face_key[slot] = key
-                                along = i if axis == 0 else (j if axis == 1 else k)
-                                interior[slot] = 0 < along < cells[axis]
-                                n_faces += 1
-                            phi[slot] += half
-                            if interior[slot]:
-                                entry_face[n_entries] = slot
-                                entry_half[n_entries] = half
-                                n_entries += 1
+                    key = _face_key(axis, i, j, k, cells)
+                    slot = slots[key]
+                    if slot < 0:
+                        slot = n_faces
+                        slots[key] = slot
+                        face_axis[slot] = axis
+                        face_index[slot, 0] = i
+                        face_index[slot, 1] = j
+                        face_index[slot, 2] = k
+                        face_key[slot] = key
+                        along = i if axis == 0 else (j if axis == 1 else k)
+                        interior[slot] = 0 < along < cells[axis]
+                        n_faces += 1
+                    phi[slot] += half
+                    if interior[slot]:
+                        entry_face[n_entries] = slot
+                        entry_half[n_entries] = half
+                        n_entries += 1
         entry_start[b + 1] = n_entries
     for f in range(n_faces):
         slots[face_key[f]] = -1
@@ -235,25 +224,34 @@ def _face_jacobian(axis, index, lower, h, centre, jac):
 
 @kernel
 def accumulate_rigid(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
-                     motions, weights, phi, fluid_density, out):
-    """out[f] += sum over bodies of weight_b phi_b' (J x_b) on the set's faces, phi_b' the body's
-    share scaled by 1 / max(1, phi): the rigid part of a blended velocity (weights 1) or of the
-    momentum density (weights rho_b). A negative weight stands for the fluid's density on the face
-    (``FOLLOWS_FLUID``)."""
+                     motions, densities, phi, fluid_density, velocity_out, momentum_out,
+                     with_momentum):
+    """velocity_out[f] += sum over bodies of phi_b' (J x_b) on the set's faces, phi_b' the body's
+    share scaled by 1 / max(1, phi): the rigid part of a blended velocity; with
+    ``with_momentum`` also momentum_out[f] += sum of rho_b phi_b' (J x_b), the rigid part of the
+    momentum density, in the same pass. A negative density stands for the fluid's on the face
+    (``FOLLOWS_FLUID``). A body at rest (x_b = 0: a fixed one after the projection) adds nothing
+    and is skipped."""
     jac = np.empty(6)
     for b in range(entry_start.shape[0] - 1):
-        if weights[b] == 0.0:
+        moving = False
+        for m in range(6):
+            if motions[b, m] != 0.0:
+                moving = True
+        if not moving:
             continue
         for e in range(entry_start[b], entry_start[b + 1]):
             f = entry_face[e]
             share = entry_half[e] / max(1.0, phi[f])
-            weight = fluid_density[f] if weights[b] < 0.0 else weights[b]
             _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac)
             value = 0.0
             for m in range(6):
                 value += jac[m] * motions[b, m]
-            value *= weight * share
-            out[f] += value
+            value *= share
+            velocity_out[f] += value
+            if with_momentum:
+                rho = fluid_density[f] if densities[b] < 0.0 else densities[b]
+                momentum_out[f] += rho * value
 
 
 @kernel
@@ -270,7 +268,7 @@ def accumulate_density(entry_start, entry_face, entry_half, densities, phi, flui
 @parallel_kernel
 def momentum_systems(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
                      densities, phi, fluid_density, velocities, unaccounted, with_matrices,
-                     matrices, body_matrices, rhs):
+                     chosen, matrices, body_matrices, rhs):
     """For every body the 6 x 6 system M x = r of its rigid motion after the projection:
 
         M = sum_f w_f J_f^T J_f,  r = sum_f J_f^T (w_f u_f - C_f phi_b' / phi),
@@ -284,7 +282,8 @@ def momentum_systems(entry_start, entry_face, entry_half, face_axis, face_index,
     ``velocities`` and ``unaccounted`` (r, F): r right-hand sides at once, ``rhs`` (bodies, r, 6).
     With ``with_matrices``, also M and ``body_matrices``, the body's own part of M (weights
     phi_b' rho_b), whose product with a motion is the body's momentum on the grid. Each body's sums
-    are its own (threads over bodies), in the order of its entries.
+    are its own (threads over bodies), in the order of its entries. Only bodies with ``chosen[b]``
+    are summed; the others are left 0.
     """
     volume = h * h * h
     n_rhs = velocities.shape[0]
@@ -298,6 +297,8 @@ def momentum_systems(entry_start, entry_face, entry_half, face_axis, face_index,
                 for n in range(6):
                     matrices[b, m, n] = 0.0
                     body_matrices[b, m, n] = 0.0
+        if not chosen[b]:
+            continue
         for e in range(entry_start[b], entry_start[b + 1]):
             f = entry_face[e]
             phi_f = phi[f]

@@ -29,7 +29,7 @@ import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
 
-__all__ = ["fill_blocks"]
+__all__ = ["fill_blocks", "halve_block"]
 
 # A triangle cut by the 4 sides of a column has at most 7 corners, one more plane adds one.
 _MAX_CORNERS = 16
@@ -178,3 +178,28 @@ def fill_blocks(nodes, triangles, triangle_start, lower, h, origin, shape, offse
                     if (s + 1) * h <= lowest[p, q] or abs(value) < _ZERO_FRACTION * cell:
                         value = 0.0
                     block[p, q, s] = value
+
+
+@kernel
+def halve_block(fine_origin, fine_volumes, origin, cells, halves):
+    """Sum a block of volumes on the grid of half the cell size (starting at fine grid index
+    ``fine_origin``) into the cells of the grid (``cells`` (bi, bj, bk), block starting at
+    ``origin``) and into each cell's lower and upper halves along every axis (``halves``
+    (bi, bj, bk, 3, 2)); both zero on entry."""
+    fi, fj, fk = fine_volumes.shape
+    for p in range(fi):
+        gi = fine_origin[0] + p
+        ci, si = gi // 2 - origin[0], gi % 2
+        for q in range(fj):
+            gj = fine_origin[1] + q
+            cj, sj = gj // 2 - origin[1], gj % 2
+            for r in range(fk):
+                volume = fine_volumes[p, q, r]
+                if volume == 0.0:
+                    continue
+                gk = fine_origin[2] + r
+                ck, sk = gk // 2 - origin[2], gk % 2
+                cells[ci, cj, ck] += volume
+                halves[ci, cj, ck, 0, si] += volume
+                halves[ci, cj, ck, 1, sj] += volume
+                halves[ci, cj, ck, 2, sk] += volume
