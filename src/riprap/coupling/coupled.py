@@ -476,14 +476,13 @@ class CoupledSolver:
         for b in range(solids.n_bodies):
             if np.any(transferred[b]):
                 predicted[b] += np.linalg.lstsq(body_matrices[b], transferred[b], rcond=None)[0]
-        blended_rigid, rigid_momentum = faces.zeros(), faces.zeros()
+        blended_rigid = faces.zeros()
         rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
                                         fluid.h, centres, predicted, densities, faces.phi,
-                                        rho_fluid, blended_rigid, rigid_momentum, True)
+                                        rho_fluid, blended_rigid, blended_rigid, False)
         fluid_share = 1.0 - faces.capped
         blended = fluid_share * fluid_part + blended_rigid
         mixture = fluid_share * rho_fluid + solid_density
-        unaccounted = mixture * blended - fluid_share * rho_fluid * fluid_part - rigid_momentum
         faces.scatter(blended, (u, v, w))
         # The predictor's face densities are not needed again: they become the mixture's.
         faces.scatter(mixture, fluid_densities)
@@ -499,10 +498,15 @@ class CoupledSolver:
         # The pressure's load rides along as a second right-hand side with no velocity: the
         # momentum -grad p h^3 over the body's share of its faces (buoyancy and form drag).
         pressure_unaccounted = -pressure_force * np.maximum(faces.capped, 1e-300)
-        _, _, rhs = self._momentum_systems(
-            faces, centres, densities, rho_fluid, [projected, zero],
-            [unaccounted, pressure_unaccounted], bodies=free)
-        rhs, pressure_rhs = rhs[:, 0], rhs[:, 1]
+        _, _, pressure_rhs = self._momentum_systems(
+            faces, centres, densities, rho_fluid, [zero], [pressure_unaccounted], bodies=free)
+        pressure_rhs = pressure_rhs[:, 0]
+        # Each part of a face's momentum after the projection goes to whom it belongs: a body's
+        # share moves with its own blended motion plus the pressure's change of the face velocity.
+        pressure_change = projected - blended
+        fluid_term = fluid_share * rho_fluid * (fluid_part + pressure_change - fluid_share * projected)
+        rhs = self._own_momentum(faces, centres, predicted, densities, rho_fluid, pressure_change,
+                                 fluid_term, free)
         final = np.zeros((solids.n_bodies, 6))
         entry_start = faces.entries[0]
         for b in np.flatnonzero(free):
@@ -533,9 +537,9 @@ class CoupledSolver:
         # without contacts they end with exactly the motion the projection gave them.
         self.fluid_loads = np.where(free[:, None], loads, 0.0)
         self._free_pressure_loads = np.where(free[:, None], pressure_rhs, 0.0)
-        self._pending_fixed_loads = (faces, centres.copy(), densities, rho_fluid, projected,
-                                     unaccounted, pressure_unaccounted, body_matrices,
-                                     predicted_dry, dt, pressure)
+        self._pending_fixed_loads = (faces, centres.copy(), densities, rho_fluid, predicted,
+                                     pressure_change, fluid_term, pressure_unaccounted,
+                                     body_matrices, predicted_dry, dt, pressure)
         self.last_exchange_seconds = exchange_seconds
         started = time.perf_counter()
         substeps = self._advance_solids(dt)
@@ -561,6 +565,16 @@ class CoupledSolver:
                                         chosen, matrices, body, rhs)
         return matrices, body, rhs
 
+    def _own_momentum(self, faces, centres, motions, densities, rho_fluid, pressure_change,
+                      fluid_term, bodies):
+        """``rigid_coupling.own_momentum_rhs`` (bodies, 6) for the chosen bodies (bool each)."""
+        rhs = np.zeros((self.solids.n_bodies, 6))
+        rigid_coupling.own_momentum_rhs(*faces.entries, faces.axis, faces.index, self._lower,
+                                        self.fluid.h, centres, motions, densities, faces.phi,
+                                        rho_fluid, pressure_change, fluid_term,
+                                        np.asarray(bodies, dtype=np.bool_), rhs)
+        return rhs
+
     # ------------------------------------------------------------------ loads for the outputs
     # The loads on fixed bodies (and the pressure/viscous split) only go to the outputs: they are
     # summed from the last step's face values when first asked for, not on every step.
@@ -584,17 +598,20 @@ class CoupledSolver:
 
     def _output_loads(self):
         if self._pending_fixed_loads is not None:
-            (faces, centres, densities, rho_fluid, projected, unaccounted, pressure_unaccounted,
-             body_matrices, predicted_dry, dt, pressure) = self._pending_fixed_loads
+            (faces, centres, densities, rho_fluid, predicted, pressure_change, fluid_term,
+             pressure_unaccounted, body_matrices, predicted_dry, dt,
+             pressure) = self._pending_fixed_loads
             self._pending_fixed_loads = None
             fixed = self.solids.fixed
-            _, _, rhs = self._momentum_systems(
-                faces, centres, densities, rho_fluid, [projected, faces.zeros()],
-                [unaccounted, pressure_unaccounted], bodies=fixed)
+            rhs = self._own_momentum(faces, centres, predicted, densities, rho_fluid,
+                                     pressure_change, fluid_term, fixed)
+            _, _, pressure_rhs = self._momentum_systems(
+                faces, centres, densities, rho_fluid, [faces.zeros()], [pressure_unaccounted],
+                bodies=fixed)
             # a fixed body ends at rest: its load is the momentum its faces were given, less the
             # fall it was blended in with
-            loads = (rhs[:, 0] - np.einsum("bij,bj->bi", body_matrices, predicted_dry)) / dt
-            pressure_part = rhs[:, 1]
+            loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted_dry)) / dt
+            pressure_part = pressure_rhs[:, 0]
             if self._shut is not None:
                 shut = self._shut_face_loads(pressure)
                 loads += shut

@@ -254,6 +254,44 @@ def accumulate_rigid(entry_start, entry_face, entry_half, face_axis, face_index,
                 momentum_out[f] += rho * value
 
 
+@parallel_kernel
+def own_momentum_rhs(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
+                     motions, densities, phi, fluid_density, pressure_change, fluid_term, chosen,
+                     rhs):
+    """Per body the right-hand side r of its 6 x 6 system after the projection, each part of a
+    face's momentum given to whom it belongs: the body's own share at its own blended motion plus
+    the pressure's velocity change on the face, and its part (phi_b' / phi) of the fluid share's
+
+        r = sum_f J_f^T (phi_b' rho_b (J_f x_b + dv_f) + phi_b' / phi F_f) h^3,
+        F_f = (1 - phi) rho_fluid (u_fluid + dv_f - (1 - phi) u_projected).
+
+    Summed over the bodies of a face this is the momentum_systems right-hand side (w u - C): for a
+    face of one body it is the same; where two bodies share a face, neither takes the other's
+    motion (a unit sliding on the slope is not dragged by the slope's share of the face).
+    ``rhs`` (bodies, 6); only bodies with ``chosen[b]``, the others left 0."""
+    volume = h * h * h
+    for b in prange(entry_start.shape[0] - 1):
+        jac = np.empty(6)
+        for m in range(6):
+            rhs[b, m] = 0.0
+        if not chosen[b]:
+            continue
+        for e in range(entry_start[b], entry_start[b + 1]):
+            f = entry_face[e]
+            share = entry_half[e] / max(1.0, phi[f])
+            capped = min(phi[f], 1.0)
+            own = fluid_density[f] if densities[b] < 0.0 else densities[b]
+            _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac)
+            rigid = 0.0
+            for m in range(6):
+                rigid += jac[m] * motions[b, m]
+            source = (share * own * (rigid + pressure_change[f])
+                      + share / capped * fluid_term[f]) * volume
+            for m in range(6):
+                if jac[m] != 0.0:
+                    rhs[b, m] += jac[m] * source
+
+
 @kernel
 def accumulate_density(entry_start, entry_face, entry_half, densities, phi, fluid_density, out):
     """out[f] += sum over bodies of phi_b' rho_b on the set's faces (the solid part of the mixture
