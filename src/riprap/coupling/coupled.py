@@ -478,8 +478,7 @@ class CoupledSolver:
                 predicted[b] += np.linalg.lstsq(body_matrices[b], transferred[b], rcond=None)[0]
         blended_rigid = faces.zeros()
         rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
-                                        fluid.h, centres, predicted, densities, faces.phi,
-                                        rho_fluid, blended_rigid, blended_rigid, False)
+                                        fluid.h, centres, predicted, faces.phi, blended_rigid)
         fluid_share = 1.0 - faces.capped
         blended = fluid_share * fluid_part + blended_rigid
         mixture = fluid_share * rho_fluid + solid_density
@@ -519,8 +518,7 @@ class CoupledSolver:
                  - np.einsum("bij,bj->bi", matrices - body_matrices, final)) / dt
         rigid = faces.zeros()
         rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
-                                        fluid.h, centres, final, densities, faces.phi, rho_fluid,
-                                        rigid, rigid, False)
+                                        fluid.h, centres, final, faces.phi, rigid)
         after = fluid_share * projected + rigid
         faces.scatter(after, (u, v, w))
         # The projected field is divergence free; the water and the mass of the next step move

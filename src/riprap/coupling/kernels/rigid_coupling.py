@@ -224,14 +224,10 @@ def _face_jacobian(axis, index, lower, h, centre, jac):
 
 @kernel
 def accumulate_rigid(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
-                     motions, densities, phi, fluid_density, velocity_out, momentum_out,
-                     with_momentum):
-    """velocity_out[f] += sum over bodies of phi_b' (J x_b) on the set's faces, phi_b' the body's
-    share scaled by 1 / max(1, phi): the rigid part of a blended velocity; with
-    ``with_momentum`` also momentum_out[f] += sum of rho_b phi_b' (J x_b), the rigid part of the
-    momentum density, in the same pass. A negative density stands for the fluid's on the face
-    (``FOLLOWS_FLUID``). A body at rest (x_b = 0: a fixed one after the projection) adds nothing
-    and is skipped."""
+                     motions, phi, out):
+    """out[f] += sum over bodies of phi_b' (J x_b) on the set's faces, phi_b' the body's share
+    scaled by 1 / max(1, phi): the rigid part of a blended velocity. A body at rest (x_b = 0: a
+    fixed one after the projection) adds nothing and is skipped."""
     jac = np.empty(6)
     for b in range(entry_start.shape[0] - 1):
         moving = False
@@ -247,11 +243,7 @@ def accumulate_rigid(entry_start, entry_face, entry_half, face_axis, face_index,
             value = 0.0
             for m in range(6):
                 value += jac[m] * motions[b, m]
-            value *= share
-            velocity_out[f] += value
-            if with_momentum:
-                rho = fluid_density[f] if densities[b] < 0.0 else densities[b]
-                momentum_out[f] += rho * value
+            out[f] += value * share
 
 
 @parallel_kernel
