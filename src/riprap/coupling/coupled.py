@@ -487,7 +487,11 @@ class CoupledSolver:
         faces.scatter(mixture, fluid_densities)
         exchange_seconds += time.perf_counter() - started
         betas = fluid._face_coefficients(fluid_densities)
-        pressure, report = fluid.project(u, v, w, betas, dt)
+        # The free bodies' cells get extra smoothing in the pressure solve: a heavy body in air
+        # is an island of its own pressure modes that the coarse grids miss.
+        listed = [self._cell_lists[b][0] for b in np.flatnonzero(free)]
+        listed = np.unique(np.concatenate(listed)) if listed else None
+        pressure, report = fluid.project(u, v, w, betas, dt, listed_cells=listed)
 
         started = time.perf_counter()
         projected, pressure_force = faces.empty(), faces.empty()

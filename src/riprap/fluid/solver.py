@@ -320,15 +320,17 @@ class FluidSolver:
         self._zero_solid_faces(u, v, w)
         return u, v, w, densities
 
-    def project(self, u, v, w, betas, dt: float):
+    def project(self, u, v, w, betas, dt: float, listed_cells=None):
         """Make (u, v, w) divergence free in place with face coefficients ``betas`` (1/rho);
-        returns (pressure, the pressure solver's report)."""
+        returns (pressure, the pressure solver's report). ``listed_cells``: flat indices of cells
+        that get extra smoothing in the pressure solve (``PressureSolver.solve``)."""
         rhs = np.empty_like(self.pressure)
         momentum.divergence(u, v, w, self.h, rhs)
         rhs /= dt
         started = time.perf_counter()
         pressure, report = self.pressure_solver.solve(betas[0], betas[1], betas[2], rhs,
-                                                      p_initial=self.pressure)
+                                                      p_initial=self.pressure,
+                                                      listed_cells=listed_cells)
         self.last_pressure_seconds = time.perf_counter() - started
         self._correct(u, v, w, pressure, betas, dt)
         return pressure, report

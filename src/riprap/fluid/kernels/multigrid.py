@@ -68,6 +68,13 @@ has zero mean. Only the constant over *all* active cells is removed: a region cu
 rest by zero faces and with no Dirichlet face of its own is not treated (CG then stalls or breaks
 down and the driver reports it).
 
+Local smoothing: a caller may list level-0 cells that get extra Gauss-Seidel sweeps before the
+pre-smoothing and after the post-smoothing (the adjoint order, so B stays symmetric). Why: a heavy
+island in light fluid (a concrete unit in air, density ratio 2000) has pressure modes of its own,
+nearly decoupled from the air around it, that averaged coarse coefficients cannot see; the coarse
+grid then leaves them to CG, one iteration each. Sweeps on the island's cells alone remove them at
+a few per cent of a V-cycle's cost (measured in ``riprap/fluid/pressure.py``).
+
 Reductions (dot products, norms, means) are summed per x-slab in parallel and the slabs are then
 added in order on one thread, so results do not depend on the number of threads.
 """
@@ -661,11 +668,83 @@ def solve_coarsest(factor, rhs, x):
         x_flat[r] = value / pivot if pivot > 0.0 else 0.0
 
 
+@parallel_kernel
+def zero_cells(x):
+    """x = 0, in parallel."""
+    for i in prange(x.shape[0]):
+        x[i, :, :] = 0.0
+
+
+#: Cells of level 0 with extra smoothing (flat indices, red ones first, then black): per cell its
+#: six neighbours' flat indices (its own where a face has no neighbour), their couplings g_f
+#: (0 across a boundary or wall face) and 1 / d_c (0 for an inactive cell); ``red`` cells first.
+ListedCells = namedtuple("ListedCells", ["cells", "neighbours", "couplings", "inverse_diagonal",
+                                         "red"])
+
+
+@parallel_kernel
+def listed_stencils(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, cells,
+                    neighbours, couplings, inverse_diagonal):
+    """Fill the stencils of ``ListedCells`` for ``cells`` (flat indices) from level 0's faces.
+
+    Why stored: a sweep over a list of scattered cells that derives every stencil from the faces
+    (index arithmetic and six branches per cell) ran ten times slower per cell than the sweeps
+    over the whole grid.
+    """
+    nx = beta_y.shape[0]
+    ny = beta_x.shape[1]
+    nz = beta_x.shape[2]
+    for m in prange(cells.shape[0]):
+        cell = cells[m]
+        i = cell // (ny * nz)
+        j = (cell // nz) % ny
+        k = cell % nz
+        faces = (beta_x[i, j, k] * inverse_hx2, beta_x[i + 1, j, k] * inverse_hx2,
+                 beta_y[i, j, k] * inverse_hy2, beta_y[i, j + 1, k] * inverse_hy2,
+                 beta_z[i, j, k] * inverse_hz2, beta_z[i, j, k + 1] * inverse_hz2)
+        inside = (i > 0, i < nx - 1, j > 0, j < ny - 1, k > 0, k < nz - 1)
+        steps = (-ny * nz, ny * nz, -nz, nz, -1, 1)
+        diagonal = 0.0
+        for f in range(6):
+            if inside[f]:
+                diagonal += faces[f]
+                couplings[m, f] = faces[f]
+                neighbours[m, f] = cell + steps[f]
+            else:
+                diagonal += 2.0 * faces[f]
+                couplings[m, f] = 0.0
+                neighbours[m, f] = cell
+        inverse_diagonal[m] = 1.0 / diagonal if diagonal > 0.0 else 0.0
+
+
+@parallel_kernel
+def smooth_listed_cells(listed, rhs, x, first, stop):
+    """One Gauss-Seidel sweep over the listed cells first..stop-1 (all of one colour).
+
+    Cells of one colour never neighbour each other, so the parallel sweep is race-free and does not
+    depend on the number of threads.
+    """
+    rhs_flat = rhs.reshape(-1)
+    x_flat = x.reshape(-1)
+    for m in prange(first, stop):
+        total = rhs_flat[listed.cells[m]]
+        for f in range(6):
+            total += listed.couplings[m, f] * x_flat[listed.neighbours[m, f]]
+        x_flat[listed.cells[m]] = total * listed.inverse_diagonal[m]
+
+
 @kernel
-def apply_v_cycle(hierarchy, sweeps):
-    """corrections[level 0] = B residuals[level 0], B one symmetric V-cycle (module docstring)."""
+def apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps):
+    """corrections[level 0] = B residuals[level 0], B one symmetric V-cycle (module docstring).
+
+    The cells of ``listed`` (``ListedCells``) get ``listed_sweeps`` extra Gauss-Seidel sweeps (red,
+    black) before the level's own pre-smoothing and the same in reverse order (black, red) after its
+    post-smoothing, which keeps B symmetric (module docstring, "Local smoothing").
+    """
     n_levels = hierarchy.shapes.shape[0]
     spacing = hierarchy.inverse_spacing_squared
+    local = listed_sweeps > 0 and listed.cells.shape[0] > 0
+    red, stop = listed.red, listed.cells.shape[0]
     for level in range(n_levels - 1):
         beta_x = face_array(hierarchy.beta_x, hierarchy, level, 0)
         beta_y = face_array(hierarchy.beta_y, hierarchy, level, 1)
@@ -673,8 +752,15 @@ def apply_v_cycle(hierarchy, sweeps):
         rhs = cell_array(hierarchy.residuals, hierarchy, level)
         x = cell_array(hierarchy.corrections, hierarchy, level)
         hx2, hy2, hz2 = spacing[level, 0], spacing[level, 1], spacing[level, 2]
+        first_from_zero = True
+        if level == 0 and local:
+            zero_cells(x)
+            for _ in range(listed_sweeps):
+                smooth_listed_cells(listed, rhs, x, 0, red)
+                smooth_listed_cells(listed, rhs, x, red, stop)
+            first_from_zero = False
         for sweep in range(sweeps):
-            if sweep == 0:
+            if sweep == 0 and first_from_zero:
                 smooth_first_red(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x)
             else:
                 smooth_colour(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0)
@@ -699,12 +785,16 @@ def apply_v_cycle(hierarchy, sweeps):
         for sweep in range(sweeps):
             smooth_colour(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 1)
             smooth_colour(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0)
+        if level == 0 and local:
+            for _ in range(listed_sweeps):
+                smooth_listed_cells(listed, rhs, x, red, stop)
+                smooth_listed_cells(listed, rhs, x, 0, red)
 
 
 @kernel
-def _precondition(hierarchy, sweeps, singular, active_cells, row_sums):
+def _precondition(hierarchy, sweeps, singular, active_cells, row_sums, listed, listed_sweeps):
     """z = B r in corrections[0] (r in residuals[0]); closed tank: z's active mean removed."""
-    apply_v_cycle(hierarchy, sweeps)
+    apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps)
     z = cell_array(hierarchy.corrections, hierarchy, 0)
     if singular:
         beta_x = face_array(hierarchy.beta_x, hierarchy, 0, 0)
@@ -716,7 +806,7 @@ def _precondition(hierarchy, sweeps, singular, active_cells, row_sums):
 
 @kernel
 def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tolerance,
-              max_iterations, sweeps, singular, active_cells):
+              max_iterations, sweeps, singular, active_cells, listed, listed_sweeps):
     """Preconditioned conjugate gradients for L pressure = system_rhs, from the given pressure.
 
     Stops when ||r||_2 <= tolerance ||system_rhs||_2, with r re-evaluated as system_rhs - L
@@ -746,7 +836,8 @@ def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tol
     restart = True
     curvature_product = 0.0
     while relative > tolerance and iterations < max_iterations:
-        _precondition(hierarchy, sweeps, singular, active_cells, row_sums)
+        _precondition(hierarchy, sweeps, singular, active_cells, row_sums, listed,
+                      listed_sweeps)
         new_product = dot(residual, preconditioned, row_sums)
         if not np.isfinite(new_product):
             return iterations, relative, NON_FINITE
