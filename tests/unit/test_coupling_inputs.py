@@ -1,8 +1,9 @@
 """CoupledSolver refuses bodies it cannot take, naming the body, and clips only bodies that moved."""
+import numpy as np
 import pytest
 
 from riprap import FluidGrid, FluidSolver
-from riprap.coupling.coupled import MINIMUM_CELLS_ACROSS, CoupledSolver
+from riprap.coupling.coupled import MINIMUM_CELLS_ACROSS, RECLIP_DISTANCE, CoupledSolver
 from riprap.errors import CaseFileError
 from riprap.geometry import shapes
 from riprap.solid.materials import Material
@@ -44,3 +45,25 @@ def test_fixed_bodies_are_clipped_once():
     assert coupled.last_clipped_bodies == 0        # nothing moved since
     coupled.step()
     assert coupled.last_clipped_bodies == 1        # only the moving cube
+
+
+def test_a_body_is_clipped_again_only_once_it_has_moved_a_thousandth_of_a_cell():
+    """RECLIP_DISTANCE: a nudge of 0.5e-3 h keeps the body's block (its volumes are those of the
+    last clipping), 1.5e-3 h in all clips it again; the clipping pose rides in the checkpoint, so
+    a restored solver clips where the original had (restart bit for bit)."""
+    fluid, solids = _setup(16, 0.1, (0.2, 0.2, 0.2))
+    coupled = CoupledSolver(fluid, solids)
+    h = fluid.h
+    clipped = coupled._solid_volumes().block(0)[1].copy()
+    solids.positions[0, 0] += 0.5 * RECLIP_DISTANCE * h
+    again = coupled._solid_volumes().block(0)[1]
+    assert coupled.last_clipped_bodies == 0 and np.array_equal(again, clipped)
+    arrays = coupled.state_arrays()
+    solids.positions[0, 0] += RECLIP_DISTANCE * h
+    moved = coupled._solid_volumes().block(0)[1]
+    assert coupled.last_clipped_bodies == 1 and not np.array_equal(moved, clipped)
+
+    restored_fluid, restored_solids = _setup(16, 0.1, (0.2, 0.2, 0.2))
+    restored = CoupledSolver(restored_fluid, restored_solids)
+    restored.load_state_arrays(arrays)
+    assert np.array_equal(restored._solid_volumes().block(0)[1], clipped)

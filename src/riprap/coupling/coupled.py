@@ -49,6 +49,12 @@ __all__ = ["CoupledSolver", "CoupledStepReport", "fluid_box_walls", "MINIMUM_CEL
 #: the ten Cate sphere (4 cells across its diameter, nominal diameter 3.2 cells) still settles
 #: within 9 % of the experiment; below that its forces are noise.
 MINIMUM_CELLS_ACROSS = 3.0
+#: A body is clipped against the grid again once some point of it may have moved more than this
+#: fraction of a cell since it was last clipped. Why not on every move: units resting or rocking
+#: in the flow move microns per step, and clipping them again costs more than the rest of the
+#: exchange; a lag of at most 1e-3 h changes a face's solid fraction by at most about 1e-3
+#: (docs/coupling.md, Speed).
+RECLIP_DISTANCE = 1e-3
 
 
 def _same_plane(a, b, tolerance: float = 1e-9) -> bool:
@@ -163,6 +169,9 @@ class CoupledSolver:
                                     for m in solids.material_index_of_body], dtype=np.float64)
         self._blocks = None
         self._block_poses = None
+        self._restart_block_poses = None
+        self._faces = None
+        self._listed = None
         self.obstacle_bodies = np.asarray(obstacle_bodies, dtype=np.int64)
         #: The last step's projected (divergence-free) velocity on its faces: (axis, index,
         #: values), or None before the first step.
@@ -227,6 +236,8 @@ class CoupledSolver:
         if self._carried is not None:
             for name, value in zip(("axis", "index", "values"), self._carried):
                 arrays[f"coupling_carried_{name}"] = value.copy()
+        if self._block_poses is not None:
+            arrays["coupling_block_poses"] = self._block_poses.copy()
         return arrays
 
     def load_state_arrays(self, arrays: dict) -> None:
@@ -235,7 +246,9 @@ class CoupledSolver:
                                        if name.startswith("bodies_")})
         self.fluid_loads = np.array(arrays["bodies_fluid_loads"], dtype=np.float64)
         self.solids.external_loads[:] = arrays["bodies_external_loads"]
-        self._blocks = self._block_poses = None
+        self._blocks = self._block_poses = self._faces = None
+        self._restart_block_poses = (np.array(arrays["coupling_block_poses"], dtype=np.float64)
+                                     if "coupling_block_poses" in arrays else None)
         self._carried = (tuple(np.array(arrays[f"coupling_carried_{name}"])
                                for name in ("axis", "index", "values"))
                          if "coupling_carried_axis" in arrays else None)
@@ -246,8 +259,14 @@ class CoupledSolver:
 
     # ------------------------------------------------------------------ helpers
     def _solid_volumes(self):
-        """Every body's cell volumes; only bodies whose pose changed since they were last
-        clipped are clipped again (fixed bodies once), so the cost follows the moving bodies."""
+        """Every body's cell volumes (``_clip_moved_bodies``, merged)."""
+        self._clip_moved_bodies()
+        return merge_blocks(self.fluid.grid, self._blocks)
+
+    def _clip_moved_bodies(self) -> None:
+        """Bring every body's block and cell list up to date: a body is clipped again only once
+        some point of it has moved more than ``RECLIP_DISTANCE`` cells since it was last clipped
+        (fixed bodies once), so the cost follows the moving bodies."""
         solids = self.solids
         poses = np.concatenate([solids.positions, solids.quaternions], axis=1)
         if self._blocks is None:
@@ -258,17 +277,32 @@ class CoupledSolver:
                 self._blocks[body] = (np.zeros(3, dtype=np.int64), np.zeros((0, 0, 0)),
                                       np.zeros((0, 0, 0, 3, 2)))
             stale = np.setdiff1d(np.arange(solids.n_bodies), self.obstacle_bodies)
+            # a restart clips where the run it continues had clipped last (bit for bit)
+            if self._restart_block_poses is not None:
+                poses = self._restart_block_poses
+                self._restart_block_poses = None
+            self._block_poses = poses.copy()
         else:
-            stale = np.flatnonzero(np.any(poses != self._block_poses, axis=1))
+            stale = np.flatnonzero(self._moved_since_clipped(poses)
+                                   > RECLIP_DISTANCE * self.fluid.h)
+            self._block_poses[stale] = poses[stale]
         if len(stale):
-            fresh = rigid_body_half_cell_volumes(self.fluid.grid, solids, bodies=stale)
+            fresh = rigid_body_half_cell_volumes(self.fluid.grid, solids, bodies=stale,
+                                                 poses=self._block_poses[stale])
             for body, block in zip(stale, fresh):
                 self._blocks[body] = block
                 self._cell_lists[body] = self._cell_list(block)
-        self._block_poses = poses.copy()
+            self._faces = None
         self.last_clipped_bodies = len(stale)
-        return merge_blocks(self.fluid.grid, self._blocks)
 
+    def _moved_since_clipped(self, poses) -> np.ndarray:
+        """Per body, a bound on how far any point of it has moved since its last clipping (m):
+        its centre's displacement plus the rotation angle times its bounding radius."""
+        solids = self.solids
+        shift = np.linalg.norm(poses[:, :3] - self._block_poses[:, :3], axis=1)
+        alignment = np.abs(np.einsum("bi,bi->b", poses[:, 3:], self._block_poses[:, 3:]))
+        angle = 2.0 * np.arccos(np.minimum(alignment, 1.0))
+        return shift + angle * solids.bounding_radius[solids.shape_index]
 
     def _cell_list(self, block):
         """(flat grid index of every cell of a body's block that holds solid and is not an
@@ -311,6 +345,7 @@ class CoupledSolver:
             self._shut_faces_of(fixed, volumes, deep)
             for body in fixed:     # their cell lists without the cells just closed
                 self._cell_lists[body] = self._cell_list(self._blocks[body])
+            self._faces = None
 
     def _carriers(self):
         """The fluid's velocity with the last projected field on the faces the bodies touched:
@@ -411,8 +446,11 @@ class CoupledSolver:
 
     # ------------------------------------------------------------------ the step
     def _face_set(self) -> _FaceSet:
-        """The faces the bodies' cells touch at their present poses, with per body its entries."""
-        self._solid_volumes()
+        """The faces the bodies' cells touch at their present poses, with per body its entries;
+        the last step's set while no body has been clipped since (its arrays are only read)."""
+        self._clip_moved_bodies()
+        if self._faces is not None:
+            return self._faces
         lists = self._cell_lists
         counts = [len(index) for index, _ in lists]
         cell_start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
@@ -422,8 +460,16 @@ class CoupledSolver:
          entry_half) = rigid_coupling.touched_faces(cell_start, cell_index, cell_halves,
                                                     self.fluid.h ** 3, self._cells,
                                                     self._slots, self.fluid.solid.reshape(-1))
-        return _FaceSet(axis=axis, index=index, phi=phi, capped=np.minimum(phi, 1.0),
-                        interior=interior, entries=(entry_start, entry_face, entry_half))
+        self._faces = _FaceSet(axis=axis, index=index, phi=phi, capped=np.minimum(phi, 1.0),
+                               interior=interior, entries=(entry_start, entry_face, entry_half))
+        return self._faces
+
+    def _free_cells(self, faces, free):
+        """The flat indices of the free bodies' cells, kept with the face set they belong to."""
+        if self._listed is None or self._listed[0] is not faces:
+            lists = [self._cell_lists[b][0] for b in np.flatnonzero(free)]
+            self._listed = (faces, np.unique(np.concatenate(lists)) if lists else None)
+        return self._listed[1]
 
     def step(self, dt: float | None = None) -> CoupledStepReport:
         fluid, solids = self.fluid, self.solids
@@ -489,9 +535,8 @@ class CoupledSolver:
         betas = fluid._face_coefficients(fluid_densities)
         # The free bodies' cells get extra smoothing in the pressure solve: a heavy body in air
         # is an island of its own pressure modes that the coarse grids miss.
-        listed = [self._cell_lists[b][0] for b in np.flatnonzero(free)]
-        listed = np.unique(np.concatenate(listed)) if listed else None
-        pressure, report = fluid.project(u, v, w, betas, dt, listed_cells=listed)
+        pressure, report = fluid.project(u, v, w, betas, dt,
+                                         listed_cells=self._free_cells(faces, free))
 
         started = time.perf_counter()
         projected, pressure_force = faces.empty(), faces.empty()

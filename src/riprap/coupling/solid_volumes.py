@@ -22,6 +22,7 @@ from riprap.coupling.kernels import surface_cell_volumes as surface_kernels
 from riprap.coupling.kernels import tet_cell_volumes
 from riprap.errors import CaseFileError
 from riprap.fluid.grid import FluidGrid
+from riprap.solid.kernels.geometry_ops import rotation_matrix
 
 __all__ = ["BodyCellVolumes", "body_cell_volumes", "surface_cell_volumes", "rigid_body_cell_volumes",
            "rigid_body_half_cell_volumes", "merge_blocks"]
@@ -129,21 +130,25 @@ def surface_cell_volumes(grid: FluidGrid, nodes, triangles, triangle_start) -> B
     return _fill(grid, surface_kernels.fill_blocks, nodes, triangles, triangle_start)
 
 
-def rigid_body_cell_volumes(grid: FluidGrid, solver, bodies=None) -> BodyCellVolumes:
+def rigid_body_cell_volumes(grid: FluidGrid, solver, bodies=None, poses=None) -> BodyCellVolumes:
     """The cell volumes of the bodies of a :class:`riprap.solid.solver.SolidSolver` at their
     present position and orientation (:func:`surface_cell_volumes` of their boundary triangles):
-    all of them, or those listed in ``bodies`` (the result's blocks are then in that order)."""
+    all of them, or those listed in ``bodies`` (the result's blocks are then in that order).
+    ``poses`` (one row per chosen body: position (3), unit quaternion (4)) clips them there
+    instead of at their present poses."""
     if not solver._ready:
         solver.finalize()
     table = solver.table
-    rotations = solver.rotation_matrices()
     node_parts, triangle_parts, triangle_start = [], [], [0]
     node_count = 0
     chosen = range(solver.n_bodies) if bodies is None else [int(b) for b in bodies]
-    for body in chosen:
+    if poses is None:
+        poses = np.concatenate([solver.positions, solver.quaternions], axis=1)[list(chosen)]
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 7)
+    for place, body in enumerate(chosen):
         s = solver.shape_index[body]
         local = table.nodes[table.node_offset[s]:table.node_offset[s + 1]]
-        node_parts.append(local @ rotations[body].T + solver.positions[body])
+        node_parts.append(local @ rotation_matrix(poses[place, 3:]).T + poses[place, :3])
         triangle_parts.append(table.triangles[table.triangle_offset[s]:table.triangle_offset[s + 1]]
                               + node_count)
         node_count += len(local)
@@ -156,7 +161,7 @@ def rigid_body_cell_volumes(grid: FluidGrid, solver, bodies=None) -> BodyCellVol
                                 np.array(triangle_start))
 
 
-def rigid_body_half_cell_volumes(grid: FluidGrid, solver, bodies=None) -> list:
+def rigid_body_half_cell_volumes(grid: FluidGrid, solver, bodies=None, poses=None) -> list:
     """Per body (origin (3,), cell volumes (bi, bj, bk), half-cell volumes (bi, bj, bk, 3, 2)):
     :func:`rigid_body_cell_volumes` on the grid of half the cell size, summed to the cells and to
     each cell's lower and upper half along every axis. A face of the staggered grid owns the
@@ -165,7 +170,7 @@ def rigid_body_half_cell_volumes(grid: FluidGrid, solver, bodies=None) -> list:
     cell wide, where the mean of the two cells' fractions would smear the body over two."""
     fine_grid = FluidGrid(lower=grid.lower, upper=grid.upper,
                           cells=tuple(2 * int(n) for n in grid.cells))
-    fine = rigid_body_cell_volumes(fine_grid, solver, bodies=bodies)
+    fine = rigid_body_cell_volumes(fine_grid, solver, bodies=bodies, poses=poses)
     blocks = []
     for body in range(fine.n_bodies):
         fine_origin, volumes = fine.block(body)

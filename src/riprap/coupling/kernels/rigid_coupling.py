@@ -137,10 +137,10 @@ def touched_faces(cell_start, cell_index, cell_halves, cell_volume, cells, slots
             entry_start, entry_face[:n_entries], entry_half[:n_entries])
 
 
-@kernel
+@parallel_kernel
 def gather(face_axis, face_index, on_x, on_y, on_z, out):
     """out[f] = the value of face f in the face arrays of the three axes."""
-    for f in range(face_axis.shape[0]):
+    for f in prange(face_axis.shape[0]):
         i, j, k = face_index[f, 0], face_index[f, 1], face_index[f, 2]
         axis = face_axis[f]
         if axis == 0:
@@ -151,10 +151,11 @@ def gather(face_axis, face_index, on_x, on_y, on_z, out):
             out[f] = on_z[i, j, k]
 
 
-@kernel
+@parallel_kernel
 def scatter(face_axis, face_index, values, on_x, on_y, on_z):
-    """Face f of the face arrays of the three axes = values[f]."""
-    for f in range(face_axis.shape[0]):
+    """Face f of the face arrays of the three axes = values[f] (faces of a set are distinct, so
+    the parallel writes never meet)."""
+    for f in prange(face_axis.shape[0]):
         i, j, k = face_index[f, 0], face_index[f, 1], face_index[f, 2]
         axis = face_axis[f]
         if axis == 0:
@@ -177,11 +178,11 @@ def _cells_of_face(axis, index, cell_values):
     return cell_values[i, j, k - 1], high
 
 
-@kernel
+@parallel_kernel
 def face_mean_density(face_axis, face_index, interior, fraction, water_density, air_density, out):
     """Mean density of the two cells of each interior face from the water fraction (0 on walls):
     the face density a fluid step starts from."""
-    for f in range(face_axis.shape[0]):
+    for f in prange(face_axis.shape[0]):
         if not interior[f]:
             out[f] = 0.0
             continue
@@ -191,10 +192,10 @@ def face_mean_density(face_axis, face_index, interior, fraction, water_density, 
         out[f] = 0.5 * (low_density + high_density)
 
 
-@kernel
+@parallel_kernel
 def face_pressure_force(face_axis, face_index, interior, pressure, h, out):
     """-grad p on each interior face (0 on walls): the pressure's force per unit volume."""
-    for f in range(face_axis.shape[0]):
+    for f in prange(face_axis.shape[0]):
         if not interior[f]:
             out[f] = 0.0
             continue
