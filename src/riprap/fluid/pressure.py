@@ -42,7 +42,8 @@ __all__ = ["PressureSolver", "PressureSolveReport", "apply_operator"]
 # Coarsening stops once a level has at most this many cells; the coarsest level is then factored
 # directly (banded Cholesky, cost cells x (ny nz)^2: about a million operations for 8 x 8 x 8).
 COARSEST_MAXIMUM_CELLS = 512
-# Red-black Gauss-Seidel sweeps before and after each coarse correction. Measured on 128^3,
+# Red-black Gauss-Seidel sweeps before and after each coarse correction on the two finest levels
+# (more below them: ``multigrid.level_sweeps``). Measured on 128^3,
 # 1024 x 1 x 128 and 200 x 40 x 60 with a 1000:1 wavy surface (2-core machine): one sweep needs
 # about twice the iterations (20 against 9 on 128^3) and is slower; two, three and four sweeps
 # take about the same time (fewer iterations, dearer V-cycles).
@@ -50,10 +51,11 @@ SMOOTHING_SWEEPS = 2
 # Extra sweeps on the cells a caller lists (``solve(listed_cells=...)``: the coupled solver lists
 # the cells of free bodies), before and after each V-cycle. Measured on the pressure problem of
 # examples/06 as the bore reaches the layer (0.91 M cells, 46,628 cells of 25 concrete units partly
-# in air): 23 CG iterations and 514-523 ms without; 17 iterations and 418-427 ms with 2 sweeps; 17
-# and 427-453 ms with 3; 16 and 418-474 ms with 4; 14 with 16 sweeps or an exact solve on those
-# cells (the rest is the core's obstacle cells: the water alone with them takes 13-14).
-LISTED_SWEEPS = 2
+# in air), with the coarse levels' sweeps of ``multigrid.level_sweeps``: 22 CG iterations and
+# 530-550 ms without; 16 and 426-455 ms with 2 sweeps; 14 and 402-410 ms with 4; 14 and 456 ms
+# with 8. (With 2 sweeps on every level: 23 iterations without, 17 with 2 sweeps, 14 with an
+# exact solve on those cells.)
+LISTED_SWEEPS = 4
 
 
 @dataclass(frozen=True)
