@@ -468,7 +468,8 @@ class CoupledSolver:
         """The flat indices of the free bodies' cells, kept with the face set they belong to."""
         if self._listed is None or self._listed[0] is not faces:
             lists = [self._cell_lists[b][0] for b in np.flatnonzero(free)]
-            self._listed = (faces, np.unique(np.concatenate(lists)) if lists else None)
+            # the pressure solver sorts them and drops repeats (cells two bodies share)
+            self._listed = (faces, np.concatenate(lists) if lists else None)
         return self._listed[1]
 
     def step(self, dt: float | None = None) -> CoupledStepReport:
