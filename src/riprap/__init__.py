@@ -9,10 +9,11 @@ The public API, one namespace::
 """
 __version__ = "0.1.0"
 
-from riprap import analysis, errors, placement
+from riprap import analysis, deformable, errors, placement
 from riprap.analysis import analyse, compare_layers
 from riprap.case.build import build_simulation
 from riprap.case.load import load_case, parse_case
+from riprap.deformable import DeformableBody, ElasticMaterial
 from riprap.fluid.grid import FluidGrid
 from riprap.fluid.phases import AIR_20C, SEA_WATER_20C, WATER_20C, Phase
 from riprap.fluid.run import FluidRun
@@ -29,7 +30,7 @@ from riprap.solid.shape import RigidShape
 from riprap.solid.solver import ContactRecords, SolidSolver
 
 __all__ = [
-    "AIR_20C", "ArmourUnit", "ContactRecords", "FluidGrid", "FluidRun", "FluidSolver", "Phase",
+    "AIR_20C", "ArmourUnit", "ContactRecords", "DeformableBody", "ElasticMaterial", "deformable", "FluidGrid", "FluidRun", "FluidSolver", "Phase",
     "SEA_WATER_20C", "WATER_20C", "analyse", "analysis", "compare_layers", "Material", "RigidShape", "RockGrading", "RunSummary",
     "Simulation", "SolidSolver", "TetMesh", "armour_unit", "build_simulation", "errors",
     "load_case", "mass_properties", "parse_case", "placement", "rock_library", "shapes", "walls",

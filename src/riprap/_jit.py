@@ -65,4 +65,8 @@ _use_source_stamped_cache()
 
 kernel = numba.njit(cache=True, fastmath=False, error_model="numpy")
 parallel_kernel = numba.njit(cache=True, fastmath=False, parallel=True, error_model="numpy")
+# Small per-element or per-node bodies called from both a parallel and a serial loop: inlined
+# into each caller at numba's IR level, since an LLVM call per element measured 1.6x slower
+# (finite-strain tets). Compiled only as part of their callers, which are cached.
+inline_kernel = numba.njit(fastmath=False, error_model="numpy", inline="always")
 prange = numba.prange

@@ -1,0 +1,391 @@
+"""Compiled kernels of explicit finite-strain tetrahedra: internal forces, the central-difference
+update, element stresses and stored energy.
+
+Every element is described by the reference gradients of its shape functions at its integration
+points, so F = sum_a x_a (x) grad N_a and the nodal internal force is
+f_a = -sum_g w_g P_g grad N_a, with P = J sigma F^-T the first Piola-Kirchhoff stress. The 4-node
+tet (one point) has its own kernel because it carries nearly all the work; the 10-node tet uses the
+general one. Positions are taken relative to the element's first node (the gradients sum to zero),
+which keeps F accurate for bodies far from the origin.
+
+Element forces go to a per-element array first and are summed per node by a second loop over a
+node-to-element list, so that both loops run in parallel without atomics.
+
+Constitutive codes (``riprap.deformable.material.CONSTITUTIVE_MODELS``): 0 the seed's eq. 10,
+1 Neo-Hookean with lambda ln J, 2 the volumetric-isochoric split.
+"""
+import math
+
+import numpy as np
+
+from riprap._jit import inline_kernel, kernel, parallel_kernel, prange
+
+
+@inline_kernel
+def kirchhoff_stress(model, mu, lam, kappa, eta,
+                     f00, f01, f02, f10, f11, f12, f20, f21, f22,
+                     g00, g01, g02, g10, g11, g12, g20, g21, g22):
+    """J and the Kirchhoff stress tau = J sigma (6 components xx, yy, zz, xy, yz, zx) for the
+    deformation gradient F (f..) and its rate dF/dt (g..); also F's cofactor matrix (F^-T = cof / J).
+    Returns (J, t00, t11, t22, t01, t12, t20, c00, c01, c02, c10, c11, c12, c20, c21, c22)."""
+    c00 = f11 * f22 - f12 * f21
+    c01 = f12 * f20 - f10 * f22
+    c02 = f10 * f21 - f11 * f20
+    c10 = f02 * f21 - f01 * f22
+    c11 = f00 * f22 - f02 * f20
+    c12 = f01 * f20 - f00 * f21
+    c20 = f01 * f12 - f02 * f11
+    c21 = f02 * f10 - f00 * f12
+    c22 = f00 * f11 - f01 * f10
+    jac = f00 * c00 + f01 * c01 + f02 * c02
+    # B = F F^T
+    b00 = f00 * f00 + f01 * f01 + f02 * f02
+    b11 = f10 * f10 + f11 * f11 + f12 * f12
+    b22 = f20 * f20 + f21 * f21 + f22 * f22
+    b01 = f00 * f10 + f01 * f11 + f02 * f12
+    b12 = f10 * f20 + f11 * f21 + f12 * f22
+    b20 = f20 * f00 + f21 * f01 + f22 * f02
+    trace_b = b00 + b11 + b22
+    if model == 0:
+        shear = mu
+        iso = -mu + 0.5 * lam * (trace_b - 3.0)
+    elif model == 1:
+        shear = mu
+        log_j = math.log(jac) if jac > 0.0 else -np.inf
+        iso = -mu + lam * log_j
+    else:
+        # J^(-2/3); the sign keeps an inverted element's stress finite until the run stops on it
+        scale = mu / np.cbrt(jac * jac) if jac != 0.0 else np.inf
+        shear = scale
+        iso = 0.5 * kappa * (jac * jac - 1.0) - scale * trace_b / 3.0
+    t00 = shear * b00 + iso
+    t11 = shear * b11 + iso
+    t22 = shear * b22 + iso
+    t01 = shear * b01
+    t12 = shear * b12
+    t20 = shear * b20
+    if eta > 0.0:
+        # tau_viscous = 2 eta J D, D = sym(dF/dt F^-1) and J F^-1 = cof^T
+        l00 = g00 * c00 + g01 * c01 + g02 * c02
+        l01 = g00 * c10 + g01 * c11 + g02 * c12
+        l02 = g00 * c20 + g01 * c21 + g02 * c22
+        l10 = g10 * c00 + g11 * c01 + g12 * c02
+        l11 = g10 * c10 + g11 * c11 + g12 * c12
+        l12 = g10 * c20 + g11 * c21 + g12 * c22
+        l20 = g20 * c00 + g21 * c01 + g22 * c02
+        l21 = g20 * c10 + g21 * c11 + g22 * c12
+        l22 = g20 * c20 + g21 * c21 + g22 * c22
+        t00 += 2.0 * eta * l00
+        t11 += 2.0 * eta * l11
+        t22 += 2.0 * eta * l22
+        t01 += eta * (l01 + l10)
+        t12 += eta * (l12 + l21)
+        t20 += eta * (l20 + l02)
+    return (jac, t00, t11, t22, t01, t12, t20, c00, c01, c02, c10, c11, c12, c20, c21, c22)
+
+
+@inline_kernel
+def point_piola(positions, velocities, nodes, point_gradients, weight, model, mu, lam, kappa, eta):
+    """J and the first Piola-Kirchhoff stress times ``weight`` (9 components, row-major) at one
+    integration point of an element with nodes ``nodes`` and shape-function gradients
+    ``point_gradients`` (n_local, 3)."""
+    n0 = nodes[0]
+    f00 = f01 = f02 = f10 = f11 = f12 = f20 = f21 = f22 = 0.0
+    g00 = g01 = g02 = g10 = g11 = g12 = g20 = g21 = g22 = 0.0
+    for a in range(1, nodes.shape[0]):
+        n = nodes[a]
+        dx0 = positions[n, 0] - positions[n0, 0]
+        dx1 = positions[n, 1] - positions[n0, 1]
+        dx2 = positions[n, 2] - positions[n0, 2]
+        dv0 = velocities[n, 0] - velocities[n0, 0]
+        dv1 = velocities[n, 1] - velocities[n0, 1]
+        dv2 = velocities[n, 2] - velocities[n0, 2]
+        h0 = point_gradients[a, 0]
+        h1 = point_gradients[a, 1]
+        h2 = point_gradients[a, 2]
+        f00 += dx0 * h0
+        f01 += dx0 * h1
+        f02 += dx0 * h2
+        f10 += dx1 * h0
+        f11 += dx1 * h1
+        f12 += dx1 * h2
+        f20 += dx2 * h0
+        f21 += dx2 * h1
+        f22 += dx2 * h2
+        g00 += dv0 * h0
+        g01 += dv0 * h1
+        g02 += dv0 * h2
+        g10 += dv1 * h0
+        g11 += dv1 * h1
+        g12 += dv1 * h2
+        g20 += dv2 * h0
+        g21 += dv2 * h1
+        g22 += dv2 * h2
+    (jac, t00, t11, t22, t01, t12, t20,
+     c00, c01, c02, c10, c11, c12, c20, c21, c22) = kirchhoff_stress(
+        model, mu, lam, kappa, eta, f00, f01, f02, f10, f11, f12, f20, f21, f22,
+        g00, g01, g02, g10, g11, g12, g20, g21, g22)
+    # P = tau F^-T = tau cof / J
+    s = weight / jac
+    return (jac,
+            s * (t00 * c00 + t01 * c10 + t20 * c20), s * (t00 * c01 + t01 * c11 + t20 * c21),
+            s * (t00 * c02 + t01 * c12 + t20 * c22), s * (t01 * c00 + t11 * c10 + t12 * c20),
+            s * (t01 * c01 + t11 * c11 + t12 * c21), s * (t01 * c02 + t11 * c12 + t12 * c22),
+            s * (t20 * c00 + t12 * c10 + t22 * c20), s * (t20 * c01 + t12 * c11 + t22 * c21),
+            s * (t20 * c02 + t12 * c12 + t22 * c22))
+
+
+@inline_kernel
+def tet4_element(e, positions, velocities, tets, gradients, volumes,
+                 model, mu, lam, kappa, eta, element_forces, jacobians):
+    """Internal forces of 4-node tet ``e`` into ``element_forces[e]`` (4, 3) and J into
+    ``jacobians[e]``. ``gradients[e]`` (4, 3): the reference gradients of the shape functions,
+    ``volumes[e]`` the reference volume."""
+    (jac, p00, p01, p02, p10, p11, p12, p20, p21, p22) = point_piola(
+        positions, velocities, tets[e], gradients[e], volumes[e], model, mu, lam, kappa, eta)
+    jacobians[e] = jac
+    s0 = s1 = s2 = 0.0
+    for k in range(1, 4):
+        h0 = gradients[e, k, 0]
+        h1 = gradients[e, k, 1]
+        h2 = gradients[e, k, 2]
+        a0 = -(p00 * h0 + p01 * h1 + p02 * h2)
+        a1 = -(p10 * h0 + p11 * h1 + p12 * h2)
+        a2 = -(p20 * h0 + p21 * h1 + p22 * h2)
+        element_forces[e, k, 0] = a0
+        element_forces[e, k, 1] = a1
+        element_forces[e, k, 2] = a2
+        s0 += a0
+        s1 += a1
+        s2 += a2
+    # node 0's gradient is minus the sum of the others'
+    element_forces[e, 0, 0] = -s0
+    element_forces[e, 0, 1] = -s1
+    element_forces[e, 0, 2] = -s2
+
+
+@inline_kernel
+def general_element(e, positions, velocities, elements, gradients, weights,
+                    model, mu, lam, kappa, eta, element_forces, jacobians):
+    """Internal forces of element ``e`` with several integration points (the 10-node tet).
+
+    ``gradients[e, g, a]`` is the reference gradient of node a's shape function at point g,
+    ``weights[e, g]`` the reference volume that point stands for; ``jacobians[e]`` gets the
+    smallest J over the element's points."""
+    n_nodes = elements.shape[1]
+    for a in range(n_nodes):
+        for i in range(3):
+            element_forces[e, a, i] = 0.0
+    smallest = np.inf
+    for g in range(gradients.shape[1]):
+        (jac, p00, p01, p02, p10, p11, p12, p20, p21, p22) = point_piola(
+            positions, velocities, elements[e], gradients[e, g], weights[e, g], model, mu, lam,
+            kappa, eta)
+        smallest = min(smallest, jac)
+        for a in range(n_nodes):
+            h0 = gradients[e, g, a, 0]
+            h1 = gradients[e, g, a, 1]
+            h2 = gradients[e, g, a, 2]
+            element_forces[e, a, 0] -= p00 * h0 + p01 * h1 + p02 * h2
+            element_forces[e, a, 1] -= p10 * h0 + p11 * h1 + p12 * h2
+            element_forces[e, a, 2] -= p20 * h0 + p21 * h1 + p22 * h2
+    jacobians[e] = smallest
+
+
+@parallel_kernel
+def tet4_element_forces(positions, velocities, tets, gradients, volumes,
+                        model, mu, lam, kappa, eta, element_forces, jacobians):
+    """:func:`tet4_element` for every element, in parallel."""
+    for e in prange(tets.shape[0]):
+        tet4_element(e, positions, velocities, tets, gradients, volumes, model, mu, lam, kappa,
+                     eta, element_forces, jacobians)
+
+
+@kernel
+def element_forces_serial(positions, velocities, elements, tet4_gradients, gradients, weights,
+                          model, mu, lam, kappa, eta, element_forces, jacobians):
+    """Internal forces of every element on one thread (small bodies: no thread start-up)."""
+    if elements.shape[1] == 4:
+        for e in range(elements.shape[0]):
+            tet4_element(e, positions, velocities, elements, tet4_gradients, weights[:, 0],
+                         model, mu, lam, kappa, eta, element_forces, jacobians)
+    else:
+        for e in range(elements.shape[0]):
+            general_element(e, positions, velocities, elements, gradients, weights, model, mu,
+                            lam, kappa, eta, element_forces, jacobians)
+
+
+@parallel_kernel
+def general_element_forces(positions, velocities, elements, gradients, weights,
+                           model, mu, lam, kappa, eta, element_forces, jacobians):
+    """:func:`general_element` for every element, in parallel."""
+    for e in prange(elements.shape[0]):
+        general_element(e, positions, velocities, elements, gradients, weights, model, mu, lam,
+                        kappa, eta, element_forces, jacobians)
+
+
+@inline_kernel
+def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots, masses,
+                external_forces, gravity, mass_damping, constrained, prescribed_velocities,
+                time_step, nodal_forces):
+    """Central-difference update of node ``n`` (see :func:`central_difference_update`)."""
+    m = masses[n]
+    for i in range(3):
+        total = external_forces[n, i] + m * gravity[i] - mass_damping * m * velocities[n, i]
+        for s in range(node_offsets[n], node_offsets[n + 1]):
+            total += flat_forces[node_slots[s], i]
+        nodal_forces[n, i] = total
+        if constrained[n, i]:
+            velocity = prescribed_velocities[n, i]
+        else:
+            velocity = velocities[n, i] + time_step * total / m
+        velocities[n, i] = velocity
+        positions[n, i] += time_step * velocity
+
+
+@parallel_kernel
+def central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
+                              masses, external_forces, gravity, mass_damping, constrained,
+                              prescribed_velocities, time_step, nodal_forces):
+    """Sum the element forces at every node, add loads, gravity and mass-proportional damping, and
+    advance the half-step velocity and the position (central difference / leapfrog).
+
+    ``node_slots[node_offsets[n]:node_offsets[n + 1]]`` lists the flat (element, local node)
+    entries of ``element_forces`` that act on node n. Components flagged in ``constrained`` take
+    ``prescribed_velocities`` instead. ``nodal_forces`` receives the total force at every node (for
+    reactions and outputs)."""
+    flat = element_forces.reshape((-1, 3))
+    for n in prange(positions.shape[0]):
+        update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
+                    external_forces, gravity, mass_damping, constrained, prescribed_velocities,
+                    time_step, nodal_forces)
+
+
+@kernel
+def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
+                                     node_slots, masses, external_forces, gravity, mass_damping,
+                                     constrained, prescribed_velocities, time_step, nodal_forces):
+    """:func:`central_difference_update` on one thread (small bodies: no thread start-up)."""
+    flat = element_forces.reshape((-1, 3))
+    for n in range(positions.shape[0]):
+        update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
+                    external_forces, gravity, mass_damping, constrained, prescribed_velocities,
+                    time_step, nodal_forces)
+
+
+@parallel_kernel
+def cauchy_stresses(positions, velocities, elements, gradients, weights, model, mu, lam, kappa,
+                    eta, stresses):
+    """Volume-weighted mean Cauchy stress of every element over its integration points into
+    ``stresses`` (n, 3, 3)."""
+    n_points = gradients.shape[1]
+    n_nodes = elements.shape[1]
+    for e in prange(elements.shape[0]):
+        n0 = elements[e, 0]
+        s00 = s11 = s22 = s01 = s12 = s20 = 0.0
+        volume = 0.0
+        for g in range(n_points):
+            f = np.zeros((3, 3))
+            fd = np.zeros((3, 3))
+            for a in range(1, n_nodes):
+                n = elements[e, a]
+                for i in range(3):
+                    dx = positions[n, i] - positions[n0, i]
+                    dv = velocities[n, i] - velocities[n0, i]
+                    for j in range(3):
+                        f[i, j] += dx * gradients[e, g, a, j]
+                        fd[i, j] += dv * gradients[e, g, a, j]
+            result = kirchhoff_stress(
+                model, mu, lam, kappa, eta, f[0, 0], f[0, 1], f[0, 2], f[1, 0], f[1, 1], f[1, 2],
+                f[2, 0], f[2, 1], f[2, 2], fd[0, 0], fd[0, 1], fd[0, 2], fd[1, 0], fd[1, 1],
+                fd[1, 2], fd[2, 0], fd[2, 1], fd[2, 2])
+            jac = result[0]
+            # sigma = tau / J, weighted by the deformed volume J w
+            w = weights[e, g]
+            s00 += w * result[1]
+            s11 += w * result[2]
+            s22 += w * result[3]
+            s01 += w * result[4]
+            s12 += w * result[5]
+            s20 += w * result[6]
+            volume += w * jac
+        stresses[e, 0, 0] = s00 / volume
+        stresses[e, 1, 1] = s11 / volume
+        stresses[e, 2, 2] = s22 / volume
+        stresses[e, 0, 1] = stresses[e, 1, 0] = s01 / volume
+        stresses[e, 1, 2] = stresses[e, 2, 1] = s12 / volume
+        stresses[e, 2, 0] = stresses[e, 0, 2] = s20 / volume
+
+
+@parallel_kernel
+def stored_energies(positions, elements, gradients, weights, model, mu, lam, kappa, energies):
+    """Stored elastic energy of every element (J) for the hyperelastic models (1 and 2)."""
+    n_points = gradients.shape[1]
+    n_nodes = elements.shape[1]
+    for e in prange(elements.shape[0]):
+        n0 = elements[e, 0]
+        energy = 0.0
+        for g in range(n_points):
+            f = np.zeros((3, 3))
+            for a in range(1, n_nodes):
+                n = elements[e, a]
+                for i in range(3):
+                    dx = positions[n, i] - positions[n0, i]
+                    for j in range(3):
+                        f[i, j] += dx * gradients[e, g, a, j]
+            jac = np.linalg.det(f)
+            first_invariant = np.sum(f * f)
+            if model == 1:
+                log_j = math.log(jac)
+                density = 0.5 * mu * (first_invariant - 3.0) - mu * log_j + 0.5 * lam * log_j * log_j
+            else:
+                density = (0.5 * mu * (first_invariant / np.cbrt(jac * jac) - 3.0)
+                           + 0.25 * kappa * (jac * jac - 1.0 - 2.0 * math.log(jac)))
+            energy += weights[e, g] * density
+        energies[e] = energy
+
+
+@kernel
+def smallest_jacobian(jacobians):
+    """(index, value) of the smallest J."""
+    worst = 0
+    value = np.inf
+    for e in range(jacobians.shape[0]):
+        if jacobians[e] < value:
+            value = jacobians[e]
+            worst = e
+    return worst, value
+
+
+@kernel
+def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradients, gradients, weights,
+                  model, mu, lam, kappa, eta, element_forces, jacobians, node_offsets,
+                  node_slots, masses, external_forces, gravity, mass_damping, constrained,
+                  prescribed_velocities, time_step, nodal_forces):
+    """Up to ``n_steps`` central-difference steps without returning to Python. Stops before the
+    update of a step in which an element has J <= 0 (or a non-finite J) and returns
+    (steps done, that element or -1, its J)."""
+    tet4 = elements.shape[1] == 4
+    for step in range(n_steps):
+        if not parallel:
+            element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
+                                  weights, model, mu, lam, kappa, eta, element_forces, jacobians)
+        elif tet4:
+            tet4_element_forces(positions, velocities, elements, tet4_gradients, weights[:, 0],
+                                model, mu, lam, kappa, eta, element_forces, jacobians)
+        else:
+            general_element_forces(positions, velocities, elements, gradients, weights, model,
+                                   mu, lam, kappa, eta, element_forces, jacobians)
+        worst, value = smallest_jacobian(jacobians)
+        if not value > 0.0:
+            return step, worst, value
+        if parallel:
+            central_difference_update(positions, velocities, element_forces, node_offsets,
+                                      node_slots, masses, external_forces, gravity, mass_damping,
+                                      constrained, prescribed_velocities, time_step, nodal_forces)
+        else:
+            central_difference_update_serial(positions, velocities, element_forces, node_offsets,
+                                             node_slots, masses, external_forces, gravity,
+                                             mass_damping, constrained, prescribed_velocities,
+                                             time_step, nodal_forces)
+    return n_steps, -1, 1.0

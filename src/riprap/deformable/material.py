@@ -1,0 +1,124 @@
+"""Elastic materials of deformable bodies: compressible Neo-Hookean with a viscous term.
+
+The seed paper's eq. 10 gives the Cauchy stress of Y3D-D,
+
+    T = (mu / J) (B - I) + (lambda / 2J) tr(B - I) I + 2 eta D,
+
+with B = F F^T the left Cauchy-Green tensor, J = det F and D the rate of deformation. It agrees
+with linear elasticity at small strain (concrete units strain about 1e-4) but has no stored-energy
+function, so it cannot conserve energy exactly at finite strain. Two hyperelastic forms are offered
+beside it (``constitutive_model``):
+
+- ``"neo_hookean_seed"`` (default): eq. 10 as printed.
+- ``"neo_hookean"``: T = (mu/J)(B - I) + (lambda ln J / J) I + 2 eta D, energy
+  mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2 (Bonet & Wood, *Nonlinear Continuum Mechanics*,
+  2008, eq. 6.28; the form Y3D's code evaluates).
+- ``"neo_hookean_decoupled"``: energy mu/2 (J^(-2/3) I1 - 3) + kappa/4 (J^2 - 1 - 2 ln J), the
+  volumetric-isochoric split of the deal.II and solids4foam Cook's membrane references.
+
+All three have the same small-strain moduli (Lame's lambda and mu from Young's modulus and
+Poisson's ratio), so they share wave speeds and the stable time step.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from riprap.errors import CaseFileError
+
+#: Names of the constitutive models, in the integer code order the kernels use.
+CONSTITUTIVE_MODELS = ("neo_hookean_seed", "neo_hookean", "neo_hookean_decoupled")
+
+
+@dataclass(frozen=True)
+class ElasticMaterial:
+    """Material of a deformable body.
+
+    Parameters
+    ----------
+    name : str
+        Used in error messages.
+    density : float
+        kg/m^3 (concrete about 2400).
+    young_modulus : float
+        Young's modulus E (Pa); concrete about 30-40 GPa.
+    poisson_ratio : float
+        Poisson's ratio nu (-), in (-1, 0.5); concrete about 0.2.
+    viscosity : float
+        eta of the viscous stress 2 eta D (Pa s), >= 0. It damps the highest element frequencies
+        first (its damping ratio grows with frequency) and is the only damping of a physics run.
+    constitutive_model : str
+        One of :data:`CONSTITUTIVE_MODELS`.
+    tensile_strength : float or None
+        Tensile strength of the material (Pa), only compared with the largest principal stress in
+        reports; None when not given.
+    """
+
+    name: str = "concrete"
+    density: float = 2400.0
+    young_modulus: float = 30.0e9
+    poisson_ratio: float = 0.2
+    viscosity: float = 0.0
+    constitutive_model: str = "neo_hookean_seed"
+    tensile_strength: float | None = None
+
+    def __post_init__(self):
+        checks = [
+            ("density", self.density > 0, "> 0 kg/m^3"),
+            ("young_modulus", self.young_modulus > 0, "> 0 Pa"),
+            ("poisson_ratio", -1.0 < self.poisson_ratio < 0.5, "in (-1, 0.5)"),
+            ("viscosity", self.viscosity >= 0, ">= 0 Pa s"),
+        ]
+        for key, ok, expected in checks:
+            value = getattr(self, key)
+            if not (ok and math.isfinite(value)):
+                raise CaseFileError(f"material '{self.name}': {key} = {value!r} must be {expected}")
+        if self.constitutive_model not in CONSTITUTIVE_MODELS:
+            raise CaseFileError(
+                f"material '{self.name}': constitutive_model = {self.constitutive_model!r} is not "
+                f"one of {', '.join(CONSTITUTIVE_MODELS)}")
+        if self.tensile_strength is not None and not self.tensile_strength > 0:
+            raise CaseFileError(
+                f"material '{self.name}': tensile_strength = {self.tensile_strength!r} must be > 0 Pa")
+
+    @property
+    def model_code(self) -> int:
+        """Integer code of the constitutive model for the kernels."""
+        return CONSTITUTIVE_MODELS.index(self.constitutive_model)
+
+    @property
+    def shear_modulus(self) -> float:
+        """Lame's mu = E / (2 (1 + nu)) (Pa)."""
+        return self.young_modulus / (2.0 * (1.0 + self.poisson_ratio))
+
+    @property
+    def lame_lambda(self) -> float:
+        """Lame's lambda = E nu / ((1 + nu)(1 - 2 nu)) (Pa)."""
+        nu = self.poisson_ratio
+        return self.young_modulus * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+
+    @property
+    def bulk_modulus(self) -> float:
+        """kappa = lambda + 2 mu / 3 (Pa)."""
+        return self.lame_lambda + 2.0 * self.shear_modulus / 3.0
+
+    @property
+    def constrained_modulus(self) -> float:
+        """lambda + 2 mu (Pa): the modulus of a laterally constrained bar."""
+        return self.lame_lambda + 2.0 * self.shear_modulus
+
+    @property
+    def p_wave_speed(self) -> float:
+        """Dilatational wave speed c_p = sqrt((lambda + 2 mu) / rho) (m/s)."""
+        return math.sqrt(self.constrained_modulus / self.density)
+
+    @property
+    def bar_wave_speed(self) -> float:
+        """Wave speed of a thin bar c = sqrt(E / rho) (m/s)."""
+        return math.sqrt(self.young_modulus / self.density)
+
+    @property
+    def viscous_time_constant(self) -> float:
+        """beta (s): the viscous stress damps a mode of angular frequency omega with damping ratio
+        at most beta omega / 2 (the larger of eta / mu for shear and 2 eta / (3 kappa) for volume)."""
+        return self.viscosity * max(1.0 / self.shear_modulus, 2.0 / (3.0 * self.bulk_modulus))
