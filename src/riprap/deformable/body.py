@@ -22,6 +22,12 @@ from riprap.errors import CaseFileError, InstabilityError
 #: The step used by default is this fraction of the stable step.
 TIME_STEP_SAFETY = 0.9
 
+# The contact arguments of a run without contact (see finite_strain.advance_steps).
+NO_CONTACT = (np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int64), np.zeros(0),
+              np.zeros((0, 2), dtype=np.int64), 0.0, np.zeros((0, 6)), np.zeros((0, 3)), 1.0,
+              np.zeros(1))
+NO_TET4_GRADIENTS = np.zeros((0, 4, 3))
+
 # Bodies with fewer integration points than this step on one thread: starting the threads of a
 # parallel loop (twice a step) cost more than the work for the 480-tet cantilever of the tests
 # (147 against 32 microseconds a step on this 2-core machine).
@@ -82,6 +88,9 @@ class DeformableBody:
         self._element_forces = np.zeros((n_el, n_local, 3))
         self.jacobians = np.ones(n_el)
         self._offsets, self._slots = self.elements.node_to_element_slots()
+        self.materials = material_table([material])
+        self.element_material = np.zeros(n_el, dtype=np.int64)
+        self.contact_forces = np.zeros((n_nodes, 3))
         self._stable_time_step = None
         self._time_step = None
 
@@ -144,14 +153,9 @@ class DeformableBody:
             self.velocities[node_ids, component] = velocity[:, column]
 
     # ------------------------------------------------------------------ dynamics
-    def _model_arguments(self):
-        material = self.material
-        return (material.model_code, material.shear_modulus, material.lame_lambda,
-                material.bulk_modulus, material.viscosity)
-
     def compute_element_forces(self) -> None:
         """Internal forces of every element at the present state (into the element buffer) and J."""
-        arguments = self._model_arguments()
+        arguments = (self.materials, self.element_material)
         if self.elements.element_type == "tet4":
             finite_strain.tet4_element_forces(
                 self.positions, self.velocities, self.elements.elements,
@@ -174,20 +178,19 @@ class DeformableBody:
         if one inverts (J <= 0); the state is then that of the start of the failed step."""
         dt = self.time_step
         elements = self.elements
-        material = self.material
         tet4_gradients = (elements.tet4_gradients if elements.tet4_gradients is not None
-                          else np.zeros((0, 4, 3)))
+                          else NO_TET4_GRADIENTS)
         parallel = self.n_elements * elements.weights.shape[1] >= PARALLEL_POINTS
-        done, worst, value = finite_strain.advance_steps(
-            int(n_steps), parallel, self.positions, self.velocities, elements.elements, tet4_gradients,
-            elements.gradients, elements.weights, material.model_code, material.shear_modulus,
-            material.lame_lambda, material.bulk_modulus, material.viscosity, self._element_forces,
-            self.jacobians, self._offsets, self._slots, self.masses, self.external_forces,
-            self.gravity, self.mass_damping, self.constrained, self.prescribed_velocities, dt,
-            self.nodal_forces)
+        done, status, worst, value = finite_strain.advance_steps(
+            int(n_steps), parallel, self.positions, self.velocities, elements.elements,
+            tet4_gradients, elements.gradients, elements.weights, self.materials,
+            self.element_material, self._element_forces, self.jacobians, self._offsets,
+            self._slots, self.masses, self.external_forces, self.contact_forces, self.gravity,
+            self.mass_damping, self.constrained, self.prescribed_velocities, dt, self.nodal_forces,
+            NO_CONTACT)
         self.step_count += int(done)
         self.time += int(done) * dt
-        if worst >= 0:
+        if status == finite_strain.INVERTED:
             self._raise_inverted(int(worst), float(value))
 
     def _raise_inverted(self, worst: int, value: float) -> None:
@@ -205,7 +208,7 @@ class DeformableBody:
         stresses = np.zeros((self.n_elements, 3, 3))
         finite_strain.cauchy_stresses(self.positions, self.velocities, self.elements.elements,
                                       self.elements.gradients, self.elements.weights,
-                                      *self._model_arguments(), stresses)
+                                      self.materials, self.element_material, stresses)
         return stresses
 
     def kinetic_energy(self, velocities=None) -> float:
@@ -219,12 +222,16 @@ class DeformableBody:
                 f"deformable body '{self.name}': the seed's eq. 10 (neo_hookean_seed) has no "
                 "stored-energy function; use constitutive_model = 'neo_hookean' for energy balances")
         energies = np.zeros(self.n_elements)
-        material = self.material
         finite_strain.stored_energies(self.positions, self.elements.elements,
                                       self.elements.gradients, self.elements.weights,
-                                      material.model_code, material.shear_modulus,
-                                      material.lame_lambda, material.bulk_modulus, energies)
+                                      self.materials, self.element_material, energies)
         return float(energies.sum())
+
+
+def material_table(materials) -> np.ndarray:
+    """Rows (model code, mu, lambda, kappa, eta) of the kernels, one per material."""
+    return np.array([[m.model_code, m.shear_modulus, m.lame_lambda, m.bulk_modulus, m.viscosity]
+                     for m in materials], dtype=np.float64)
 
 
 def stable_step_for(omega_max: float, viscous_time_constant: float, mass_damping: float) -> float:

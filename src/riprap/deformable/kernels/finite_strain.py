@@ -19,6 +19,7 @@ import math
 import numpy as np
 
 from riprap._jit import inline_kernel, kernel, parallel_kernel, prange
+from riprap.deformable.kernels import contact as contact_kernels
 
 
 @inline_kernel
@@ -85,10 +86,10 @@ def kirchhoff_stress(model, mu, lam, kappa, eta,
 
 
 @inline_kernel
-def point_piola(positions, velocities, nodes, point_gradients, weight, model, mu, lam, kappa, eta):
+def point_piola(positions, velocities, nodes, point_gradients, weight, material):
     """J and the first Piola-Kirchhoff stress times ``weight`` (9 components, row-major) at one
-    integration point of an element with nodes ``nodes`` and shape-function gradients
-    ``point_gradients`` (n_local, 3)."""
+    integration point of an element with nodes ``nodes``, shape-function gradients
+    ``point_gradients`` (n_local, 3) and ``material`` (model code, mu, lambda, kappa, eta)."""
     n0 = nodes[0]
     f00 = f01 = f02 = f10 = f11 = f12 = f20 = f21 = f22 = 0.0
     g00 = g01 = g02 = g10 = g11 = g12 = g20 = g21 = g22 = 0.0
@@ -123,8 +124,8 @@ def point_piola(positions, velocities, nodes, point_gradients, weight, model, mu
         g22 += dv2 * h2
     (jac, t00, t11, t22, t01, t12, t20,
      c00, c01, c02, c10, c11, c12, c20, c21, c22) = kirchhoff_stress(
-        model, mu, lam, kappa, eta, f00, f01, f02, f10, f11, f12, f20, f21, f22,
-        g00, g01, g02, g10, g11, g12, g20, g21, g22)
+        int(material[0]), material[1], material[2], material[3], material[4],
+        f00, f01, f02, f10, f11, f12, f20, f21, f22, g00, g01, g02, g10, g11, g12, g20, g21, g22)
     # P = tau F^-T = tau cof / J
     s = weight / jac
     return (jac,
@@ -137,12 +138,12 @@ def point_piola(positions, velocities, nodes, point_gradients, weight, model, mu
 
 @inline_kernel
 def tet4_element(e, positions, velocities, tets, gradients, volumes,
-                 model, mu, lam, kappa, eta, element_forces, jacobians):
+                 materials, element_material, element_forces, jacobians):
     """Internal forces of 4-node tet ``e`` into ``element_forces[e]`` (4, 3) and J into
     ``jacobians[e]``. ``gradients[e]`` (4, 3): the reference gradients of the shape functions,
     ``volumes[e]`` the reference volume."""
     (jac, p00, p01, p02, p10, p11, p12, p20, p21, p22) = point_piola(
-        positions, velocities, tets[e], gradients[e], volumes[e], model, mu, lam, kappa, eta)
+        positions, velocities, tets[e], gradients[e], volumes[e], materials[element_material[e]])
     jacobians[e] = jac
     s0 = s1 = s2 = 0.0
     for k in range(1, 4):
@@ -166,7 +167,7 @@ def tet4_element(e, positions, velocities, tets, gradients, volumes,
 
 @inline_kernel
 def general_element(e, positions, velocities, elements, gradients, weights,
-                    model, mu, lam, kappa, eta, element_forces, jacobians):
+                    materials, element_material, element_forces, jacobians):
     """Internal forces of element ``e`` with several integration points (the 10-node tet).
 
     ``gradients[e, g, a]`` is the reference gradient of node a's shape function at point g,
@@ -179,8 +180,8 @@ def general_element(e, positions, velocities, elements, gradients, weights,
     smallest = np.inf
     for g in range(gradients.shape[1]):
         (jac, p00, p01, p02, p10, p11, p12, p20, p21, p22) = point_piola(
-            positions, velocities, elements[e], gradients[e, g], weights[e, g], model, mu, lam,
-            kappa, eta)
+            positions, velocities, elements[e], gradients[e, g], weights[e, g],
+            materials[element_material[e]])
         smallest = min(smallest, jac)
         for a in range(n_nodes):
             h0 = gradients[e, g, a, 0]
@@ -194,44 +195,45 @@ def general_element(e, positions, velocities, elements, gradients, weights,
 
 @parallel_kernel
 def tet4_element_forces(positions, velocities, tets, gradients, volumes,
-                        model, mu, lam, kappa, eta, element_forces, jacobians):
+                        materials, element_material, element_forces, jacobians):
     """:func:`tet4_element` for every element, in parallel."""
     for e in prange(tets.shape[0]):
-        tet4_element(e, positions, velocities, tets, gradients, volumes, model, mu, lam, kappa,
-                     eta, element_forces, jacobians)
+        tet4_element(e, positions, velocities, tets, gradients, volumes, materials,
+                     element_material, element_forces, jacobians)
 
 
 @kernel
 def element_forces_serial(positions, velocities, elements, tet4_gradients, gradients, weights,
-                          model, mu, lam, kappa, eta, element_forces, jacobians):
+                          materials, element_material, element_forces, jacobians):
     """Internal forces of every element on one thread (small bodies: no thread start-up)."""
     if elements.shape[1] == 4:
         for e in range(elements.shape[0]):
             tet4_element(e, positions, velocities, elements, tet4_gradients, weights[:, 0],
-                         model, mu, lam, kappa, eta, element_forces, jacobians)
+                         materials, element_material, element_forces, jacobians)
     else:
         for e in range(elements.shape[0]):
-            general_element(e, positions, velocities, elements, gradients, weights, model, mu,
-                            lam, kappa, eta, element_forces, jacobians)
+            general_element(e, positions, velocities, elements, gradients, weights, materials,
+                            element_material, element_forces, jacobians)
 
 
 @parallel_kernel
 def general_element_forces(positions, velocities, elements, gradients, weights,
-                           model, mu, lam, kappa, eta, element_forces, jacobians):
+                           materials, element_material, element_forces, jacobians):
     """:func:`general_element` for every element, in parallel."""
     for e in prange(elements.shape[0]):
-        general_element(e, positions, velocities, elements, gradients, weights, model, mu, lam,
-                        kappa, eta, element_forces, jacobians)
+        general_element(e, positions, velocities, elements, gradients, weights, materials,
+                        element_material, element_forces, jacobians)
 
 
 @inline_kernel
 def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots, masses,
-                external_forces, gravity, mass_damping, constrained, prescribed_velocities,
+                external_forces, contact_forces, gravity, mass_damping, constrained, prescribed_velocities,
                 time_step, nodal_forces):
     """Central-difference update of node ``n`` (see :func:`central_difference_update`)."""
     m = masses[n]
     for i in range(3):
-        total = external_forces[n, i] + m * gravity[i] - mass_damping * m * velocities[n, i]
+        total = (external_forces[n, i] + contact_forces[n, i] + m * gravity[i]
+                 - mass_damping * m * velocities[n, i])
         for s in range(node_offsets[n], node_offsets[n + 1]):
             total += flat_forces[node_slots[s], i]
         nodal_forces[n, i] = total
@@ -245,8 +247,8 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
 
 @parallel_kernel
 def central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
-                              masses, external_forces, gravity, mass_damping, constrained,
-                              prescribed_velocities, time_step, nodal_forces):
+                              masses, external_forces, contact_forces, gravity, mass_damping,
+                              constrained, prescribed_velocities, time_step, nodal_forces):
     """Sum the element forces at every node, add loads, gravity and mass-proportional damping, and
     advance the half-step velocity and the position (central difference / leapfrog).
 
@@ -257,30 +259,32 @@ def central_difference_update(positions, velocities, element_forces, node_offset
     flat = element_forces.reshape((-1, 3))
     for n in prange(positions.shape[0]):
         update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
-                    external_forces, gravity, mass_damping, constrained, prescribed_velocities,
-                    time_step, nodal_forces)
+                    external_forces, contact_forces, gravity, mass_damping, constrained,
+                    prescribed_velocities, time_step, nodal_forces)
 
 
 @kernel
 def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
-                                     node_slots, masses, external_forces, gravity, mass_damping,
-                                     constrained, prescribed_velocities, time_step, nodal_forces):
+                                     node_slots, masses, external_forces, contact_forces, gravity,
+                                     mass_damping, constrained, prescribed_velocities, time_step,
+                                     nodal_forces):
     """:func:`central_difference_update` on one thread (small bodies: no thread start-up)."""
     flat = element_forces.reshape((-1, 3))
     for n in range(positions.shape[0]):
         update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
-                    external_forces, gravity, mass_damping, constrained, prescribed_velocities,
-                    time_step, nodal_forces)
+                    external_forces, contact_forces, gravity, mass_damping, constrained,
+                    prescribed_velocities, time_step, nodal_forces)
 
 
 @parallel_kernel
-def cauchy_stresses(positions, velocities, elements, gradients, weights, model, mu, lam, kappa,
-                    eta, stresses):
+def cauchy_stresses(positions, velocities, elements, gradients, weights, materials,
+                    element_material, stresses):
     """Volume-weighted mean Cauchy stress of every element over its integration points into
     ``stresses`` (n, 3, 3)."""
     n_points = gradients.shape[1]
     n_nodes = elements.shape[1]
     for e in prange(elements.shape[0]):
+        material = materials[element_material[e]]
         n0 = elements[e, 0]
         s00 = s11 = s22 = s01 = s12 = s20 = 0.0
         volume = 0.0
@@ -296,9 +300,10 @@ def cauchy_stresses(positions, velocities, elements, gradients, weights, model, 
                         f[i, j] += dx * gradients[e, g, a, j]
                         fd[i, j] += dv * gradients[e, g, a, j]
             result = kirchhoff_stress(
-                model, mu, lam, kappa, eta, f[0, 0], f[0, 1], f[0, 2], f[1, 0], f[1, 1], f[1, 2],
-                f[2, 0], f[2, 1], f[2, 2], fd[0, 0], fd[0, 1], fd[0, 2], fd[1, 0], fd[1, 1],
-                fd[1, 2], fd[2, 0], fd[2, 1], fd[2, 2])
+                int(material[0]), material[1], material[2], material[3], material[4],
+                f[0, 0], f[0, 1], f[0, 2], f[1, 0], f[1, 1], f[1, 2], f[2, 0], f[2, 1], f[2, 2],
+                fd[0, 0], fd[0, 1], fd[0, 2], fd[1, 0], fd[1, 1], fd[1, 2], fd[2, 0], fd[2, 1],
+                fd[2, 2])
             jac = result[0]
             # sigma = tau / J, weighted by the deformed volume J w
             w = weights[e, g]
@@ -318,11 +323,18 @@ def cauchy_stresses(positions, velocities, elements, gradients, weights, model, 
 
 
 @parallel_kernel
-def stored_energies(positions, elements, gradients, weights, model, mu, lam, kappa, energies):
-    """Stored elastic energy of every element (J) for the hyperelastic models (1 and 2)."""
+def stored_energies(positions, elements, gradients, weights, materials, element_material,
+                    energies):
+    """Stored elastic energy of every element (J) for the hyperelastic models (1 and 2; NaN for
+    the seed's eq. 10, which has none)."""
     n_points = gradients.shape[1]
     n_nodes = elements.shape[1]
     for e in prange(elements.shape[0]):
+        material = materials[element_material[e]]
+        model = int(material[0])
+        mu = material[1]
+        lam = material[2]
+        kappa = material[3]
         n0 = elements[e, 0]
         energy = 0.0
         for g in range(n_points):
@@ -338,9 +350,11 @@ def stored_energies(positions, elements, gradients, weights, model, mu, lam, kap
             if model == 1:
                 log_j = math.log(jac)
                 density = 0.5 * mu * (first_invariant - 3.0) - mu * log_j + 0.5 * lam * log_j * log_j
-            else:
+            elif model == 2:
                 density = (0.5 * mu * (first_invariant / np.cbrt(jac * jac) - 3.0)
                            + 0.25 * kappa * (jac * jac - 1.0 - 2.0 * math.log(jac)))
+            else:
+                density = np.nan
             energy += weights[e, g] * density
         energies[e] = energy
 
@@ -357,35 +371,68 @@ def smallest_jacobian(jacobians):
     return worst, value
 
 
+#: Status codes of :func:`advance_steps`.
+DONE = 0
+INVERTED = 1
+REBUILD_CONTACTS = 2
+
+
 @kernel
-def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradients, gradients, weights,
-                  model, mu, lam, kappa, eta, element_forces, jacobians, node_offsets,
-                  node_slots, masses, external_forces, gravity, mass_damping, constrained,
-                  prescribed_velocities, time_step, nodal_forces):
-    """Up to ``n_steps`` central-difference steps without returning to Python. Stops before the
-    update of a step in which an element has J <= 0 (or a non-finite J) and returns
-    (steps done, that element or -1, its J)."""
+def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradients, gradients,
+                  weights, materials, element_material, element_forces, jacobians, node_offsets,
+                  node_slots, masses, external_forces, contact_forces, gravity, mass_damping,
+                  constrained, prescribed_velocities, time_step, nodal_forces, contact):
+    """Up to ``n_steps`` central-difference steps without returning to Python.
+
+    ``contact`` = (triangles, tets, wall depth per triangle, candidate (triangle, tet) pairs,
+    penalty, walls (n, 6: point, outward normal), positions when the pairs were listed, skin,
+    totals (n_walls + 1): the normal force of each wall and of the body pairs at the last step).
+    Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
+    which ``element`` has J <= 0 (or a non-finite J); REBUILD_CONTACTS before a step once a node has
+    moved half the skin since the pairs were listed."""
+    (triangles, contact_tets, wall_depths, pairs, penalty, walls, listed_positions, skin,
+     totals) = contact
     tet4 = elements.shape[1] == 4
+    has_contact = triangles.shape[0] > 0
+    half_skin_squared = 0.25 * skin * skin
     for step in range(n_steps):
+        if has_contact:
+            for n in range(positions.shape[0]):
+                moved = 0.0
+                for i in range(3):
+                    moved += (positions[n, i] - listed_positions[n, i]) ** 2
+                if moved > half_skin_squared:
+                    return step, REBUILD_CONTACTS, -1, 1.0
+            contact_forces[:] = 0.0
+            totals[:] = 0.0
+            weight, _ = contact_kernels.pair_forces(positions, triangles, contact_tets, pairs, penalty,
+                                                    contact_forces)
+            totals[walls.shape[0]] = weight
+            for w in range(walls.shape[0]):
+                force, _ = contact_kernels.wall_forces(positions, triangles, contact_tets,
+                                                       walls[w, 0:3], walls[w, 3:6], penalty,
+                                                       wall_depths, contact_forces)
+                totals[w] = force
         if not parallel:
             element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
-                                  weights, model, mu, lam, kappa, eta, element_forces, jacobians)
+                                  weights, materials, element_material, element_forces, jacobians)
         elif tet4:
             tet4_element_forces(positions, velocities, elements, tet4_gradients, weights[:, 0],
-                                model, mu, lam, kappa, eta, element_forces, jacobians)
+                                materials, element_material, element_forces, jacobians)
         else:
-            general_element_forces(positions, velocities, elements, gradients, weights, model,
-                                   mu, lam, kappa, eta, element_forces, jacobians)
+            general_element_forces(positions, velocities, elements, gradients, weights, materials,
+                                   element_material, element_forces, jacobians)
         worst, value = smallest_jacobian(jacobians)
         if not value > 0.0:
-            return step, worst, value
+            return step, INVERTED, worst, value
         if parallel:
             central_difference_update(positions, velocities, element_forces, node_offsets,
-                                      node_slots, masses, external_forces, gravity, mass_damping,
-                                      constrained, prescribed_velocities, time_step, nodal_forces)
+                                      node_slots, masses, external_forces, contact_forces,
+                                      gravity, mass_damping, constrained, prescribed_velocities,
+                                      time_step, nodal_forces)
         else:
             central_difference_update_serial(positions, velocities, element_forces, node_offsets,
-                                             node_slots, masses, external_forces, gravity,
-                                             mass_damping, constrained, prescribed_velocities,
-                                             time_step, nodal_forces)
-    return n_steps, -1, 1.0
+                                             node_slots, masses, external_forces, contact_forces,
+                                             gravity, mass_damping, constrained,
+                                             prescribed_velocities, time_step, nodal_forces)
+    return n_steps, DONE, -1, 1.0

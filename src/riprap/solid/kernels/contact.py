@@ -594,7 +594,7 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
                 n_in += 1
         if n_in == 0 or n_in == 4:
             continue
-        m = _plane_section(nodes, noff, tets, t, depths, n_b, polygon)
+        m = plane_section(nodes, noff, tets, t, depths, n_b, polygon)
         if m < 3:
             continue
         for i in range(6):
@@ -626,7 +626,7 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
 
 
 @kernel
-def _plane_section(nodes, noff, tets, t, depths, normal, polygon):
+def plane_section(nodes, noff, tets, t, depths, normal, polygon):
     """Polygon where the plane depth = 0 cuts tet t, counter-clockwise about ``normal``, with the
     barycentric coordinates of each vertex in columns 3-6. Returns the vertex count (3 or 4)."""
     m = 0
