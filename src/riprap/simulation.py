@@ -54,7 +54,7 @@ class RunSummary:
     steps: int
     wall_time: float
     frames: int
-    model: str = "rigid"         # "rigid", "fluid" or "coupled"
+    model: str = "rigid"         # "rigid", "fluid", "coupled" or "deformable"
     outputs: dict = field(default_factory=dict)
     case_file: str = ""          # the case file run (absolute), "" when built in Python
     smoke: bool = False          # RIPRAP_SMOKE=1 cut the run short: its figures are not results
@@ -79,6 +79,9 @@ class RunSummary:
     pressure_iterations_mean: float | None = None
     pressure_iterations_max: int | None = None
     pressure_time_share: float | None = None
+    # deformable bodies
+    element_steps_per_second: float | None = None
+    max_tensile_stress: float | None = None
 
     def as_dict(self) -> dict:
         return {key: value for key, value in self.__dict__.items() if value is not None}
@@ -170,6 +173,10 @@ class Simulation:
             self.add_fluid(fluid)
         # Pairs allowed to overlap at the start, up to a depth (m): a pack's resting contacts.
         self.accepted_overlaps: dict[tuple[int, int], float] = {}
+        #: Deformable bodies (:meth:`add_deformable_body`) and how they touch.
+        self.deformable_bodies = []
+        self.deformable_contact_penalty = None
+        self.deformable_mass_damping = 0.0
 
     # ------------------------------------------------------------------ building
     def add_material(self, material: Material) -> None:
@@ -203,6 +210,34 @@ class Simulation:
                                     position=position, orientation=orientation, velocity=velocity,
                                     angular_velocity=angular_velocity, fixed=fixed, frame=frame)
 
+    def add_deformable_body(self, *, shape: str, material, position,
+                            orientation=(1.0, 0.0, 0.0, 0.0), velocity=(0.0, 0.0, 0.0),
+                            angular_velocity=(0.0, 0.0, 0.0), element_type: str = "tet4",
+                            name: str | None = None) -> int:
+        """Add a deformable body (:class:`riprap.deformable.DeformableBody`) of a shape's mesh:
+        ``material`` an :class:`riprap.deformable.ElasticMaterial`, ``position`` its centroid
+        (m), ``orientation`` a quaternion (w, x, y, z) applied to the mesh as built, ``velocity``
+        and ``angular_velocity`` its initial rigid motion. Returns its index among the deformable
+        bodies."""
+        from scipy.spatial.transform import Rotation
+
+        from riprap.deformable.body import DeformableBody
+        from riprap.geometry.mass_properties import mass_properties
+
+        mesh = self._meshes[self._shape_index(shape)]
+        centroid = np.asarray(mass_properties(mesh).centroid, dtype=np.float64)
+        w, x, y, z = (float(v) for v in orientation)
+        rotation = Rotation.from_quat([x, y, z, w]).as_matrix()
+        nodes = (mesh.nodes - centroid) @ rotation.T + np.asarray(position, dtype=np.float64)
+        index = len(self.deformable_bodies)
+        body = DeformableBody(nodes, mesh.tets, material, element_type=element_type,
+                              name=name or f"{shape}_{index}")
+        offsets = body.positions - np.asarray(position, dtype=np.float64)
+        body.velocities[:] = np.asarray(velocity, dtype=np.float64) + np.cross(
+            np.asarray(angular_velocity, dtype=np.float64), offsets)
+        self.deformable_bodies.append(body)
+        return index
+
     def add_walls(self, walls: list[Wall], *, container_box=None) -> None:
         self.solver.add_walls(walls)
         if container_box is not None:
@@ -234,6 +269,8 @@ class Simulation:
         from riprap.models.fluid import CoupledModel, FluidModel
         from riprap.models.rigid import RigidModel
 
+        if self.deformable_bodies:
+            return self._deformable_model()
         if self.fluid is None:
             return RigidModel(self)
         if hasattr(self.fluid, "solids"):            # a CoupledSolver built by the caller
@@ -252,6 +289,26 @@ class Simulation:
         except OverlapError as error:
             raise name_obstacles_in_overlap(error, obstacle_bodies, boxes) from None
         return CoupledModel(CoupledSolver(self.fluid, self.solver, obstacle_bodies=obstacle_bodies))
+
+    def _deformable_model(self):
+        from riprap.deformable.system import DeformableSystem
+        from riprap.models.deformable import DeformableModel
+
+        if self.solver.n_bodies > 0:
+            raise CaseFileError(
+                f"{self.solver.n_bodies} rigid and {len(self.deformable_bodies)} deformable bodies: "
+                "runs that mix rigid and deformable bodies are not available yet; make every body "
+                "deformable or none")
+        if self.fluid is not None:
+            raise CaseFileError("deformable bodies in a fluid are not available yet")
+        walls = [(wall.point, wall.normal) for wall in self.solver.walls]
+        system = DeformableSystem(self.deformable_bodies, walls=walls,
+                                  contact_penalty=self.deformable_contact_penalty,
+                                  gravity=self.solver.gravity,
+                                  mass_damping=self.deformable_mass_damping)
+        if self.requested_time_step > 0:
+            system.time_step = self.requested_time_step
+        return DeformableModel(system)
 
     def prepare(self) -> None:
         """Build the model, choose time steps, evaluate initial forces and check the start state
@@ -599,6 +656,7 @@ class Simulation:
 
 # Checkpoint kinds a model restarts from: coupled runs were "fluid runs" before the one run loop.
 _ACCEPTED_KINDS = {"riprap rigid run": ("riprap rigid run",),
+                   "riprap deformable run": ("riprap deformable run",),
                    "riprap fluid run": ("riprap fluid run",),
                    "riprap coupled run": ("riprap coupled run", "riprap fluid run")}
 

@@ -142,10 +142,12 @@ class DeformableSystem:
         for body in self.bodies:
             body.stable_time_step()
             omega_elements = max(omega_elements, body._stiffest_frequency)
-        corners = self.positions[self.triangles]
+        # from the reference geometry, so that a run and its restart take the same step
+        reference = np.concatenate([b.elements.reference_nodes for b in self.bodies])
+        corners = reference[self.triangles]
         areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
                                               corners[:, 2] - corners[:, 0]), axis=1)
-        node_area = np.zeros(len(self.positions))
+        node_area = np.zeros(len(reference))
         np.add.at(node_area, self.triangles.ravel(), np.repeat(areas / 3.0, 3))
         heights = np.array([b._contact_height for b in self.bodies])
         node_body = np.repeat(np.arange(len(self.bodies)), np.diff(self.node_offsets))

@@ -1,0 +1,24 @@
+"""``units.csv`` of a deformable run: one row per body with the largest tensile principal stress
+of the run (Pa), the element and point where it was and when, and the ratio to the material's
+tensile strength where one is given (NaN otherwise)."""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+__all__ = ["UNIT_COLUMNS", "write_units_csv"]
+
+UNIT_COLUMNS = ("body", "name", "mass_kg", "elements", "element_type", "max_tensile_stress_Pa",
+                "max_tensile_element", "max_tensile_x_m", "max_tensile_y_m", "max_tensile_z_m",
+                "max_tensile_time_s", "tensile_strength_Pa", "stress_over_strength")
+
+
+def write_units_csv(path, rows) -> Path:
+    path = Path(path)
+    with open(path, "w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=UNIT_COLUMNS)
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({key: (f"{value:.6g}" if isinstance(value, float) else value)
+                             for key, value in row.items()})
+    return path

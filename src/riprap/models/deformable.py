@@ -1,0 +1,255 @@
+"""Deformable bodies in contact (the seed's Y3D-D) as a model of the run loop: a fixed
+central-difference step counted in steps, frames with the stresses inside every body, and per
+body the largest tensile principal stress of the run and where it was."""
+from __future__ import annotations
+
+import math
+import time as wallclock
+
+import numpy as np
+
+from riprap.deformable.kernels import contact as contact_kernels
+from riprap.deformable.stresses import principal_stresses, von_mises
+from riprap.errors import OverlapError, RiprapError
+from riprap.models.base import Model
+
+__all__ = ["DeformableModel", "UnitStressRecord"]
+
+# Wall-clock seconds between progress updates and stress records.
+_PROGRESS_PERIOD = 0.25
+# Bodies may touch but not overlap at the start: a contact force above this fraction of the
+# weight of the lighter body (or, without gravity, any contact force) is an overlap.
+_START_OVERLAP_WEIGHT_FRACTION = 1e-6
+
+
+class UnitStressRecord:
+    """Per body, the largest tensile principal stress seen at the records so far (Pa), with the
+    element, its centroid and the time."""
+
+    def __init__(self, n_bodies: int):
+        self.stress = np.full(n_bodies, -np.inf)
+        self.element = np.full(n_bodies, -1, dtype=np.int64)
+        self.point = np.zeros((n_bodies, 3))
+        self.time = np.zeros(n_bodies)
+
+    def update(self, body_index: int, sigma_1: np.ndarray, centroids: np.ndarray, time: float) -> None:
+        worst = int(np.argmax(sigma_1))
+        if sigma_1[worst] > self.stress[body_index]:
+            self.stress[body_index] = sigma_1[worst]
+            self.element[body_index] = worst
+            self.point[body_index] = centroids[worst]
+            self.time[body_index] = time
+
+
+class DeformableModel(Model):
+    """The deformable bodies of a :class:`riprap.simulation.Simulation`, joined in a
+    :class:`riprap.deformable.system.DeformableSystem`."""
+
+    kind = "riprap deformable run"
+    name = "deformable"
+
+    def __init__(self, system, *, body_names=None):
+        self.system = system
+        self.body_names = list(body_names or [b.name for b in system.bodies])
+        self._chunk = 10
+        self._series = None
+        self._directory = None
+        self.records = UnitStressRecord(len(system.bodies))
+
+    # ------------------------------------------------------------------ clock
+    @property
+    def time(self) -> float:
+        return self.system.time
+
+    @property
+    def step_count(self) -> int:
+        return self.system.step_count
+
+    def _steps_at(self, time: float) -> int:
+        return int(math.ceil(time / self.system.time_step - 1e-9))
+
+    def reached(self, time: float) -> bool:
+        return self.system.step_count >= self._steps_at(time)
+
+    def last_time_step(self) -> float:
+        return self.system.time_step
+
+    def prepare(self, *, restarted: bool) -> None:
+        self.system.time_step       # chosen now, from the stiffest element and contact
+        if not restarted:
+            self.check_start_overlaps()
+        self._record_stresses()
+
+    def check_start_overlaps(self) -> None:
+        """Refuse bodies that overlap each other or a wall at the start, naming them."""
+        s = self.system
+        s._list_pairs()
+        forces = np.zeros_like(s.positions)
+        weight_scale = np.linalg.norm(s.gravity) * min(b.mass for b in s.bodies)
+        tolerance = _START_OVERLAP_WEIGHT_FRACTION * weight_scale
+        for q in range(len(s._pairs)):
+            forces[:] = 0.0
+            pair = s._pairs[q:q + 1]
+            weight, _ = contact_kernels.pair_forces(s.positions, s.triangles, s.contact_tets, pair,
+                                                    s.contact_penalty, forces)
+            if weight > tolerance:
+                a = s.bodies[int(s.triangle_body[pair[0, 0]])].name
+                b = s.bodies[int(s.tet_body[pair[0, 1]])].name
+                raise OverlapError(
+                    f"deformable bodies '{a}' and '{b}' overlap at the start (contact force "
+                    f"{weight:.3g} N); move them apart so that they at most touch")
+        for w in range(len(s.walls)):
+            for k, body in enumerate(s.bodies):
+                on_body = s.triangle_body == k
+                forces[:] = 0.0
+                total, _ = contact_kernels.wall_forces(
+                    s.positions, s.triangles[on_body], s.contact_tets[s.tet_body == k],
+                    s.walls[w, :3], s.walls[w, 3:], s.contact_penalty, s.wall_depths[on_body], forces)
+                if total > tolerance:
+                    raise OverlapError(
+                        f"deformable body '{body.name}' starts inside wall {w} (point "
+                        f"{s.walls[w, :3].tolist()}, normal {s.walls[w, 3:].tolist()}): move it "
+                        "out so that it at most touches")
+
+    def advance(self, until: float) -> None:
+        n = min(self._steps_at(until) - self.system.step_count, self._chunk)
+        tick = wallclock.perf_counter()
+        self.system.step(n)
+        elapsed = wallclock.perf_counter() - tick
+        self._chunk = max(1, min(1_000_000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
+        self._record_stresses()
+
+    def _record_stresses(self) -> None:
+        for k, body in enumerate(self.system.bodies):
+            sigma_1 = principal_stresses(body.cauchy_stresses())[:, 0]
+            centroids = body.positions[body.elements.corner_tets].mean(axis=1)
+            self.records.update(k, sigma_1, centroids, self.system.time)
+
+    # ------------------------------------------------------------------ state
+    def state_arrays(self) -> dict:
+        s = self.system
+        return {"clock": np.array([s.time, float(s.step_count), s.time_step]),
+                "positions": s.positions.copy(), "velocities": s.velocities.copy(),
+                "contact_pairs": s._pairs.copy(), "listed_positions": s._listed_positions.copy(),
+                "record_stress": self.records.stress.copy(),
+                "record_element": self.records.element.copy(),
+                "record_point": self.records.point.copy(), "record_time": self.records.time.copy()}
+
+    def load_state_arrays(self, arrays: dict) -> None:
+        s = self.system
+        s.time = float(arrays["clock"][0])
+        s.step_count = int(arrays["clock"][1])
+        s.positions[:] = arrays["positions"]
+        s.velocities[:] = arrays["velocities"]
+        s._pairs = np.array(arrays["contact_pairs"], dtype=np.int64).reshape(-1, 2)
+        s._listed_positions[:] = arrays["listed_positions"]
+        for body in s.bodies:
+            body.time = s.time
+            body.step_count = s.step_count
+        self.records.stress[:] = arrays["record_stress"]
+        self.records.element[:] = arrays["record_element"]
+        self.records.point[:] = arrays["record_point"]
+        self.records.time[:] = arrays["record_time"]
+
+    def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
+        arrays = dict(state)
+        arrays["reference_nodes"] = np.concatenate([b.elements.reference_nodes for b in self.system.bodies])
+        return arrays, {"bodies": self.body_names}
+
+    def check_checkpoint(self, path, arrays: dict, metadata: dict) -> None:
+        problems = []
+        if metadata.get("bodies") != self.body_names:
+            problems.append(f"its bodies {metadata.get('bodies')} differ from the case's {self.body_names}")
+        else:
+            reference = np.concatenate([b.elements.reference_nodes for b in self.system.bodies])
+            if not np.array_equal(arrays["reference_nodes"], reference):
+                problems.append("the bodies were meshed differently")
+        if problems:
+            raise RiprapError(f"{path}: cannot restart this case from that checkpoint: "
+                              + "; ".join(problems))
+
+    def restore(self, arrays: dict) -> None:
+        self.load_state_arrays(arrays)
+
+    # ------------------------------------------------------------------ outputs
+    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
+        from riprap.io import vtk
+
+        self._directory = directory
+        if paraview:
+            self._series = vtk.ParaViewSeries(directory, "bodies", append=append)
+
+    def frame_fields(self) -> dict:
+        """Points, corner tets and the per-element stress fields of all bodies (ParaView names)."""
+        s = self.system
+        stresses = np.concatenate([b.cauchy_stresses() for b in s.bodies])
+        principal = principal_stresses(stresses)
+        corner_tets = np.concatenate([b.elements.corner_tets + s.node_offsets[k]
+                                      for k, b in enumerate(s.bodies)])
+        reference = np.concatenate([b.elements.reference_nodes for b in s.bodies])
+        body_of_element = np.repeat(np.arange(len(s.bodies)), [b.n_elements for b in s.bodies])
+        cell_data = {
+            "body": body_of_element,
+            "sigma_1": principal[:, 0], "sigma_2": principal[:, 1], "sigma_3": principal[:, 2],
+            "differential_stress": principal[:, 0] - principal[:, 2],
+            "von_mises": von_mises(stresses),
+            "jacobian": s.jacobians.copy(),
+        }
+        for name, (i, j) in {"sigma_xx": (0, 0), "sigma_yy": (1, 1), "sigma_zz": (2, 2),
+                             "sigma_xy": (0, 1), "sigma_yz": (1, 2), "sigma_zx": (2, 0)}.items():
+            cell_data[name] = stresses[:, i, j]
+        point_data = {"velocity": s.velocities.copy(), "displacement": s.positions - reference,
+                      "contact_force": s.contact_forces.copy()}
+        return {"points": s.positions.copy(), "cells": corner_tets, "cell_data": cell_data,
+                "point_data": point_data}
+
+    def write_frame(self, frame_index: int) -> None:
+        if self._series is not None:
+            fields = self.frame_fields()
+            self._series.add(self.time, points=fields["points"], cells=fields["cells"],
+                             cell_data=fields["cell_data"], point_data=fields["point_data"])
+
+    def unit_rows(self) -> list[dict]:
+        """One row per body for ``units.csv``."""
+        rows = []
+        for k, body in enumerate(self.system.bodies):
+            strength = body.material.tensile_strength
+            point = self.records.point[k]
+            rows.append({
+                "body": k, "name": self.body_names[k], "mass_kg": body.mass,
+                "elements": body.n_elements, "element_type": body.element_type,
+                "max_tensile_stress_Pa": self.records.stress[k],
+                "max_tensile_element": int(self.records.element[k]),
+                "max_tensile_x_m": point[0], "max_tensile_y_m": point[1], "max_tensile_z_m": point[2],
+                "max_tensile_time_s": self.records.time[k],
+                "tensile_strength_Pa": strength if strength is not None else float("nan"),
+                "stress_over_strength": (self.records.stress[k] / strength
+                                         if strength is not None else float("nan")),
+            })
+        return rows
+
+    def close_outputs(self) -> dict:
+        from riprap.io.deformable_outputs import write_units_csv
+
+        outputs = {"units": str(write_units_csv(self._directory / "units.csv", self.unit_rows()))}
+        if self._series is not None:
+            outputs["paraview"] = str(self._series.pvd_path)
+        return outputs
+
+    def progress_text(self) -> str:
+        s = self.system
+        speed = float(np.linalg.norm(s.velocities, axis=1).max(initial=0.0))
+        return (f"largest sigma1 {self.records.stress.max() / 1e6:.3g} MPa  fastest node "
+                f"{speed:.3g} m/s  dt {s.time_step:.2e} s")
+
+    def summary_fields(self, wall_time: float, steps: int) -> dict:
+        s = self.system
+        return {"time_step": s.time_step, "bodies": len(s.bodies),
+                "element_steps_per_second": steps * len(s.elements) / max(wall_time, 1e-9),
+                "kinetic_energy": s.kinetic_energy(),
+                "max_speed": float(np.linalg.norm(s.velocities, axis=1).max(initial=0.0)),
+                "max_tensile_stress": float(self.records.stress.max())}
+
+    def failure_advice(self, good: dict) -> str:
+        return ("An element inverted: the time step may be too long for the contact penalty, or "
+                "the loads too large for the mesh; see units.csv and the last frames.")

@@ -1,0 +1,113 @@
+"""Deformable bodies in the one run loop: outputs (ParaView stresses, units.csv, summary), restart
+bit for bit, and the errors a user meets (overlap at the start, mixed rigid and deformable
+bodies, bad material keys, a step above the stable one, an element that inverts)."""
+import csv
+
+import numpy as np
+import pytest
+
+import riprap as rr
+from riprap.errors import CaseFileError, InstabilityError, MeshError, OverlapError
+from riprap.geometry import shapes
+from riprap.io.vtk import ParaViewSeries
+from riprap.solid import walls
+
+CONCRETE_LIKE = dict(young_modulus=5e7, density=2400.0, poisson_ratio=0.2, tensile_strength=3e6)
+
+
+def _two_cubes(out, end_time, *, drop_position=(0.05, 0.0, 0.35), checkpoint_interval=0.0):
+    sim = rr.Simulation(end_time=end_time, output_interval=0.01, output_directory=out,
+                        progress=False, picture=False, checkpoint_interval=checkpoint_interval)
+    sim.add_shape("cube", shapes.cube(side=0.2, mesh_size=0.07))
+    sim.add_material(rr.Material(name="concrete"))
+    sim.add_walls(walls.plane(point=(0, 0, 0), normal=(0, 0, 1), material="concrete"))
+    material = rr.ElasticMaterial(**CONCRETE_LIKE)
+    sim.add_deformable_body(shape="cube", material=material, position=(0.0, 0.0, 0.1005), name="lower")
+    sim.add_deformable_body(shape="cube", material=material, position=drop_position,
+                            velocity=(0.0, 0.0, -1.0), angular_velocity=(0.0, 2.0, 0.0), name="upper")
+    return sim
+
+
+def test_run_writes_stresses_units_and_summary(tmp_path):
+    summary = _two_cubes(tmp_path, 0.06).run()
+    assert summary.model == "deformable" and summary.end_reason == "end_time"
+    assert summary.max_tensile_stress > 0.0 and summary.element_steps_per_second > 0.0
+    with open(tmp_path / "units.csv") as stream:
+        rows = list(csv.DictReader(stream))
+    assert [row["name"] for row in rows] == ["lower", "upper"]
+    for row in rows:
+        assert float(row["max_tensile_stress_Pa"]) > 0.0
+        assert float(row["stress_over_strength"]) == pytest.approx(
+            float(row["max_tensile_stress_Pa"]) / 3e6, rel=1e-5)
+    import meshio
+
+    frame = meshio.read(tmp_path / ParaViewSeries(tmp_path, "bodies", append=True).frames[-1][1])
+    for name in ("sigma_1", "sigma_3", "differential_stress", "von_mises", "body"):
+        assert name in frame.cell_data
+    sigma_1 = frame.cell_data["sigma_1"][0]
+    sigma_3 = frame.cell_data["sigma_3"][0]
+    assert np.all(sigma_1 >= sigma_3)
+    assert np.allclose(frame.cell_data["differential_stress"][0], sigma_1 - sigma_3)
+
+
+def test_restart_continues_bit_for_bit(tmp_path):
+    whole = _two_cubes(tmp_path / "whole", 0.05)
+    whole.run()
+    first = _two_cubes(tmp_path / "part", 0.025)
+    first.run()
+    second = _two_cubes(tmp_path / "part", 0.05)
+    second.run(restart_from=tmp_path / "part" / "checkpoint.npz")
+    a, b = whole.model.state_arrays(), second.model.state_arrays()
+    assert a["clock"][1] == b["clock"][1]
+    assert np.array_equal(a["positions"], b["positions"])
+    assert np.array_equal(a["velocities"], b["velocities"])
+
+
+def test_overlapping_bodies_are_named(tmp_path):
+    sim = _two_cubes(tmp_path, 0.01, drop_position=(0.05, 0.0, 0.25))
+    with pytest.raises(OverlapError, match="'lower' and 'upper'|'upper' and 'lower'"):
+        sim.run()
+
+
+def test_mixed_rigid_and_deformable_is_refused_clearly(tmp_path):
+    sim = _two_cubes(tmp_path, 0.01)
+    sim.add_body(shape="cube", material="concrete", position=(1.0, 0.0, 0.1005))
+    with pytest.raises(CaseFileError, match="mix rigid and deformable"):
+        sim.run()
+
+
+@pytest.mark.parametrize("key, value", [("young_modulus", 0.0), ("young_modulus", -1.0),
+                                        ("poisson_ratio", 0.5), ("poisson_ratio", -1.0),
+                                        ("viscosity", -0.1), ("density", 0.0)])
+def test_bad_material_values_name_the_key(key, value):
+    with pytest.raises(CaseFileError, match=key):
+        rr.ElasticMaterial(**{**CONCRETE_LIKE, key: value})
+
+
+def test_step_above_the_stable_step_is_refused():
+    nodes, tets = rr.deformable.box_mesh((0.1, 0.1, 0.1), (2, 2, 2))
+    body = rr.DeformableBody(nodes, tets, rr.ElasticMaterial(**CONCRETE_LIKE))
+    with pytest.raises(CaseFileError, match="above the stable step"):
+        body.time_step = 1.01 * body.stable_time_step()
+
+
+def test_inverted_reference_element_is_named():
+    nodes = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
+    # element 1 is listed with two nodes swapped: negative volume
+    with pytest.raises(MeshError, match="'bad': element\\(s\\) 1 "):
+        rr.DeformableBody(nodes, [[0, 1, 2, 3], [1, 3, 2, 4]], rr.ElasticMaterial(**CONCRETE_LIKE),
+                          name="bad")
+
+
+def test_element_inverting_in_a_run_stops_with_a_failure_checkpoint(tmp_path):
+    sim = rr.Simulation(end_time=0.05, output_interval=0.01, output_directory=tmp_path,
+                        progress=False, picture=False)
+    sim.add_shape("cube", shapes.cube(side=0.2, mesh_size=0.1))
+    sim.add_material(rr.Material(name="concrete"))
+    sim.add_walls(walls.plane(point=(0, 0, 0), normal=(0, 0, 1), material="concrete"))
+    # a very soft body thrown at the floor far faster than its wave speed (3 m/s): it inverts
+    sim.add_deformable_body(shape="cube", material=rr.ElasticMaterial(young_modulus=1e4, density=1000.0),
+                            position=(0.0, 0.0, 0.1005), velocity=(0.0, 0.0, -200.0), name="jelly")
+    with pytest.raises(InstabilityError, match="'jelly': element [0-9]+ inverted"):
+        sim.run()
+    assert (tmp_path / "failure_checkpoint.npz").is_file()
