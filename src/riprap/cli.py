@@ -55,7 +55,12 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
               f"s, {summary.cell_updates_per_second:,.0f} cell-updates/s; water volume error "
               f"{summary.water_volume_error:.1e}, pressure iterations "
               f"{summary.pressure_iterations_mean:.1f} (max {summary.pressure_iterations_max})")
-    if summary.bodies is not None:
+    if summary.element_steps_per_second is not None:
+        print(f"riprap: deformable bodies: {summary.bodies}, steps of {summary.time_step:.3e} s "
+              f"({summary.element_steps_per_second:,.0f} element-steps/s), largest tensile "
+              f"principal stress {summary.max_tensile_stress / 1e6:.3g} MPa (units.csv), fastest "
+              f"node {summary.max_speed:.3g} m/s")
+    elif summary.bodies is not None:
         steps = (f"steps of {summary.time_step:.3e} s" if summary.time_step is not None
                  else f"{summary.solid_substeps} contact sub-steps")
         print(f"riprap: bodies: {steps} ({summary.body_steps_per_second:,.0f} body-steps/s); "

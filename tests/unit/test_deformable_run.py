@@ -111,3 +111,75 @@ def test_element_inverting_in_a_run_stops_with_a_failure_checkpoint(tmp_path):
     with pytest.raises(InstabilityError, match="'jelly': element [0-9]+ inverted"):
         sim.run()
     assert (tmp_path / "failure_checkpoint.npz").is_file()
+
+
+CASE = """
+format_version = 1
+[simulation]
+end_time = 0.004
+[[materials]]
+name = "concrete"
+density = 2400.0
+[[shapes]]
+name = "cube"
+type = "cube"
+side = 0.2
+mesh_size = 0.1
+[[bodies]]
+shape = "cube"
+material = "concrete"
+position = [0.0, 0.0, 0.1005]
+[[bodies]]
+shape = "cube"
+material = "concrete"
+position = [0.0, 0.0, 0.35]
+velocity = [0.0, 0.0, -1.0]
+[[walls]]
+type = "plane"
+material = "concrete"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[deformable]
+{deformable}
+[output]
+paraview = false
+picture = false
+"""
+
+
+def _case(tmp_path, deformable):
+    path = tmp_path / "case.toml"
+    path.write_text(CASE.replace("{deformable}", deformable))
+    return path
+
+
+def test_case_file_runs_deformable_bodies(tmp_path):
+    from riprap.case.build import build_simulation
+    from riprap.case.load import load_case
+
+    case = load_case(_case(tmp_path, 'bodies = "all"\nyoung_modulus = 5e7\ntensile_strength = 3e6'))
+    assert case.deformable.young_modulus == 5e7 and case.deformable.bodies == "all"
+    sim = build_simulation(case, output_directory=tmp_path / "out", progress=False)
+    assert len(sim.deformable_bodies) == 2 and sim.solver.n_bodies == 0
+    assert sim.deformable_bodies[0].material.density == 2400.0
+    summary = sim.run()
+    assert summary.model == "deformable" and (tmp_path / "out" / "units.csv").is_file()
+
+
+@pytest.mark.parametrize("text, message", [
+    ("bodies = [0, 5]", "bodies lists \\[5\\], but the case makes 2 bodies"),
+    ("bodies = [0]", "mix rigid and deformable"),
+    ("poisson_ratio = 0.5", "poisson_ratio"),
+    ("young_modulus = -1.0", "young_modulus"),
+    ("bodies = [0, 0]", "bodies"),
+    ('element_type = "tet10"', "contact of tet10 bodies is not available yet"),
+    ('constitutive_model = "mooney"', "constitutive_model"),
+])
+def test_case_file_errors_name_the_key(tmp_path, text, message):
+    from riprap.case.build import build_simulation
+    from riprap.case.load import load_case
+    from riprap.errors import RiprapError
+
+    with pytest.raises(RiprapError, match=message):
+        case = load_case(_case(tmp_path, text))
+        build_simulation(case, output_directory=tmp_path / "out", progress=False).run()

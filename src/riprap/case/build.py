@@ -12,6 +12,7 @@ from scipy.spatial.transform import Rotation
 
 from riprap.errors import RiprapError
 from riprap.geometry import shapes as builtin_shapes
+from riprap.geometry.armour_units import armour_unit
 from riprap.geometry.tetmesh import TetMesh
 from riprap.simulation import Simulation
 from riprap.solid import walls as wall_builders
@@ -48,6 +49,8 @@ def build_shape(spec) -> TetMesh:
         "tetrapod": lambda: builtin_shapes.tetrapod(height=p["height"], mesh_size=mesh_size),
         "l_shape": lambda: builtin_shapes.l_shape(length=p["length"], width=p["width"],
                                                   thickness=p["thickness"], mesh_size=mesh_size),
+        "armour_unit": lambda: armour_unit(p["unit_kind"], height=p["unit_height"],
+                                           mesh_size=mesh_size).mesh,
     }
     return builders[spec.type]()
 
@@ -84,13 +87,15 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
             # The shape builders name the key and value; the case file names the entry.
             raise type(error)(f"{case.source}: [[shapes]] '{spec.name}': {error}") from None
         sim.add_shape(spec.name, mesh)
+    place = _BodyPlacer(sim, case)
     for body in case.bodies:
-        sim.add_body(shape=body.shape, material=body.material, position=body.position,
-                     orientation=body.orientation, velocity=body.velocity,
-                     angular_velocity=body.angular_velocity, fixed=body.fixed)
+        place(shape=body.shape, material=body.material, position=body.position,
+              orientation=body.orientation, velocity=body.velocity,
+              angular_velocity=body.angular_velocity, fixed=body.fixed)
     rng = np.random.default_rng(settings.seed)
     for grid in case.body_grids:
-        add_body_grid(sim, grid, rng)
+        add_body_grid(sim, grid, rng, place=place)
+    place.check_selection()
     add_case_walls(sim, case)
     if settings.contact_history:
         from riprap.io.contact_history import read_contact_history
@@ -115,8 +120,63 @@ def add_case_walls(sim: Simulation, case) -> None:
                           container_box=(tuple(lo), tuple(hi)))
 
 
-def add_body_grid(sim: Simulation, grid, rng: np.random.Generator) -> None:
+class _BodyPlacer:
+    """Adds the case's bodies in order, as rigid bodies or, where ``[deformable]`` selects them,
+    as deformable ones (their ElasticMaterial from ``[deformable]`` and their material's
+    density)."""
+
+    def __init__(self, sim: Simulation, case):
+        self.sim = sim
+        self.case = case
+        self.spec = case.deformable
+        self.count = 0
+        self._materials = {}
+        if self.spec is not None:
+            sim.deformable_contact_penalty = self.spec.contact_penalty or None
+            sim.deformable_mass_damping = self.spec.mass_damping
+
+    def _elastic_material(self, name: str):
+        from riprap.deformable import ElasticMaterial
+
+        if name not in self._materials:
+            spec = self.spec
+            density = next(m.density for m in self.case.materials if m.name == name)
+            self._materials[name] = ElasticMaterial(
+                name=name, density=density, young_modulus=spec.young_modulus,
+                poisson_ratio=spec.poisson_ratio, viscosity=spec.viscosity,
+                constitutive_model=spec.constitutive_model,
+                tensile_strength=spec.tensile_strength or None)
+        return self._materials[name]
+
+    def __call__(self, *, shape, material, position, orientation=(1.0, 0.0, 0.0, 0.0),
+                 velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0), fixed=False) -> None:
+        index = self.count
+        self.count += 1
+        if self.spec is not None and self.spec.selects(index):
+            if fixed:
+                raise RiprapError(f"{self.case.source}: [deformable] bodies selects body {index}, "
+                                  "which is fixed; a fixed body cannot deform")
+            self.sim.add_deformable_body(
+                shape=shape, material=self._elastic_material(material), position=position,
+                orientation=orientation, velocity=velocity, angular_velocity=angular_velocity,
+                element_type=self.spec.element_type, name=f"body_{index}")
+        else:
+            self.sim.add_body(shape=shape, material=material, position=position,
+                              orientation=orientation, velocity=velocity,
+                              angular_velocity=angular_velocity, fixed=fixed)
+
+    def check_selection(self) -> None:
+        spec = self.spec
+        if spec is not None and spec.bodies != "all":
+            missing = [i for i in spec.bodies if i >= self.count]
+            if missing:
+                raise RiprapError(f"{self.case.source}: [deformable] bodies lists {missing}, but the "
+                                  f"case makes {self.count} bodies (numbered 0 to {self.count - 1})")
+
+
+def add_body_grid(sim: Simulation, grid, rng: np.random.Generator, place=None) -> None:
     """Bodies on a rectangular grid, with random or identity orientations and optional jitter."""
+    place = place or sim.add_body
     nx, ny, nz = grid.counts
     k = 0
     for iz in range(nz):
@@ -134,6 +194,6 @@ def add_body_grid(sim: Simulation, grid, rng: np.random.Generator) -> None:
                     orientation = (w, x, y, z)
                 else:
                     orientation = (1.0, 0.0, 0.0, 0.0)
-                sim.add_body(shape=shape, material=grid.material, position=position,
-                             orientation=orientation, velocity=grid.velocity)
+                place(shape=shape, material=grid.material, position=position,
+                      orientation=orientation, velocity=grid.velocity)
                 k += 1

@@ -222,6 +222,24 @@ class FluidSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class DeformableSpec:
+    """``[deformable]``: see ``docs/case-file.md``."""
+
+    bodies: object = _default("deformable", "bodies")        # "all" or a tuple of indices
+    young_modulus: float = _default("deformable", "young_modulus")
+    poisson_ratio: float = _default("deformable", "poisson_ratio")
+    viscosity: float = _default("deformable", "viscosity")
+    constitutive_model: str = _default("deformable", "constitutive_model")
+    element_type: str = _default("deformable", "element_type")
+    tensile_strength: float = _default("deformable", "tensile_strength")
+    contact_penalty: float = _default("deformable", "contact_penalty")
+    mass_damping: float = _default("deformable", "mass_damping")
+
+    def selects(self, index: int) -> bool:
+        return self.bodies == "all" or index in self.bodies
+
+
+@dataclass(frozen=True, kw_only=True)
 class RegionSpec:
     """One ``[[water_regions]]`` or ``[[obstacles]]`` entry; ``parameters`` holds its type's keys."""
 
@@ -267,6 +285,7 @@ class Case:
     armour: ArmourSpec | None = None
     placement: PlacementSpec | None = None
     fluid: FluidSpec | None = None
+    deformable: DeformableSpec | None = None
     water_regions: tuple[RegionSpec, ...] = ()
     obstacles: tuple[RegionSpec, ...] = ()
 
@@ -684,6 +703,19 @@ class _Validator:
             if not isinstance(value, str):
                 return _INVALID, _type_name(value)
             return (value, "") if value.strip() else (_INVALID, "an empty string")
+        if kind == "body_selection":
+            if value == "all":
+                return "all", ""
+            if not isinstance(value, list):
+                return _INVALID, _type_name(value)
+            if not value:
+                return _INVALID, "an empty list"
+            for number, item in enumerate(value):
+                if isinstance(item, bool) or not isinstance(item, int) or item < 0:
+                    return _INVALID, f"{item!r} at item {number}"
+            if len(set(value)) != len(value):
+                return _INVALID, "a body listed twice"
+            return tuple(value), ""
         if kind == "string_list":
             if not isinstance(value, list):
                 return _INVALID, _type_name(value)
@@ -988,6 +1020,7 @@ class _Validator:
             armour=_optional(ArmourSpec, tables["armour"]),
             placement=_optional(PlacementSpec, tables["placement"]),
             fluid=_optional(FluidSpec, tables["fluid"]),
+            deformable=_optional(DeformableSpec, tables["deformable"]),
             water_regions=tuple(_with_parameters(RegionSpec, "water_regions", values)
                                 for values in tables["water_regions"]),
             obstacles=tuple(_with_parameters(RegionSpec, "obstacles", values)

@@ -73,6 +73,8 @@ KINDS = {
     ),
     "direction": "3 numbers [x, y, z], not all zero (normalised on load)",
     "string_list": "a non-empty list of strings",
+    "body_selection": '"all", or a non-empty list of body indices (integers from 0, in the order '
+                      'the case creates its bodies)',
     "path": "a file path (string)",
 }
 
@@ -211,7 +213,8 @@ _POSITIVE = Range(minimum=0.0, minimum_inclusive=False)
 _NON_NEGATIVE = Range(minimum=0.0)
 _FRACTION = Range(minimum=0.0, maximum=1.0, minimum_inclusive=False)
 _ZERO = (0.0, 0.0, 0.0)
-_SHAPE_TYPES = ("sphere", "box", "cube", "random_rock", "tetrapod", "l_shape", "mesh_file")
+_SHAPE_TYPES = ("sphere", "box", "cube", "random_rock", "tetrapod", "l_shape", "armour_unit",
+                "mesh_file")
 _WALL_TYPES = ("plane", "box")
 #: Armour unit kinds of :mod:`riprap.geometry.armour_units` (a test keeps the two lists equal).
 UNIT_KINDS = ("core_loc_like", "accropode_like", "xbloc_like", "tetrapod", "cube", "antifer_cube")
@@ -247,6 +250,10 @@ TABLES: tuple[Table, ...] = (
           "Fixed solid boxes in the fluid (every cell whose centre is inside; `[fluid]` cases). "
           "With bodies, each box is also a fixed body of the same cells, so that bodies meet it "
           "(contact, with the first material); a body may not start inside one."),
+    Table("deformable", False, 0, None,
+          "Deformable bodies (`riprap run`): which bodies deform, their elastic material (the "
+          "density is their `[[materials]]` entry's), elements and contact. Explicit finite-strain "
+          "tetrahedra (docs/deformable.md); stresses in every frame and units.csv."),
     Table("output", False, 1, None, "Where and what riprap writes."),
 )
 
@@ -331,6 +338,10 @@ KEYS: tuple[Key, ...] = (
         default=24, valid_range=Range(minimum=8), variant="random_rock"),
     Key("shapes", "height", "number", "m", "Overall height of the tetrapod.",
         valid_range=_POSITIVE, variant="tetrapod"),
+    Key("shapes", "unit_kind", "string", "-", "Which armour unit (the library of `[armour]`).",
+        choices=UNIT_KINDS, variant="armour_unit"),
+    Key("shapes", "unit_height", "number", "m", "Height H of the armour unit.",
+        valid_range=_POSITIVE, variant="armour_unit"),
     Key("shapes", "length", "number", "m", "Length of each leg of the L.",
         valid_range=_POSITIVE, variant="l_shape"),
     Key("shapes", "width", "number", "m", "Width of the L (extrusion depth).",
@@ -549,6 +560,33 @@ KEYS: tuple[Key, ...] = (
     Key("obstacles", "upper", "vector", "m", "Upper corner of the solid box.", variant="box",
         greater_than="lower"),
     # [output]
+    # [deformable]
+    Key("deformable", "bodies", "body_selection", "-", "Which bodies deform.", default="all"),
+    Key("deformable", "young_modulus", "number", "Pa", "Young's modulus E (concrete about 30e9).",
+        default=30.0e9, valid_range=_POSITIVE),
+    Key("deformable", "poisson_ratio", "number", "-", "Poisson's ratio (concrete about 0.2).",
+        default=0.2, valid_range=Range(minimum=-1.0, maximum=0.5, minimum_inclusive=False,
+                                       maximum_inclusive=False)),
+    Key("deformable", "viscosity", "number", "Pa s",
+        "eta of the viscous stress 2 eta D (damps the highest element frequencies first).",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("deformable", "constitutive_model", "string", "-",
+        "neo_hookean_seed: the seed paper's eq. 10; neo_hookean and neo_hookean_decoupled: "
+        "hyperelastic forms with a stored energy (docs/deformable.md).",
+        default="neo_hookean_seed",
+        choices=("neo_hookean_seed", "neo_hookean", "neo_hookean_decoupled")),
+    Key("deformable", "element_type", "string", "-",
+        "tet4: constant-strain tets (bodies in contact); tet10: quadratic tets, no locking in "
+        "bending, not yet in contact.", default="tet4", choices=("tet4", "tet10")),
+    Key("deformable", "tensile_strength", "number", "Pa",
+        "Tensile strength the largest principal stresses are compared with in units.csv; 0: none "
+        "given.", default=0.0, valid_range=_NON_NEGATIVE),
+    Key("deformable", "contact_penalty", "number", "Pa",
+        "Penalty of the potential contact between deformable bodies and walls; 0: Young's "
+        "modulus.", default=0.0, valid_range=_NON_NEGATIVE),
+    Key("deformable", "mass_damping", "number", "1/s",
+        "alpha of a force -alpha m v on every node: 0 for physics, a settling aid otherwise.",
+        default=0.0, valid_range=_NON_NEGATIVE),
     Key("output", "directory", "string", "-",
         "Output folder, relative to the current directory unless the command line overrides it.",
         default="riprap-out"),

@@ -145,6 +145,20 @@ def _strain_displacement(gradients: np.ndarray) -> np.ndarray:
     return matrix
 
 
+# Faces of a positively oriented tet (0, 1, 2, 3) ordered so that their normal points outward.
+_OUTWARD_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]], dtype=np.int64)
+
+
+def boundary_faces_with_owners(tets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(faces (n, 3) outward, owner tet of each): the faces used by exactly one tet."""
+    faces = tets[:, _OUTWARD_FACES].reshape(-1, 3)
+    owners = np.repeat(np.arange(len(tets)), 4)
+    keys = np.sort(faces, axis=1)
+    _, first, counts = np.unique(keys, axis=0, return_index=True, return_counts=True)
+    single = first[counts == 1]
+    return faces[single], owners[single]
+
+
 def check_reference_tets(nodes: np.ndarray, tets: np.ndarray, body: str) -> np.ndarray:
     """Signed volumes of the tets; raises MeshError naming the body and the first inverted or
     degenerate elements."""

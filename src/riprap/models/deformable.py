@@ -15,8 +15,11 @@ from riprap.models.base import Model
 
 __all__ = ["DeformableModel", "UnitStressRecord"]
 
-# Wall-clock seconds between progress updates and stress records.
+# Wall-clock seconds between progress updates.
 _PROGRESS_PERIOD = 0.25
+#: The largest tensile stress of each body is looked for every this many steps (a fixed count, so
+#: that units.csv does not depend on the machine's speed): an impact's peak lasts hundreds of steps.
+RECORD_EVERY_STEPS = 50
 # Bodies may touch but not overlap at the start: a contact force above this fraction of the
 # weight of the lighter body (or, without gravity, any contact force) is an overlap.
 _START_OVERLAP_WEIGHT_FRACTION = 1e-6
@@ -55,6 +58,11 @@ class DeformableModel(Model):
         self._series = None
         self._directory = None
         self.records = UnitStressRecord(len(system.bodies))
+        self._picture = False
+        # (time, positions, sigma_1 of every element) when the largest tensile stress of the run
+        # so far was found: the state the picture shows
+        self._peak = None
+        self._surfaces = None
 
     # ------------------------------------------------------------------ clock
     @property
@@ -112,18 +120,28 @@ class DeformableModel(Model):
                         "out so that it at most touches")
 
     def advance(self, until: float) -> None:
-        n = min(self._steps_at(until) - self.system.step_count, self._chunk)
+        system = self.system
+        n = min(self._steps_at(until) - system.step_count, self._chunk)
+        target = system.step_count + n
         tick = wallclock.perf_counter()
-        self.system.step(n)
+        while system.step_count < target:
+            next_record = (system.step_count // RECORD_EVERY_STEPS + 1) * RECORD_EVERY_STEPS
+            system.step(min(target, next_record) - system.step_count)
+            if system.step_count % RECORD_EVERY_STEPS == 0:
+                self._record_stresses()
         elapsed = wallclock.perf_counter() - tick
         self._chunk = max(1, min(1_000_000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
-        self._record_stresses()
 
     def _record_stresses(self) -> None:
+        before = self.records.stress.max()
+        all_sigma_1 = []
         for k, body in enumerate(self.system.bodies):
             sigma_1 = principal_stresses(body.cauchy_stresses())[:, 0]
             centroids = body.positions[body.elements.corner_tets].mean(axis=1)
             self.records.update(k, sigma_1, centroids, self.system.time)
+            all_sigma_1.append(sigma_1)
+        if self.records.stress.max() > before:
+            self._peak = (self.system.time, self.system.positions.copy(), np.concatenate(all_sigma_1))
 
     # ------------------------------------------------------------------ state
     def state_arrays(self) -> dict:
@@ -176,6 +194,7 @@ class DeformableModel(Model):
         from riprap.io import vtk
 
         self._directory = directory
+        self._picture = picture
         if paraview:
             self._series = vtk.ParaViewSeries(directory, "bodies", append=append)
 
@@ -234,7 +253,33 @@ class DeformableModel(Model):
         outputs = {"units": str(write_units_csv(self._directory / "units.csv", self.unit_rows()))}
         if self._series is not None:
             outputs["paraview"] = str(self._series.pvd_path)
+        if self._picture and self._peak is not None:
+            outputs["picture"] = str(self.write_peak_picture(self._directory / "peak_stress.png"))
         return outputs
+
+    def write_peak_picture(self, path):
+        """The bodies' surfaces coloured by the largest principal stress of the element under each
+        face, at the moment the largest tensile stress of the run was found."""
+        from riprap.deformable.elements import boundary_faces_with_owners
+        from riprap.io.picture import render_bodies_png
+
+        time, positions, sigma_1 = self._peak
+        s = self.system
+        triangles, values = [], []
+        for k, body in enumerate(s.bodies):
+            faces, owners = boundary_faces_with_owners(body.elements.corner_tets)
+            triangles.append(positions[faces + s.node_offsets[k]])
+            values.append(sigma_1[owners + s.element_offsets[k]])
+        triangles = np.concatenate(triangles)
+        values = np.concatenate(values) / 1e6
+        worst = int(np.argmax(self.records.stress))
+        reach = float(np.abs(values).max())
+        return render_bodies_png(
+            path, triangles_world=triangles, body_ids=np.arange(len(triangles)), values=values,
+            value_label="largest principal stress sigma_1 (MPa, tension +)", colour_map="coolwarm",
+            value_range=(-reach, reach),
+            title=(f"t = {time:.4g} s: largest tensile stress {self.records.stress[worst] / 1e6:.3g} "
+                   f"MPa in {self.body_names[worst]}"))
 
     def progress_text(self) -> str:
         s = self.system
