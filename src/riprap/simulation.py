@@ -177,6 +177,10 @@ class Simulation:
         self.deformable_bodies = []
         self.deformable_contact_penalty = None
         self.deformable_mass_damping = 0.0
+        # For runs built from a case: the case's number of each deformable and each rigid body,
+        # and the resting overlaps (m) of a pack's contacts that involve deformable bodies.
+        self.deformable_case_index: list[int] = []
+        self.deformable_accepted_depths: dict[tuple[int, int], float] = {}
 
     # ------------------------------------------------------------------ building
     def add_material(self, material: Material) -> None:
@@ -294,21 +298,45 @@ class Simulation:
         from riprap.deformable.system import DeformableSystem
         from riprap.models.deformable import DeformableModel
 
-        if self.solver.n_bodies > 0:
-            raise CaseFileError(
-                f"{self.solver.n_bodies} rigid and {len(self.deformable_bodies)} deformable bodies: "
-                "runs that mix rigid and deformable bodies are not available yet; make every body "
-                "deformable or none")
         if self.fluid is not None:
             raise CaseFileError("deformable bodies in a fluid are not available yet")
-        walls = [(wall.point, wall.normal) for wall in self.solver.walls]
+        solver = self.solver
+        rigid_surfaces = []
+        if solver.n_bodies > 0:
+            # rigid bodies too: they keep their own solver, stepped with the deformable bodies'
+            # step, and meet the deformable bodies through their surface layers
+            self.build_without_checks()
+            for b in range(solver.n_bodies):
+                shape = solver.shapes[int(solver.shape_index[b])]
+                material = solver.materials[int(solver.material_index_of_body[b])]
+                mass = np.inf if solver.fixed[b] else float(solver.masses[b])
+                rigid_surfaces.append((shape.mesh.nodes, shape.mesh.tets,
+                                       material.friction_coefficient, mass,
+                                       material.damping_ratio))
+        walls = [(wall.point, wall.normal,
+                  solver.materials[solver.material_index(wall.material)].friction_coefficient)
+                 for wall in solver.walls]
         system = DeformableSystem(self.deformable_bodies, walls=walls,
                                   contact_penalty=self.deformable_contact_penalty,
-                                  gravity=self.solver.gravity,
-                                  mass_damping=self.deformable_mass_damping)
-        if self.requested_time_step > 0:
-            system.time_step = self.requested_time_step
-        return DeformableModel(system)
+                                  gravity=solver.gravity,
+                                  mass_damping=self.deformable_mass_damping,
+                                  rigid_surfaces=rigid_surfaces)
+        step = self.requested_time_step if self.requested_time_step > 0 else system.time_step
+        if solver.n_bodies > 0:
+            step = min(step, solver.time_step)
+            solver.set_time_step(step)
+        system.time_step = step
+        return DeformableModel(system, rigid=self if solver.n_bodies > 0 else None,
+                               case_numbers=self._case_numbers(),
+                               accepted_depths=self.deformable_accepted_depths)
+
+    def _case_numbers(self):
+        """(case number of each deformable body, of each rigid body): their own orders when the
+        run was built in Python."""
+        deformable = list(self.deformable_case_index) or list(range(len(self.deformable_bodies)))
+        taken = set(deformable)
+        rigid = [i for i in range(len(deformable) + self.solver.n_bodies) if i not in taken]
+        return deformable, rigid
 
     def prepare(self) -> None:
         """Build the model, choose time steps, evaluate initial forces and check the start state

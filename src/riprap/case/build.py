@@ -100,9 +100,9 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
     if settings.contact_history:
         from riprap.io.contact_history import read_contact_history
 
-        sim.set_contact_history(read_contact_history(
-            settings.contact_history, n_bodies=sim.solver.n_bodies,
-            n_walls=len(sim.solver.walls)))
+        history = read_contact_history(settings.contact_history, n_bodies=place.count,
+                                       n_walls=len(sim.solver.walls))
+        sim.set_contact_history(place.split_history(history))
     return sim
 
 
@@ -130,6 +130,7 @@ class _BodyPlacer:
         self.case = case
         self.spec = case.deformable
         self.count = 0
+        self.rigid_case_index = []
         self._materials = {}
         if self.spec is not None:
             sim.deformable_contact_penalty = self.spec.contact_penalty or None
@@ -140,9 +141,11 @@ class _BodyPlacer:
 
         if name not in self._materials:
             spec = self.spec
-            density = next(m.density for m in self.case.materials if m.name == name)
+            source = next(m for m in self.case.materials if m.name == name)
             self._materials[name] = ElasticMaterial(
-                name=name, density=density, young_modulus=spec.young_modulus,
+                name=name, density=source.density, friction_coefficient=source.friction_coefficient,
+                restitution=source.restitution,
+                young_modulus=spec.young_modulus,
                 poisson_ratio=spec.poisson_ratio, viscosity=spec.viscosity,
                 constitutive_model=spec.constitutive_model,
                 tensile_strength=spec.tensile_strength or None)
@@ -160,10 +163,37 @@ class _BodyPlacer:
                 shape=shape, material=self._elastic_material(material), position=position,
                 orientation=orientation, velocity=velocity, angular_velocity=angular_velocity,
                 element_type=self.spec.element_type, name=f"body_{index}")
+            self.sim.deformable_case_index.append(index)
         else:
+            self.rigid_case_index.append(index)
             self.sim.add_body(shape=shape, material=material, position=position,
                               orientation=orientation, velocity=velocity,
                               angular_velocity=angular_velocity, fixed=fixed)
+
+    def split_history(self, history):
+        """The contact history of the rigid bodies, renumbered as the rigid solver numbers them;
+        the resting overlaps of the deformable bodies' contacts go to
+        ``sim.deformable_accepted_depths`` (keyed by case body numbers, walls -1 - w)."""
+        from riprap.io.contact_history import ContactHistory
+
+        if not self.sim.deformable_bodies:
+            return history
+        rigid = np.full(self.count, -1, dtype=np.int64)
+        rigid[self.rigid_case_index] = np.arange(len(self.rigid_case_index))
+
+        def solver_index(i):
+            return i if i < 0 else rigid[i]
+
+        keep = []
+        for row, (i, j) in enumerate(zip(history.body_i, history.body_j)):
+            if solver_index(i) >= 0 and (j < 0 or solver_index(j) >= 0):
+                keep.append(row)
+            else:
+                self.sim.deformable_accepted_depths[(int(i), int(j))] = float(history.overlap_depths[row])
+        keep = np.asarray(keep, dtype=np.int64)
+        return ContactHistory([solver_index(i) for i in history.body_i[keep]],
+                              [solver_index(j) for j in history.body_j[keep]],
+                              history.springs[keep], history.overlap_depths[keep])
 
     def check_selection(self) -> None:
         spec = self.spec

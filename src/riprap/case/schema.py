@@ -251,9 +251,10 @@ TABLES: tuple[Table, ...] = (
           "With bodies, each box is also a fixed body of the same cells, so that bodies meet it "
           "(contact, with the first material); a body may not start inside one."),
     Table("deformable", False, 0, None,
-          "Deformable bodies (`riprap run`): which bodies deform, their elastic material (the "
-          "density is their `[[materials]]` entry's), elements and contact. Explicit finite-strain "
-          "tetrahedra (docs/deformable.md); stresses in every frame and units.csv."),
+          "Deformable bodies (`riprap run`): which bodies deform, their elastic material (density, "
+          "friction coefficient and restitution are their `[[materials]]` entry's), elements and "
+          "contact. The other bodies stay rigid. Explicit finite-strain tetrahedra "
+          "(docs/deformable.md); stresses in every frame and units.csv."),
     Table("output", False, 1, None, "Where and what riprap writes."),
 )
 

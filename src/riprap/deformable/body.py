@@ -23,9 +23,11 @@ from riprap.errors import CaseFileError, InstabilityError
 TIME_STEP_SAFETY = 0.9
 
 # The contact arguments of a run without contact (see finite_strain.advance_steps).
-NO_CONTACT = (np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int64), np.zeros(0),
-              np.zeros((0, 2), dtype=np.int64), 0.0, np.zeros((0, 6)), np.zeros((0, 3)), 1.0,
-              np.zeros(1))
+NO_CONTACT = (np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int64),
+              np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int64), np.zeros(0),
+              np.zeros((0, 2), dtype=np.int64), 0.0, np.zeros((0, 7)), np.zeros((0, 3)), 1.0,
+              np.zeros(1), np.zeros(0), np.zeros(0), 0.0, np.zeros(0), np.zeros((0, 3)),
+              np.zeros((0, 0, 3)), np.zeros((0, 0, 3)), np.zeros(0), np.zeros(0))
 NO_TET4_GRADIENTS = np.zeros((0, 4, 3))
 
 # Bodies with fewer integration points than this step on one thread: starting the threads of a

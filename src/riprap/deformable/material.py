@@ -52,6 +52,11 @@ class ElasticMaterial:
     tensile_strength : float or None
         Tensile strength of the material (Pa), only compared with the largest principal stress in
         reports; None when not given.
+    friction_coefficient : float
+        Coulomb friction coefficient (-) of its contacts; a pair takes the smaller of its two.
+    restitution : float
+        Normal coefficient of restitution of its contacts (-), in (0, 1]: sets the damping ratio
+        of their normal dashpot as for rigid bodies; a pair takes the smaller damping.
     """
 
     name: str = "concrete"
@@ -61,9 +66,13 @@ class ElasticMaterial:
     viscosity: float = 0.0
     constitutive_model: str = "neo_hookean_seed"
     tensile_strength: float | None = None
+    friction_coefficient: float = 0.6
+    restitution: float = 0.5
 
     def __post_init__(self):
         checks = [
+            ("restitution", 0 < self.restitution <= 1, "in (0, 1]"),
+            ("friction_coefficient", self.friction_coefficient >= 0, ">= 0"),
             ("density", self.density > 0, "> 0 kg/m^3"),
             ("young_modulus", self.young_modulus > 0, "> 0 Pa"),
             ("poisson_ratio", -1.0 < self.poisson_ratio < 0.5, "in (-1, 0.5)"),
@@ -80,6 +89,13 @@ class ElasticMaterial:
         if self.tensile_strength is not None and not self.tensile_strength > 0:
             raise CaseFileError(
                 f"material '{self.name}': tensile_strength = {self.tensile_strength!r} must be > 0 Pa")
+
+    @property
+    def contact_damping_ratio(self) -> float:
+        """Damping ratio of the normal contact dashpot that gives ``restitution``."""
+        from riprap.solid.materials import damping_ratio_for_restitution
+
+        return damping_ratio_for_restitution(self.restitution)
 
     @property
     def model_code(self) -> int:

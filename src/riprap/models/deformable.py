@@ -20,9 +20,9 @@ _PROGRESS_PERIOD = 0.25
 #: The largest tensile stress of each body is looked for every this many steps (a fixed count, so
 #: that units.csv does not depend on the machine's speed): an impact's peak lasts hundreds of steps.
 RECORD_EVERY_STEPS = 50
-# Bodies may touch but not overlap at the start: a contact force above this fraction of the
-# weight of the lighter body (or, without gravity, any contact force) is an overlap.
-_START_OVERLAP_WEIGHT_FRACTION = 1e-6
+# Bodies may touch but not overlap at the start: a mean overlap above this fraction of the
+# smallest boundary sub-tet height is refused (the rigid bodies' rule).
+_START_OVERLAP_FRACTION = 0.01
 
 
 class UnitStressRecord:
@@ -46,14 +46,24 @@ class UnitStressRecord:
 
 class DeformableModel(Model):
     """The deformable bodies of a :class:`riprap.simulation.Simulation`, joined in a
-    :class:`riprap.deformable.system.DeformableSystem`."""
+    :class:`riprap.deformable.system.DeformableSystem`; with ``rigid`` (the simulation, when it
+    has rigid bodies too) its rigid solver is stepped with the same step, the rigid bodies' poses
+    placed in the system before every step and the contact forces on them handed back as
+    external loads."""
 
     kind = "riprap deformable run"
     name = "deformable"
 
-    def __init__(self, system, *, body_names=None):
+    def __init__(self, system, *, rigid=None, body_names=None, case_numbers=None,
+                 accepted_depths=None):
         self.system = system
+        self.rigid = rigid
+        n_rigid = rigid.solver.n_bodies if rigid is not None else 0
+        self.case_numbers = case_numbers or (list(range(len(system.bodies))),
+                                             list(range(len(system.bodies), len(system.bodies) + n_rigid)))
+        self.accepted_depths = dict(accepted_depths or {})
         self.body_names = list(body_names or [b.name for b in system.bodies])
+        self._rigid_series = self._rigid_contact_series = None
         self._chunk = 10
         self._series = None
         self._directory = None
@@ -84,40 +94,102 @@ class DeformableModel(Model):
 
     def prepare(self, *, restarted: bool) -> None:
         self.system.time_step       # chosen now, from the stiffest element and contact
+        if self.rigid is not None:
+            self._place_rigid()
+            if not restarted:
+                self.rigid.check_start_overlaps()
         if not restarted:
             self.check_start_overlaps()
         self._record_stresses()
 
+    def _place_rigid(self, everything: bool = True) -> None:
+        solver = self.rigid.solver
+        self.system.set_rigid_poses(solver.rotation_matrices(), solver.positions,
+                                    solver.velocities, solver.angular_velocities,
+                                    moving=None if everything else ~solver.fixed)
+
+    def _step(self, n: int) -> None:
+        """n steps of the deformable bodies (and of the rigid ones, step by step, if any)."""
+        if self.rigid is None:
+            self.system.step(n)
+            return
+        solver = self.rigid.solver
+        for _ in range(n):
+            self._place_rigid(everything=False)
+            self.system.step(1)
+            forces, torques = self.system.rigid_loads(solver.positions)
+            solver.external_loads[:, :3] = forces
+            solver.external_loads[:, 3:] = torques
+            solver.advance(1)
+
     def check_start_overlaps(self) -> None:
-        """Refuse bodies that overlap each other or a wall at the start, naming them."""
+        """Refuse bodies that overlap each other or a wall at the start, naming them.
+
+        The mean overlap depth of each touching pair is estimated from its contact force: the
+        potential rises by one over the depth h of a boundary sub-tet, so depth = h F / (p A).
+        Allowed: _START_OVERLAP_FRACTION of the smallest h, or 1.5 times the resting overlap a
+        pack's contact history recorded for the pair."""
         s = self.system
         s._list_pairs()
         forces = np.zeros_like(s.positions)
-        weight_scale = np.linalg.norm(s.gravity) * min(b.mass for b in s.bodies)
-        tolerance = _START_OVERLAP_WEIGHT_FRACTION * weight_scale
+        allowed = _START_OVERLAP_FRACTION * float(s.potential_heights.min())
+        no_friction = np.zeros(max(len(s.triangles), len(s.contact_tets)))
+        touching = {}
         for q in range(len(s._pairs)):
-            forces[:] = 0.0
             pair = s._pairs[q:q + 1]
-            weight, _ = contact_kernels.pair_forces(s.positions, s.triangles, s.contact_tets, pair,
-                                                    s.contact_penalty, forces)
-            if weight > tolerance:
-                a = s.bodies[int(s.triangle_body[pair[0, 0]])].name
-                b = s.bodies[int(s.tet_body[pair[0, 1]])].name
+            weight, area = contact_kernels.pair_forces(s.positions, s.triangles, s.contact_tets, pair,
+                                                       s.contact_penalty, forces, s.velocities,
+                                                       s.masses, no_friction, no_friction,
+                                                       no_friction, no_friction, no_friction, 1.0,
+                                                       np.zeros((1, 3)))
+            if weight > 0.0 and area > 0.0:
+                a, b = int(s.triangle_body[pair[0, 0]]), int(s.tet_body[pair[0, 1]])
+                depth_weight = s.potential_heights[b] * weight / s.contact_penalty
+                key = (min(a, b), max(a, b))
+                total = touching.setdefault(key, [0.0, 0.0])
+                total[0] += depth_weight
+                total[1] += area
+        for (a, b), (depth_weight, area) in sorted(touching.items()):
+            depth = depth_weight / area
+            if depth > max(allowed, 1.5 * self._accepted_depth(a, b)):
                 raise OverlapError(
-                    f"deformable bodies '{a}' and '{b}' overlap at the start (contact force "
-                    f"{weight:.3g} N); move them apart so that they at most touch")
+                    f"bodies '{self._body_name(a)}' and '{self._body_name(b)}' overlap at the start "
+                    f"by about {depth:.3g} m (allowed {allowed:.3g} m); move them apart so that "
+                    "they at most touch")
         for w in range(len(s.walls)):
             for k, body in enumerate(s.bodies):
                 on_body = s.triangle_body == k
-                forces[:] = 0.0
-                total, _ = contact_kernels.wall_forces(
+                total, area = contact_kernels.wall_forces(
                     s.positions, s.triangles[on_body], s.contact_tets[s.tet_body == k],
-                    s.walls[w, :3], s.walls[w, 3:], s.contact_penalty, s.wall_depths[on_body], forces)
-                if total > tolerance:
+                    s.walls[w, :3], s.walls[w, 3:6], s.contact_penalty, s.wall_depths[on_body], forces,
+                    s.velocities, s.masses, no_friction, no_friction, 0.0, no_friction, no_friction,
+                    0.0, no_friction, 1.0, np.zeros((len(s.triangles), 3)),
+                    np.zeros((len(s.contact_tets), 3)))
+                if total <= 0.0 or area <= 0.0:
+                    continue
+                depth = s.potential_heights[k] * total / (s.contact_penalty * area)
+                if depth > max(allowed, 1.5 * self._accepted_depth(k, -1 - w)):
                     raise OverlapError(
-                        f"deformable body '{body.name}' starts inside wall {w} (point "
-                        f"{s.walls[w, :3].tolist()}, normal {s.walls[w, 3:].tolist()}): move it "
+                        f"deformable body '{body.name}' starts {depth:.3g} m inside wall {w} (point "
+                        f"{s.walls[w, :3].tolist()}, normal {s.walls[w, 3:6].tolist()}): move it "
                         "out so that it at most touches")
+
+    def _case_number(self, index: int) -> int:
+        """The case's number of a system body (walls stay -1 - w)."""
+        if index < 0:
+            return index
+        deformable, rigid = self.case_numbers
+        n = len(self.system.bodies)
+        return deformable[index] if index < n else rigid[index - n]
+
+    def _accepted_depth(self, a: int, b: int) -> float:
+        i, j = self._case_number(a), self._case_number(b)
+        return max(self.accepted_depths.get((i, j), 0.0), self.accepted_depths.get((j, i), 0.0))
+
+    def _body_name(self, index: int) -> str:
+        if index < len(self.system.bodies):
+            return self.system.bodies[index].name
+        return f"rigid body {self._case_number(index)}"
 
     def advance(self, until: float) -> None:
         system = self.system
@@ -126,7 +198,7 @@ class DeformableModel(Model):
         tick = wallclock.perf_counter()
         while system.step_count < target:
             next_record = (system.step_count // RECORD_EVERY_STEPS + 1) * RECORD_EVERY_STEPS
-            system.step(min(target, next_record) - system.step_count)
+            self._step(min(target, next_record) - system.step_count)
             if system.step_count % RECORD_EVERY_STEPS == 0:
                 self._record_stresses()
         elapsed = wallclock.perf_counter() - tick
@@ -149,9 +221,14 @@ class DeformableModel(Model):
         return {"clock": np.array([s.time, float(s.step_count), s.time_step]),
                 "positions": s.positions.copy(), "velocities": s.velocities.copy(),
                 "contact_pairs": s._pairs.copy(), "listed_positions": s._listed_positions.copy(),
+                "pair_springs": s.pair_springs.copy(),
+                "wall_triangle_springs": s.wall_triangle_springs.copy(),
+                "wall_tet_springs": s.wall_tet_springs.copy(),
                 "record_stress": self.records.stress.copy(),
                 "record_element": self.records.element.copy(),
-                "record_point": self.records.point.copy(), "record_time": self.records.time.copy()}
+                "record_point": self.records.point.copy(), "record_time": self.records.time.copy(),
+                **({f"rigid_{key}": value for key, value in self.rigid.solver.state_arrays().items()}
+                   if self.rigid is not None else {})}
 
     def load_state_arrays(self, arrays: dict) -> None:
         s = self.system
@@ -161,6 +238,9 @@ class DeformableModel(Model):
         s.velocities[:] = arrays["velocities"]
         s._pairs = np.array(arrays["contact_pairs"], dtype=np.int64).reshape(-1, 2)
         s._listed_positions[:] = arrays["listed_positions"]
+        s.pair_springs = np.array(arrays["pair_springs"], dtype=np.float64).reshape(-1, 3)
+        s.wall_triangle_springs[:] = arrays["wall_triangle_springs"]
+        s.wall_tet_springs[:] = arrays["wall_tet_springs"]
         for body in s.bodies:
             body.time = s.time
             body.step_count = s.step_count
@@ -168,14 +248,24 @@ class DeformableModel(Model):
         self.records.element[:] = arrays["record_element"]
         self.records.point[:] = arrays["record_point"]
         self.records.time[:] = arrays["record_time"]
+        if self.rigid is not None:
+            solver = self.rigid.solver
+            solver.load_state_arrays(
+                {key[len("rigid_"):]: value for key, value in arrays.items() if key.startswith("rigid_")})
+            solver._contacts = None
+            self._place_rigid()
 
     def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
         arrays = dict(state)
         arrays["reference_nodes"] = np.concatenate([b.elements.reference_nodes for b in self.system.bodies])
-        return arrays, {"bodies": self.body_names}
+        rigid = self.rigid.solver.n_bodies if self.rigid is not None else 0
+        return arrays, {"bodies": self.body_names, "rigid_bodies": rigid}
 
     def check_checkpoint(self, path, arrays: dict, metadata: dict) -> None:
         problems = []
+        rigid = self.rigid.solver.n_bodies if self.rigid is not None else 0
+        if metadata.get("rigid_bodies", 0) != rigid:
+            problems.append(f"it has {metadata.get('rigid_bodies', 0)} rigid bodies, the case {rigid}")
         if metadata.get("bodies") != self.body_names:
             problems.append(f"its bodies {metadata.get('bodies')} differ from the case's {self.body_names}")
         else:
@@ -197,6 +287,10 @@ class DeformableModel(Model):
         self._picture = picture
         if paraview:
             self._series = vtk.ParaViewSeries(directory, "bodies", append=append)
+            if self.rigid is not None:
+                self._rigid_series = vtk.ParaViewSeries(directory, "rigid_bodies", append=append)
+                self._rigid_contact_series = vtk.ParaViewSeries(directory, "rigid_contacts",
+                                                                append=append)
 
     def frame_fields(self) -> dict:
         """Points, corner tets and the per-element stress fields of all bodies (ParaView names)."""
@@ -205,7 +299,8 @@ class DeformableModel(Model):
         principal = principal_stresses(stresses)
         corner_tets = np.concatenate([b.elements.corner_tets + s.node_offsets[k]
                                       for k, b in enumerate(s.bodies)])
-        reference = np.concatenate([b.elements.reference_nodes for b in s.bodies])
+        reference = np.concatenate([b.elements.reference_nodes for b in s.bodies]
+                                   + [s.positions[s.n_deformable_nodes:]])
         body_of_element = np.repeat(np.arange(len(s.bodies)), [b.n_elements for b in s.bodies])
         cell_data = {
             "body": body_of_element,
@@ -225,13 +320,18 @@ class DeformableModel(Model):
     def write_frame(self, frame_index: int) -> None:
         if self._series is not None:
             fields = self.frame_fields()
-            self._series.add(self.time, points=fields["points"], cells=fields["cells"],
-                             cell_data=fields["cell_data"], point_data=fields["point_data"])
+            n = self.system.n_deformable_nodes
+            self._series.add(self.time, points=fields["points"][:n], cells=fields["cells"],
+                             cell_data=fields["cell_data"],
+                             point_data={k: v[:n] for k, v in fields["point_data"].items()})
+        if self._rigid_series is not None:
+            self.rigid._write_frame(self._rigid_series, self._rigid_contact_series)
 
     def unit_rows(self) -> list[dict]:
         """One row per body for ``units.csv``."""
         rows = []
         for k, body in enumerate(self.system.bodies):
+            final = float(principal_stresses(body.cauchy_stresses())[:, 0].max())
             strength = body.material.tensile_strength
             point = self.records.point[k]
             rows.append({
@@ -241,6 +341,7 @@ class DeformableModel(Model):
                 "max_tensile_element": int(self.records.element[k]),
                 "max_tensile_x_m": point[0], "max_tensile_y_m": point[1], "max_tensile_z_m": point[2],
                 "max_tensile_time_s": self.records.time[k],
+                "final_max_tensile_stress_Pa": final,
                 "tensile_strength_Pa": strength if strength is not None else float("nan"),
                 "stress_over_strength": (self.records.stress[k] / strength
                                          if strength is not None else float("nan")),
@@ -253,6 +354,8 @@ class DeformableModel(Model):
         outputs = {"units": str(write_units_csv(self._directory / "units.csv", self.unit_rows()))}
         if self._series is not None:
             outputs["paraview"] = str(self._series.pvd_path)
+        if self._rigid_series is not None:
+            outputs["rigid_bodies"] = str(self._rigid_series.pvd_path)
         if self._picture and self._peak is not None:
             outputs["picture"] = str(self.write_peak_picture(self._directory / "peak_stress.png"))
         return outputs
@@ -289,7 +392,8 @@ class DeformableModel(Model):
 
     def summary_fields(self, wall_time: float, steps: int) -> dict:
         s = self.system
-        return {"time_step": s.time_step, "bodies": len(s.bodies),
+        rigid = self.rigid.solver.n_bodies if self.rigid is not None else 0
+        return {"time_step": s.time_step, "bodies": len(s.bodies) + rigid,
                 "element_steps_per_second": steps * len(s.elements) / max(wall_time, 1e-9),
                 "kinetic_energy": s.kinetic_energy(),
                 "max_speed": float(np.linalg.norm(s.velocities, axis=1).max(initial=0.0)),

@@ -92,23 +92,39 @@ def product_integrals(polygon, n_vertices, a_column, b_first, n_b, out):
 def barycentric_map(positions, tet, out):
     """Rows k = (a_k, b_k) with lambda_k(x) = a_k . x + b_k for the tet's current corners, (4, 4).
     Returns False for a flat tet."""
-    x0 = positions[tet[0]]
-    e = np.empty((3, 3))
-    for k in range(3):
-        for c in range(3):
-            e[c, k] = positions[tet[k + 1], c] - x0[c]
-    det = (e[0, 0] * (e[1, 1] * e[2, 2] - e[1, 2] * e[2, 1])
-           - e[0, 1] * (e[1, 0] * e[2, 2] - e[1, 2] * e[2, 0])
-           + e[0, 2] * (e[1, 0] * e[2, 1] - e[1, 1] * e[2, 0]))
+    n0 = tet[0]
+    x0 = positions[n0, 0]
+    y0 = positions[n0, 1]
+    z0 = positions[n0, 2]
+    # columns: edges from corner 0 to corners 1, 2, 3
+    a00 = positions[tet[1], 0] - x0
+    a10 = positions[tet[1], 1] - y0
+    a20 = positions[tet[1], 2] - z0
+    a01 = positions[tet[2], 0] - x0
+    a11 = positions[tet[2], 1] - y0
+    a21 = positions[tet[2], 2] - z0
+    a02 = positions[tet[3], 0] - x0
+    a12 = positions[tet[3], 1] - y0
+    a22 = positions[tet[3], 2] - z0
+    # cofactors c_ij of the edge matrix; its inverse is c^T / det
+    c00 = a11 * a22 - a12 * a21
+    c01 = a12 * a20 - a10 * a22
+    c02 = a10 * a21 - a11 * a20
+    det = a00 * c00 + a01 * c01 + a02 * c02
     if det == 0.0:
         return False
-    inv = np.linalg.inv(e)
-    for k in range(3):
-        b = 0.0
-        for c in range(3):
-            out[k + 1, c] = inv[k, c]
-            b -= inv[k, c] * x0[c]
-        out[k + 1, 3] = b
+    inv = 1.0 / det
+    out[1, 0] = c00 * inv
+    out[1, 1] = (a02 * a21 - a01 * a22) * inv
+    out[1, 2] = (a01 * a12 - a02 * a11) * inv
+    out[2, 0] = c01 * inv
+    out[2, 1] = (a00 * a22 - a02 * a20) * inv
+    out[2, 2] = (a02 * a10 - a00 * a12) * inv
+    out[3, 0] = c02 * inv
+    out[3, 1] = (a01 * a20 - a00 * a21) * inv
+    out[3, 2] = (a00 * a11 - a01 * a10) * inv
+    for k in range(1, 4):
+        out[k, 3] = -(out[k, 0] * x0 + out[k, 1] * y0 + out[k, 2] * z0)
     for c in range(4):
         out[0, c] = -(out[1, c] + out[2, c] + out[3, c])
     out[0, 3] += 1.0
@@ -149,11 +165,23 @@ def polygon_normal(polygon):
 
 
 @kernel
-def triangle_in_tet(positions, triangle, tet, lam_map, penalty, forces, scratch):
+def triangle_in_tet(positions, triangle, tet, lam_map, penalty, forces, scratch, velocities,
+                    masses, friction_coefficient, damping_ratio, tangential_stiffness, time_step,
+                    spring):
     """Forces of the potential of ``tet`` on the boundary ``triangle`` (outward, counter-clockwise)
     of another body: added to ``forces`` at the triangle's and the tet's nodes. Returns
     (force on the triangle's body along its... magnitude p int phi dS, contact area)."""
-    polygon, work, signed, integrals, piece = scratch
+    polygon, work, signed, integrals, piece, _ = scratch
+    # quick rejection: all three corners outside the same face of the tet
+    for k in range(4):
+        outside = 0
+        for v in range(3):
+            node = triangle[v]
+            if (lam_map[k, 0] * positions[node, 0] + lam_map[k, 1] * positions[node, 1]
+                    + lam_map[k, 2] * positions[node, 2] + lam_map[k, 3]) < 0.0:
+                outside += 1
+        if outside == 3:
+            return 0.0, 0.0
     # the triangle's plane normal (outward, unit) and its vertices with N_v and lambda_k
     for v in range(3):
         node = triangle[v]
@@ -181,8 +209,11 @@ def triangle_in_tet(positions, triangle, tet, lam_map, penalty, forces, scratch)
         for v in range(m):
             for c in range(N_COLUMNS):
                 polygon[v, c] = work[v, c]
-    weight = 0.0
     area = 0.0
+    # node weights of the normal force: [0:3] the triangle's nodes, [3:7] the tet's
+    node_force = scratch[5]
+    for i in range(7):
+        node_force[i] = 0.0
     for j in range(4):
         mj = smallest_region(polygon, m, j, _LAMBDA, N_COLUMNS, piece, work, signed)
         if mj < 3:
@@ -191,33 +222,129 @@ def triangle_in_tet(positions, triangle, tet, lam_map, penalty, forces, scratch)
             integrals[i] = 0.0
         area += product_integrals(piece, mj, _LAMBDA + j, _N, 3, integrals[0:3])
         product_integrals(piece, mj, _LAMBDA + j, _LAMBDA, 4, integrals[3:7])
-        scale = 4.0 * penalty
-        for v in range(3):
-            node = triangle[v]
-            f = scale * integrals[v]
-            forces[node, 0] -= f * nx
-            forces[node, 1] -= f * ny
-            forces[node, 2] -= f * nz
-            weight += f
-        for k in range(4):
-            node = tet[k]
-            f = scale * integrals[3 + k]
-            forces[node, 0] += f * nx
-            forces[node, 1] += f * ny
-            forces[node, 2] += f * nz
+        for i in range(7):
+            node_force[i] += 4.0 * penalty * integrals[i]
+    weight = node_force[0] + node_force[1] + node_force[2]
+    if weight <= 0.0:
+        return 0.0, area
+    for v in range(3):
+        node = triangle[v]
+        forces[node, 0] -= node_force[v] * nx
+        forces[node, 1] -= node_force[v] * ny
+        forces[node, 2] -= node_force[v] * nz
+    for k in range(4):
+        node = tet[k]
+        forces[node, 0] += node_force[3 + k] * nx
+        forces[node, 1] += node_force[3 + k] * ny
+        forces[node, 2] += node_force[3 + k] * nz
+    if friction_coefficient > 0.0 or damping_ratio > 0.0:
+        # tangential stiffness: a share of the normal one, p A / h with h the tet's potential depth
+        apply_friction(triangle, tet, node_force, weight, nx, ny, nz, velocities, masses,
+                       friction_coefficient, tangential_stiffness * area, damping_ratio, time_step,
+                       spring, forces)
     return weight, area
+
+
+@kernel
+def spring_friction(spring, tx, ty, tz, nx, ny, nz, stiffness, limit, time_step):
+    """Coulomb friction by an elastic tangential spring, as for rigid bodies: the spring (3,
+    updated in place) is turned into the present tangent plane, stretched by the relative
+    tangential velocity (tx, ty, tz) times the step, and cut back to ``limit`` / ``stiffness``
+    when it would pull harder than ``limit`` (sliding). Returns the force on the first side."""
+    length = np.sqrt(spring[0] ** 2 + spring[1] ** 2 + spring[2] ** 2)
+    along = spring[0] * nx + spring[1] * ny + spring[2] * nz
+    for c, n in ((0, nx), (1, ny), (2, nz)):
+        spring[c] -= along * n
+    turned = np.sqrt(spring[0] ** 2 + spring[1] ** 2 + spring[2] ** 2)
+    if turned > 0.0:
+        for c in range(3):
+            spring[c] *= length / turned
+    spring[0] += tx * time_step
+    spring[1] += ty * time_step
+    spring[2] += tz * time_step
+    pull = stiffness * np.sqrt(spring[0] ** 2 + spring[1] ** 2 + spring[2] ** 2)
+    if pull > limit:
+        for c in range(3):
+            spring[c] *= limit / pull
+    return -stiffness * spring[0], -stiffness * spring[1], -stiffness * spring[2]
+
+
+@kernel
+def reduced_mass(side_a, side_b):
+    if np.isinf(side_b):
+        return side_a
+    if np.isinf(side_a):
+        return side_b
+    return side_a * side_b / (side_a + side_b)
+
+
+@kernel
+def apply_friction(triangle, tet, node_force, weight, nx, ny, nz, velocities, masses,
+                   friction_coefficient, stiffness, damping_ratio, time_step, spring, forces):
+    """Friction and normal damping of one (triangle, tet) contact with normal force ``weight``
+    spread over its nodes as ``node_force``: a tangential spring of ``stiffness`` (N/m) between the
+    two sides at the force's centre (:func:`spring_friction`), and a dashpot on their normal
+    relative speed with ``damping_ratio`` of the contact's normal stiffness (taken as the tangential
+    one over 2/7) and their lumped masses, clipped so that the contact never pulls; spread with the
+    same weights, equal and opposite."""
+    rx = ry = rz = 0.0
+    side_a = side_b = 0.0
+    for v in range(3):
+        share = node_force[v] / weight
+        node = triangle[v]
+        rx += share * velocities[node, 0]
+        ry += share * velocities[node, 1]
+        rz += share * velocities[node, 2]
+        side_a += share * masses[node]
+    for k in range(4):
+        share = node_force[3 + k] / weight
+        node = tet[k]
+        rx -= share * velocities[node, 0]
+        ry -= share * velocities[node, 1]
+        rz -= share * velocities[node, 2]
+        side_b += share * masses[node]
+    normal = rx * nx + ry * ny + rz * nz
+    fx, fy, fz = spring_friction(spring, rx - normal * nx, ry - normal * ny, rz - normal * nz,
+                                 nx, ny, nz, stiffness, friction_coefficient * weight, time_step)
+    if damping_ratio > 0.0:
+        # n points out of the triangle's body: approaching sides have normal > 0
+        dashpot = -2.0 * damping_ratio * np.sqrt(3.5 * stiffness * reduced_mass(side_a, side_b)) * normal
+        # along n the contact pushes the triangle's side with -weight: the sum never pulls
+        dashpot = min(dashpot, weight)
+        # on the triangle's side the contact pushes along -n
+        fx += dashpot * nx
+        fy += dashpot * ny
+        fz += dashpot * nz
+    for v in range(3):
+        share = node_force[v] / weight
+        node = triangle[v]
+        forces[node, 0] += share * fx
+        forces[node, 1] += share * fy
+        forces[node, 2] += share * fz
+    for k in range(4):
+        share = node_force[3 + k] / weight
+        node = tet[k]
+        forces[node, 0] -= share * fx
+        forces[node, 1] -= share * fy
+        forces[node, 2] -= share * fz
 
 
 @kernel
 def make_scratch():
     return (np.empty((MAX_VERTICES, N_COLUMNS)), np.empty((MAX_VERTICES, N_COLUMNS)),
-            np.empty(MAX_VERTICES), np.zeros(7), np.empty((MAX_VERTICES, N_COLUMNS)))
+            np.empty(MAX_VERTICES), np.zeros(7), np.empty((MAX_VERTICES, N_COLUMNS)), np.zeros(7))
 
 
 @kernel
-def pair_forces(positions, triangles, tets, pairs, penalty, forces):
+def pair_forces(positions, triangles, tets, pairs, penalty, forces, velocities, masses,
+                triangle_friction, tet_friction, triangle_damping, tet_damping, tet_stiffness,
+                time_step, springs):
     """Forces of every candidate (boundary triangle, tet) pair, (n, 2) indices into ``triangles``
-    and ``tets``. Returns (total p int phi dS, contact area)."""
+    and ``tets``; the friction coefficient of a pair is the smaller of its triangle's and its
+    tet's, likewise its normal damping ratio; its tangential stiffness ``tet_stiffness[tet]`` (N/m
+    per m^2 of contact) times its
+    contact area, its spring ``springs[pair]`` (zeroed while the pair does not touch). Returns
+    (total p int phi dS, contact area)."""
     scratch = make_scratch()
     lam_map = np.empty((4, 4))
     weight = 0.0
@@ -231,8 +358,14 @@ def pair_forces(positions, triangles, tets, pairs, penalty, forces):
             last = t
         if not valid:
             continue
-        w, a = triangle_in_tet(positions, triangles[pairs[q, 0]], tets[t], lam_map, penalty, forces,
-                               scratch)
+        tri = pairs[q, 0]
+        w, a = triangle_in_tet(positions, triangles[tri], tets[t], lam_map, penalty, forces,
+                               scratch, velocities, masses,
+                               min(triangle_friction[tri], tet_friction[t]),
+                               min(triangle_damping[tri], tet_damping[t]), tet_stiffness[t],
+                               time_step, springs[q])
+        if w == 0.0:
+            springs[q, 0] = springs[q, 1] = springs[q, 2] = 0.0
         weight += w
         area += a
     return weight, area
@@ -240,11 +373,16 @@ def pair_forces(positions, triangles, tets, pairs, penalty, forces):
 
 @kernel
 def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wall_depths,
-                forces):
+                forces, velocities, masses, triangle_friction, tet_friction, wall_friction,
+                triangle_damping, tet_damping, tangential_ratio, tet_stiffness, time_step,
+                triangle_springs, tet_springs):
     """Forces of one half-space wall on boundary ``triangles`` and ``tets`` (only those near the
     surface need be listed), added to ``forces``; ``wall_depths[tri]`` is the depth over which the
-    wall's potential rises for that triangle's body. Returns (normal force, contact area)."""
-    polygon, work, signed, integrals, piece = make_scratch()
+    wall's potential rises for that triangle's body; friction as for body pairs, with the
+    coefficients given per triangle and per tet (the smaller of that and ``wall_friction`` acts),
+    tangential springs per triangle and per tet of ``tangential_ratio`` p A / h_w and
+    ``tet_stiffness`` A. Returns (normal force, contact area)."""
+    polygon, work, signed, integrals, piece, node_force = make_scratch()
     total = 0.0
     area = 0.0
     # (i) boundary triangles inside the wall: -p depth / h_w n_T, spread with N_v
@@ -263,6 +401,8 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
             if depth > 0.0:
                 inside += 1
         if inside == 0:
+            for c in range(3):
+                triangle_springs[tri, c] = 0.0
             continue
         nx, ny, nz, norm = polygon_normal(polygon)
         if norm == 0.0:
@@ -272,14 +412,24 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
             continue
         for i in range(3):
             integrals[i] = 0.0
-        area += 0.5 * product_integrals(work, m, 3, 4, 3, integrals[0:3])
+        piece_area = product_integrals(work, m, 3, 4, 3, integrals[0:3])
+        area += 0.5 * piece_area
+        cosine = -(nx * wall_normal[0] + ny * wall_normal[1] + nz * wall_normal[2]) / norm
+        pushed = 0.0
         for v in range(3):
             f = penalty / wall_depths[tri] * integrals[v] / norm
+            node_force[v] = f * norm
             node = triangles[tri, v]
             forces[node, 0] -= f * nx
             forces[node, 1] -= f * ny
             forces[node, 2] -= f * nz
-            total -= f * (nx * wall_normal[0] + ny * wall_normal[1] + nz * wall_normal[2])
+            pushed += f * norm * cosine
+        total += pushed
+        mu = min(triangle_friction[tri], wall_friction)
+        if (mu > 0.0 or triangle_damping[tri] > 0.0) and pushed > 0.0:
+            slide_on_wall(triangles[tri], 3, node_force, pushed, wall_normal, velocities, masses,
+                          mu, tangential_ratio * penalty * piece_area / wall_depths[tri],
+                          triangle_damping[tri], time_step, triangle_springs[tri], forces)
     # (ii) the wall plane inside the body's tets: p phi_t n, spread with lambda_k
     depths = np.empty(4)
     for t in range(tets.shape[0]):
@@ -292,33 +442,96 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
             depths[k] = depth
             if depth > 0.0:
                 inside += 1
+        if inside == 0:
+            for c in range(3):
+                tet_springs[t, c] = 0.0
         if inside == 0 or inside == 4:
             continue
         m = plane_section(positions, 0, tets, t, depths, wall_normal, polygon)
         if m < 3:
             continue
+        for k in range(4):
+            node_force[k] = 0.0
+        section_area = 0.0
         for j in range(4):
             mj = smallest_region(polygon, m, j, 3, 7, piece, work, signed)
             if mj < 3:
                 continue
             for i in range(4):
                 integrals[i] = 0.0
-            area += 0.5 * product_integrals(piece, mj, 3 + j, 3, 4, integrals[0:4])
+            section_area += product_integrals(piece, mj, 3 + j, 3, 4, integrals[0:4])
             for k in range(4):
-                f = 4.0 * penalty * integrals[k]
-                node = tets[t, k]
-                for c in range(3):
-                    forces[node, c] += f * wall_normal[c]
-                total += f
+                node_force[k] += 4.0 * penalty * integrals[k]
+        pushed = 0.0
+        for k in range(4):
+            node = tets[t, k]
+            for c in range(3):
+                forces[node, c] += node_force[k] * wall_normal[c]
+            pushed += node_force[k]
+        total += pushed
+        area += 0.5 * section_area
+        mu = min(tet_friction[t], wall_friction)
+        if (mu > 0.0 or tet_damping[t] > 0.0) and pushed > 0.0:
+            slide_on_wall(tets[t], 4, node_force, pushed, wall_normal, velocities, masses, mu,
+                          tet_stiffness[t] * section_area, tet_damping[t], time_step,
+                          tet_springs[t], forces)
     return total, area
 
 
 @kernel
-def candidate_pairs(positions, triangles, triangle_body, tets, tet_body, skin):
-    """(triangle, tet) pairs of different bodies whose boxes, grown by ``skin``, overlap: sorted by
-    tet. Sweep along x over the boxes of both sets."""
+def slide_on_wall(nodes, count, node_force, normal_force, wall_normal, velocities, masses,
+                  friction_coefficient, stiffness, damping_ratio, time_step, spring, forces):
+    """Friction and normal damping of ``count`` nodes pressed on a still wall with
+    ``normal_force`` spread as ``node_force``, as :func:`apply_friction` with a still, infinitely
+    heavy second side."""
+    total = 0.0
+    for i in range(count):
+        total += node_force[i]
+    if total <= 0.0:
+        return
+    vx = vy = vz = 0.0
+    mass = 0.0
+    for i in range(count):
+        share = node_force[i] / total
+        node = nodes[i]
+        vx += share * velocities[node, 0]
+        vy += share * velocities[node, 1]
+        vz += share * velocities[node, 2]
+        mass += share * masses[node]
+    normal = vx * wall_normal[0] + vy * wall_normal[1] + vz * wall_normal[2]
+    fx, fy, fz = spring_friction(spring, vx - normal * wall_normal[0], vy - normal * wall_normal[1],
+                                 vz - normal * wall_normal[2], wall_normal[0], wall_normal[1],
+                                 wall_normal[2], stiffness, friction_coefficient * normal_force,
+                                 time_step)
+    if damping_ratio > 0.0:
+        # the wall pushes along +n; moving into it (normal < 0) is resisted
+        dashpot = -2.0 * damping_ratio * np.sqrt(3.5 * stiffness * mass) * normal
+        dashpot = max(dashpot, -normal_force)
+        fx += dashpot * wall_normal[0]
+        fy += dashpot * wall_normal[1]
+        fz += dashpot * wall_normal[2]
+    for i in range(count):
+        share = node_force[i] / total
+        node = nodes[i]
+        forces[node, 0] += share * fx
+        forces[node, 1] += share * fy
+        forces[node, 2] += share * fz
+
+
+@kernel
+def candidate_pairs(positions, triangles, triangle_body, tets, tet_body, skin, first_rigid_body):
+    """(triangle, tet) pairs of different bodies, not both rigid (bodies from
+    ``first_rigid_body`` on), whose boxes, grown by ``skin``, overlap: sorted by tet. Sweep along x
+    over the boxes of both sets."""
     n_tri = triangles.shape[0]
     n_tet = tets.shape[0]
+    # a rigid body's triangle or tet can only meet a deformable body near that body's box
+    n_bodies = max(triangle_body.max(), tet_body.max()) + 1 if n_tri > 0 else 0
+    deformable_boxes = np.empty((min(first_rigid_body, n_bodies), 6))
+    for b in range(deformable_boxes.shape[0]):
+        for c in range(3):
+            deformable_boxes[b, c] = np.inf
+            deformable_boxes[b, 3 + c] = -np.inf
     boxes = np.empty((n_tri + n_tet, 6))
     for i in range(n_tri):
         for c in range(3):
@@ -335,11 +548,30 @@ def candidate_pairs(positions, triangles, triangle_body, tets, tet_body, skin):
                 hi = max(hi, positions[tets[t, k], c])
             boxes[n_tri + t, c] = lo
             boxes[n_tri + t, 3 + c] = hi
-    order = np.argsort(boxes[:, 0])
+    for i in range(n_tri):
+        b = triangle_body[i]
+        if b < first_rigid_body:
+            for c in range(3):
+                deformable_boxes[b, c] = min(deformable_boxes[b, c], boxes[i, c])
+                deformable_boxes[b, 3 + c] = max(deformable_boxes[b, 3 + c], boxes[i, 3 + c])
+    near = np.zeros(n_tri + n_tet, dtype=np.bool_)
+    for i in range(n_tri + n_tet):
+        body = triangle_body[i] if i < n_tri else tet_body[i - n_tri]
+        if body < first_rigid_body:
+            near[i] = True
+            continue
+        for b in range(deformable_boxes.shape[0]):
+            if (boxes[i, 0] <= deformable_boxes[b, 3] and boxes[i, 3] >= deformable_boxes[b, 0]
+                    and boxes[i, 1] <= deformable_boxes[b, 4] and boxes[i, 4] >= deformable_boxes[b, 1]
+                    and boxes[i, 2] <= deformable_boxes[b, 5] and boxes[i, 5] >= deformable_boxes[b, 2]):
+                near[i] = True
+                break
+    candidates = np.flatnonzero(near)
+    order = candidates[np.argsort(boxes[candidates, 0])]
     capacity = 1024
     pairs = np.empty((capacity, 2), dtype=np.int64)
     count = 0
-    active = np.empty(n_tri + n_tet, dtype=np.int64)
+    active = np.empty(len(order), dtype=np.int64)
     n_active = 0
     for idx in order:
         x_lo = boxes[idx, 0]
@@ -358,6 +590,8 @@ def candidate_pairs(positions, triangles, triangle_body, tets, tet_body, skin):
             tet = other - n_tri if idx < n_tri else idx - n_tri
             if triangle_body[tri] == tet_body[tet]:
                 continue
+            if triangle_body[tri] >= first_rigid_body and tet_body[tet] >= first_rigid_body:
+                continue
             if (boxes[idx, 1] > boxes[other, 4] or boxes[other, 1] > boxes[idx, 4]
                     or boxes[idx, 2] > boxes[other, 5] or boxes[other, 2] > boxes[idx, 5]):
                 continue
@@ -374,3 +608,70 @@ def candidate_pairs(positions, triangles, triangle_body, tets, tet_body, skin):
     result = pairs[:count]
     by_tet = np.argsort(result[:, 1], kind="mergesort")
     return result[by_tet].copy()
+
+
+@kernel
+def place_rigid_nodes(positions, velocities, prescribed_velocities, first_node, local, node_body,
+                      nodes, rotations, centres, body_velocities, angular_velocities):
+    """world = R local + centre and velocity v + omega x (world - centre) for the listed rigid
+    surface nodes (indices into ``local``; system node first_node + index)."""
+    for q in range(nodes.shape[0]):
+        n = nodes[q]
+        b = node_body[n]
+        r = rotations[b]
+        ox = r[0, 0] * local[n, 0] + r[0, 1] * local[n, 1] + r[0, 2] * local[n, 2]
+        oy = r[1, 0] * local[n, 0] + r[1, 1] * local[n, 1] + r[1, 2] * local[n, 2]
+        oz = r[2, 0] * local[n, 0] + r[2, 1] * local[n, 1] + r[2, 2] * local[n, 2]
+        w = angular_velocities[b]
+        target = first_node + n
+        positions[target, 0] = centres[b, 0] + ox
+        positions[target, 1] = centres[b, 1] + oy
+        positions[target, 2] = centres[b, 2] + oz
+        vx = body_velocities[b, 0] + w[1] * oz - w[2] * oy
+        vy = body_velocities[b, 1] + w[2] * ox - w[0] * oz
+        vz = body_velocities[b, 2] + w[0] * oy - w[1] * ox
+        prescribed_velocities[target, 0] = velocities[target, 0] = vx
+        prescribed_velocities[target, 1] = velocities[target, 1] = vy
+        prescribed_velocities[target, 2] = velocities[target, 2] = vz
+
+
+@kernel
+def rigid_node_loads(positions, contact_forces, first_node, node_body, centres, n_rigid):
+    """(force (n_rigid, 3), torque about the centres (n_rigid, 3)) of the contact forces on the
+    rigid surface nodes."""
+    forces = np.zeros((n_rigid, 3))
+    torques = np.zeros((n_rigid, 3))
+    for n in range(node_body.shape[0]):
+        b = node_body[n]
+        i = first_node + n
+        fx = contact_forces[i, 0]
+        fy = contact_forces[i, 1]
+        fz = contact_forces[i, 2]
+        if fx == 0.0 and fy == 0.0 and fz == 0.0:
+            continue
+        rx = positions[i, 0] - centres[b, 0]
+        ry = positions[i, 1] - centres[b, 1]
+        rz = positions[i, 2] - centres[b, 2]
+        forces[b, 0] += fx
+        forces[b, 1] += fy
+        forces[b, 2] += fz
+        torques[b, 0] += ry * fz - rz * fy
+        torques[b, 1] += rz * fx - rx * fz
+        torques[b, 2] += rx * fy - ry * fx
+    return forces, torques
+
+
+@kernel
+def carry_springs(old_pairs, old_springs, new_pairs, n_tets):
+    """Springs of the new pair list: each pair keeps its spring if it was listed before."""
+    keys = old_pairs[:, 0] * n_tets + old_pairs[:, 1]
+    order = np.argsort(keys)
+    sorted_keys = keys[order]
+    springs = np.zeros((new_pairs.shape[0], 3))
+    for q in range(new_pairs.shape[0]):
+        key = new_pairs[q, 0] * n_tets + new_pairs[q, 1]
+        at = np.searchsorted(sorted_keys, key)
+        if at < sorted_keys.shape[0] and sorted_keys[at] == key:
+            for c in range(3):
+                springs[q, c] = old_springs[order[at], c]
+    return springs

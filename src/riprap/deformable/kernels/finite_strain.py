@@ -384,14 +384,20 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
                   constrained, prescribed_velocities, time_step, nodal_forces, contact):
     """Up to ``n_steps`` central-difference steps without returning to Python.
 
-    ``contact`` = (triangles, tets, wall depth per triangle, candidate (triangle, tet) pairs,
-    penalty, walls (n, 6: point, outward normal), positions when the pairs were listed, skin,
-    totals (n_walls + 1): the normal force of each wall and of the body pairs at the last step).
+    ``contact`` = (the triangles and tets walls act on, all contact triangles and tets, wall depth
+    per triangle, candidate (triangle, tet) pairs, penalty, walls (n, 7: point, outward normal,
+    friction coefficient), positions when the pairs were listed, skin, totals (n_walls + 1): the
+    normal force of each wall and of the body pairs at the last step, friction coefficient per
+    triangle and per tet, tangential over normal contact stiffness, tangential stiffness per tet
+    and m^2 of contact, the tangential springs of the pairs, of the wall triangles and of the
+    wall tets, the normal damping ratio per triangle and per tet).
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
     which ``element`` has J <= 0 (or a non-finite J); REBUILD_CONTACTS before a step once a node has
     moved half the skin since the pairs were listed."""
-    (triangles, contact_tets, wall_depths, pairs, penalty, walls, listed_positions, skin,
-     totals) = contact
+    (wall_triangles, wall_tets, triangles, contact_tets, wall_depths, pairs, penalty, walls,
+     listed_positions, skin, totals, triangle_friction, tet_friction, tangential_ratio,
+     tet_stiffness, pair_springs, wall_triangle_springs, wall_tet_springs, triangle_damping,
+     tet_damping) = contact
     tet4 = elements.shape[1] == 4
     has_contact = triangles.shape[0] > 0
     half_skin_squared = 0.25 * skin * skin
@@ -406,12 +412,21 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
             contact_forces[:] = 0.0
             totals[:] = 0.0
             weight, _ = contact_kernels.pair_forces(positions, triangles, contact_tets, pairs, penalty,
-                                                    contact_forces)
+                                                    contact_forces, velocities, masses,
+                                                    triangle_friction, tet_friction,
+                                                    triangle_damping, tet_damping, tet_stiffness,
+                                                    time_step, pair_springs)
             totals[walls.shape[0]] = weight
             for w in range(walls.shape[0]):
-                force, _ = contact_kernels.wall_forces(positions, triangles, contact_tets,
+                force, _ = contact_kernels.wall_forces(positions, wall_triangles, wall_tets,
                                                        walls[w, 0:3], walls[w, 3:6], penalty,
-                                                       wall_depths, contact_forces)
+                                                       wall_depths, contact_forces, velocities,
+                                                       masses, triangle_friction, tet_friction,
+                                                       walls[w, 6], triangle_damping, tet_damping,
+                                                       tangential_ratio,
+                                                       tet_stiffness, time_step,
+                                                       wall_triangle_springs[w],
+                                                       wall_tet_springs[w])
                 totals[w] = force
         if not parallel:
             element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
