@@ -357,16 +357,23 @@ class DeformableModel(Model):
         if self._rigid_series is not None:
             outputs["rigid_bodies"] = str(self._rigid_series.pvd_path)
         if self._picture and self._peak is not None:
-            outputs["picture"] = str(self.write_peak_picture(self._directory / "peak_stress.png"))
+            outputs["picture"] = str(self.write_stress_picture(self._directory / "peak_stress.png",
+                                                               self._peak, peak=True))
+            final = (self.system.time, self.system.positions.copy(),
+                     np.concatenate([principal_stresses(b.cauchy_stresses())[:, 0]
+                                     for b in self.system.bodies]))
+            outputs["final_picture"] = str(self.write_stress_picture(
+                self._directory / "final_stress.png", final, peak=False))
         return outputs
 
-    def write_peak_picture(self, path):
+    def write_stress_picture(self, path, snapshot, *, peak: bool):
         """The bodies' surfaces coloured by the largest principal stress of the element under each
-        face, at the moment the largest tensile stress of the run was found."""
+        face in ``snapshot`` (time, positions, sigma_1 of every element): the moment the largest
+        tensile stress of the run was found (``peak``), or the end of the run."""
         from riprap.deformable.elements import boundary_faces_with_owners
         from riprap.io.picture import render_bodies_png
 
-        time, positions, sigma_1 = self._peak
+        time, positions, sigma_1 = snapshot
         s = self.system
         triangles, values = [], []
         for k, body in enumerate(s.bodies):
@@ -375,14 +382,18 @@ class DeformableModel(Model):
             values.append(sigma_1[owners + s.element_offsets[k]])
         triangles = np.concatenate(triangles)
         values = np.concatenate(values) / 1e6
-        worst = int(np.argmax(self.records.stress))
         reach = float(np.abs(values).max())
+        if peak:
+            worst = int(np.argmax(self.records.stress))
+            title = (f"t = {time:.4g} s: largest tensile stress of the run, "
+                     f"{self.records.stress[worst] / 1e6:.3g} MPa in {self.body_names[worst]}")
+        else:
+            title = (f"end of the run, t = {time:.4g} s: largest tensile stress "
+                     f"{float(sigma_1.max()) / 1e6:.3g} MPa")
         return render_bodies_png(
             path, triangles_world=triangles, body_ids=np.arange(len(triangles)), values=values,
             value_label="largest principal stress sigma_1 (MPa, tension +)", colour_map="coolwarm",
-            value_range=(-reach, reach),
-            title=(f"t = {time:.4g} s: largest tensile stress {self.records.stress[worst] / 1e6:.3g} "
-                   f"MPa in {self.body_names[worst]}"))
+            value_range=(-reach, reach), title=title)
 
     def progress_text(self) -> str:
         s = self.system
