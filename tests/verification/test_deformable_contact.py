@@ -6,6 +6,8 @@ Hertz (issue 14: peak force and contact duration within 10 %). An elastic sphere
 E = 10 MPa, nu = 0.3, rho = 1000 kg/m^3, 4-node tets of 5 mm from gmsh, about 19,000) hits a rigid
 floor at 1 m/s. Johnson, Contact Mechanics (1985), §11.4: F = 4/3 E* sqrt(R) delta^3/2 with
 E* = E / (1 - nu^2), delta_max = (15 m v^2 / (16 E* sqrt(R)))^(2/5), t_c = 2.87 (m^2 / (R E*^2 v))^(1/5).
+10-node tets on a 10 mm mesh (2,518 tets; contact through their 8 sub-tets): peak +6.8 %, duration
+-0.4 % (7 mm: +8.4 %, -1.0 %).
 Penalty p = E; a small viscosity (8 Pa s: damping ratio 0.3 at the highest element frequency,
 5e-4 at the contact's) keeps the surface nodes from ringing. Measured: peak +8.3 %, duration
 -6 % (7 mm mesh: +9.8 %, -5.5 %; 3.5 mm: +7.7 %, -5.4 %): constant-strain tets are stiff near the
@@ -37,12 +39,13 @@ from riprap.solid.solver import SolidSolver
 FLOOR = [((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))]
 
 
-def test_sphere_impact_follows_hertz():
+@pytest.mark.parametrize("element_type, mesh_size", [("tet4", 0.005), ("tet10", 0.01)])
+def test_sphere_impact_follows_hertz(element_type, mesh_size):
     radius, young, poisson, speed = 0.05, 1e7, 0.3, 1.0
-    mesh = shapes.sphere(radius=radius, mesh_size=0.005)
+    mesh = shapes.sphere(radius=radius, mesh_size=mesh_size)
     nodes = mesh.nodes - mesh.nodes.mean(axis=0) + np.array([0.0, 0.0, radius + 1e-4])
     material = ElasticMaterial(young_modulus=young, density=1000.0, poisson_ratio=poisson, viscosity=8.0)
-    sphere = DeformableBody(nodes, mesh.tets, material, name="sphere")
+    sphere = DeformableBody(nodes, mesh.tets, material, name="sphere", element_type=element_type)
     sphere.velocities[:, 2] = -speed
     system = DeformableSystem([sphere], walls=FLOOR, contact_penalty=young)
     mass = sphere.mass
@@ -134,7 +137,7 @@ def test_colliding_cubes_keep_their_momentum():
     assert left.velocities[:, 0].mean() < right.velocities[:, 0].mean()   # and parted
 
 
-def _block_on_incline(theta_degrees, friction, settle, measure):
+def _block_on_incline(theta_degrees, friction, settle, measure, element_type="tet4"):
     """A 0.1 m deformable block resting on a plane inclined by theta; its centre's travel down
     the slope during ``measure`` seconds after ``settle`` seconds, and its mean speed fit then."""
     theta = np.radians(theta_degrees)
@@ -142,7 +145,7 @@ def _block_on_incline(theta_degrees, friction, settle, measure):
                                friction_coefficient=friction)
     nodes, tets = box_mesh((0.1, 0.1, 0.1), (3, 3, 3), origin=(-0.05, -0.05, 0.0))
     rotation = np.array([[np.cos(theta), 0, -np.sin(theta)], [0, 1, 0], [np.sin(theta), 0, np.cos(theta)]])
-    block = DeformableBody(nodes @ rotation.T, tets, material, name="block")
+    block = DeformableBody(nodes @ rotation.T, tets, material, name="block", element_type=element_type)
     system = DeformableSystem([block], walls=[((0.0, 0.0, 0.0), tuple(rotation[:, 2]))],
                               gravity=(0.0, 0.0, -9.81))
     down = -rotation[:, 0]
@@ -160,16 +163,21 @@ def _block_on_incline(theta_degrees, friction, settle, measure):
     return (centre() - start) @ down, np.polyfit(times, speeds, 1)[0]
 
 
-def test_block_sticks_on_an_incline_below_the_friction_angle():
+@pytest.mark.parametrize("element_type", ["tet4", "tet10"])
+def test_block_sticks_on_an_incline_below_the_friction_angle(element_type):
     """Coulomb: a block on a 20 degree slope with mu = 0.6 (tan 20 = 0.36) stays (tangential
     springs as for rigid bodies): it moves less than 10 micrometres in 0.2 s once settled."""
-    travel, _ = _block_on_incline(20.0, 0.6, settle=0.1, measure=0.2)
+    travel, _ = _block_on_incline(20.0, 0.6, settle=0.1, measure=0.2, element_type=element_type)
     assert abs(travel) < 1e-5
 
 
-def test_block_slides_on_an_incline_at_the_coulomb_rate():
+@pytest.mark.parametrize("element_type, tolerance", [("tet4", 0.02), ("tet10", 0.05)])
+def test_block_slides_on_an_incline_at_the_coulomb_rate(element_type, tolerance):
     """Above the friction angle (40 degrees, mu = 0.3) the block accelerates at
-    g (sin theta - mu cos theta) = 4.05 m/s^2, within 2 % (measured +0.5 %)."""
+    g (sin theta - mu cos theta) = 4.05 m/s^2: 4-node tets within 2 % (measured +0.5 %); 10-node
+    tets within 5 % (measured +3.4 %: friction falls short on the sub-tet faces, whose light corner
+    nodes ring against the slope so that some pieces stick and slip in turn; not yet understood
+    further, see docs/deformable.md)."""
     theta = np.radians(40.0)
-    _, acceleration = _block_on_incline(40.0, 0.3, settle=0.05, measure=0.2)
-    assert acceleration == pytest.approx(9.81 * (np.sin(theta) - 0.3 * np.cos(theta)), rel=0.02)
+    _, acceleration = _block_on_incline(40.0, 0.3, settle=0.05, measure=0.2, element_type=element_type)
+    assert acceleration == pytest.approx(9.81 * (np.sin(theta) - 0.3 * np.cos(theta)), rel=tolerance)

@@ -577,8 +577,9 @@ KEYS: tuple[Key, ...] = (
         default="neo_hookean_seed",
         choices=("neo_hookean_seed", "neo_hookean", "neo_hookean_decoupled")),
     Key("deformable", "element_type", "string", "-",
-        "tet4: constant-strain tets (bodies in contact); tet10: quadratic tets, no locking in "
-        "bending, not yet in contact.", default="tet4", choices=("tet4", "tet10")),
+        "tet4: constant-strain tets; tet10: quadratic tets, no locking in bending (contact through "
+        "their 8 linear sub-tets). All deformable bodies of a run have the same.", default="tet4",
+        choices=("tet4", "tet10")),
     Key("deformable", "tensile_strength", "number", "Pa",
         "Tensile strength the largest principal stresses are compared with in units.csv; 0: none "
         "given.", default=0.0, valid_range=_NON_NEGATIVE),

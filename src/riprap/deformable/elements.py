@@ -27,6 +27,11 @@ ELEMENT_TYPES = ("tet4", "tet10")
 # Edges of a tetrahedron in VTK_QUADRATIC_TETRA order: node 4 + k sits on edge k.
 TET10_EDGES = np.array([[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]], dtype=np.int64)
 
+# The 8 linear sub-tets of a 10-node tet (node numbers as above: 4 = edge 01, 5 = 12, 6 = 20,
+# 7 = 03, 8 = 13, 9 = 23): the 4 corner tets and the inner octahedron split along 4-9.
+_TET10_SUBTETS = ((0, 4, 6, 7), (4, 1, 5, 8), (6, 5, 2, 9), (7, 8, 9, 3),
+                  (4, 9, 5, 8), (4, 9, 8, 7), (4, 9, 7, 6), (4, 9, 6, 5))
+
 # 4-point Gauss rule on a tet, exact for quadratics: barycentric coordinates, equal weights.
 _GAUSS_A = 0.5854101966249685
 _GAUSS_B = 0.1381966011250105
@@ -71,6 +76,21 @@ class ElementSet:
     @property
     def volumes(self) -> np.ndarray:
         return self.weights.sum(axis=1)
+
+    def contact_tets(self) -> np.ndarray:
+        """4-node tets that contact sees: the elements themselves for 4-node tets; for 10-node
+        tets their 8 sub-tets through the mid-edge nodes (4 at the corners, 4 splitting the inner
+        octahedron along the 01-23 diagonal), so that the curved faces take part through all six
+        of their nodes and the light corner nodes (1/36 of the mass) do not carry the contact
+        alone. Positively oriented in the reference state."""
+        if self.element_type == "tet4":
+            return self.elements
+        e = self.elements
+        split = np.concatenate([e[:, list(sub)] for sub in _TET10_SUBTETS])
+        corners = self.reference_nodes[split]
+        negative = np.linalg.det(corners[:, 1:] - corners[:, :1]) < 0
+        split[negative] = split[negative][:, [0, 1, 3, 2]]
+        return np.ascontiguousarray(split)
 
     def lumped_masses(self, density: float) -> np.ndarray:
         """Nodal masses (kg) from the reference volumes."""

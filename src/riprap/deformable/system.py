@@ -7,9 +7,8 @@ The (boundary triangle, tet) pairs that may touch are listed from boxes grown by
 listed again only after some node has moved half the skin, so contact costs a sweep over the
 listed pairs per step.
 
-Contact uses the 4-node corner mesh of each body; 10-node bodies are refused here until their
-curved faces take part (their corner nodes carry 1/36 of a tet's mass each, so forces put on them
-alone would set a tiny stable step).
+Contact sees 4-node tets: the elements of 4-node bodies, the 8 sub-tets of each 10-node element
+(``ElementSet.contact_tets``), so that every node of a curved face takes part.
 """
 from __future__ import annotations
 
@@ -17,8 +16,8 @@ import math
 
 import numpy as np
 
-from riprap.deformable.body import (PARALLEL_POINTS, TIME_STEP_SAFETY, DeformableBody,
-                                    material_table, stable_step_for)
+from riprap.deformable.body import (NO_TET4_GRADIENTS, PARALLEL_POINTS, TIME_STEP_SAFETY,
+                                    DeformableBody, material_table, stable_step_for)
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import finite_strain
 from riprap.errors import CaseFileError
@@ -63,10 +62,10 @@ class DeformableSystem:
         for body in bodies:
             if not isinstance(body, DeformableBody):
                 raise CaseFileError(f"{body!r} is not a DeformableBody")
-            if body.element_type != "tet4":
-                raise CaseFileError(
-                    f"deformable body '{body.name}': contact of {body.element_type} bodies is not "
-                    "available yet; use element_type = 'tet4' for bodies in contact")
+        kinds = sorted({body.element_type for body in bodies})
+        if len(kinds) > 1:
+            raise CaseFileError(f"deformable bodies of {' and '.join(kinds)} elements in one run: give "
+                                "them all the same element_type")
         self.bodies = bodies
         if contact_penalty is None:
             contact_penalty = min(body.material.young_modulus for body in bodies)
@@ -129,14 +128,16 @@ class DeformableSystem:
                                      + [np.full(len(p[0]), mass) for p, mass in zip(proxies, rigid_masses)])
         self.elements = np.concatenate([b.elements.elements + self.node_offsets[k]
                                         for k, b in enumerate(bodies)])
-        self.tet4_gradients = np.concatenate([b.elements.tet4_gradients for b in bodies])
+        tet4 = bodies[0].element_type == "tet4"
+        self.tet4_gradients = (np.concatenate([b.elements.tet4_gradients for b in bodies]) if tet4
+                               else NO_TET4_GRADIENTS)
         self.gradients = np.concatenate([b.elements.gradients for b in bodies])
         self.weights = np.concatenate([b.elements.weights for b in bodies])
         self.materials = material_table([b.material for b in bodies])
         self.element_material = np.concatenate([np.full(b.n_elements, k, dtype=np.int64)
                                                 for k, b in enumerate(bodies)])
         self.jacobians = np.ones(len(self.elements))
-        self._element_forces = np.zeros((len(self.elements), 4, 3))
+        self._element_forces = np.zeros(self.elements.shape + (3,))
         flat = self.elements.ravel()
         order = np.argsort(flat, kind="stable")
         counts = np.bincount(flat, minlength=len(self.positions))
@@ -148,7 +149,7 @@ class DeformableSystem:
         # tet's potential rises by one
         potential_heights = []
         for k, body in enumerate(bodies):
-            mesh = TetMesh(body.elements.reference_nodes, body.elements.corner_tets, name=body.name)
+            mesh = TetMesh(body.elements.reference_nodes, body.elements.contact_tets(), name=body.name)
             faces = mesh.boundary_faces()
             boundary_nodes = np.zeros(len(mesh.nodes), dtype=bool)
             boundary_nodes[faces.ravel()] = True
@@ -294,7 +295,7 @@ class DeformableSystem:
     def step(self, n_steps: int = 1) -> None:
         """Advance ``n_steps`` steps; raises InstabilityError naming an element that inverts."""
         dt = self.time_step
-        parallel = len(self.elements) >= PARALLEL_POINTS
+        parallel = self.weights.size >= PARALLEL_POINTS
         remaining = int(n_steps)
         while remaining > 0:
             contact = (self.triangles[:self.n_wall_triangles], self.contact_tets[:self.n_wall_tets],
