@@ -94,6 +94,7 @@ class DeformableSystem:
         self.time = 0.0
         self.step_count = 0
         self._time_step = None
+        self._stable_time_step = None
         self.contact_totals = np.zeros(len(self.walls) + 1)
         self._pairs = np.zeros((0, 2), dtype=np.int64)
         self._listed_positions = np.full_like(self.positions, np.inf)
@@ -244,7 +245,10 @@ class DeformableSystem:
     # ------------------------------------------------------------------ time step
     def stable_time_step(self) -> float:
         """2 / sqrt(omega_elements^2 + omega_contact^2): the stiffest element and the stiffest
-        contact on one node (penalty times the node's share of surface over the potentials' depth)."""
+        contact on one node (penalty times the node's share of surface over the potentials' depth).
+        Computed once: it depends on the reference geometry only."""
+        if self._stable_time_step is not None:
+            return self._stable_time_step
         omega_elements = 0.0
         for body in self.bodies:
             body.stable_time_step()
@@ -264,7 +268,9 @@ class DeformableSystem:
         stiffness = self.contact_penalty * node_area * 2.0 / heights[node_body]
         omega_contact = float(np.sqrt(stiffness / self.masses[:self.n_deformable_nodes]).max())
         damping = max(b.material.viscous_time_constant for b in self.bodies)
-        return stable_step_for(math.hypot(omega_elements, omega_contact), damping, self.mass_damping)
+        self._stable_time_step = stable_step_for(math.hypot(omega_elements, omega_contact), damping,
+                                                 self.mass_damping)
+        return self._stable_time_step
 
     @property
     def time_step(self) -> float:
