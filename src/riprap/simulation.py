@@ -267,7 +267,8 @@ class Simulation:
     @property
     def coupled(self) -> bool:
         """Whether bodies move in a fluid."""
-        return self.fluid is not None and (hasattr(self.fluid, "solids") or self.solver.n_bodies > 0)
+        return self.fluid is not None and (hasattr(self.fluid, "solids") or self.solver.n_bodies > 0
+                                           or bool(self.deformable_bodies))
 
     def _build_model(self):
         from riprap.models.fluid import CoupledModel, FluidModel
@@ -299,7 +300,7 @@ class Simulation:
         from riprap.models.deformable import DeformableModel
 
         if self.fluid is not None:
-            raise CaseFileError("deformable bodies in a fluid are not available yet")
+            return self._deformable_coupled_model()
         solver = self.solver
         rigid_surfaces = []
         if solver.n_bodies > 0:
@@ -329,6 +330,43 @@ class Simulation:
         return DeformableModel(system, rigid=self if solver.n_bodies > 0 else None,
                                case_numbers=self._case_numbers(),
                                accepted_depths=self.deformable_accepted_depths)
+
+    def _deformable_coupled_model(self):
+        """Deformable bodies in the flow (``riprap.coupling.deformable_coupled``); the fluid box's
+        sides (all but an open top) and the case's walls bound them."""
+        from riprap.coupling.coupled import fluid_box_walls
+        from riprap.coupling.deformable_coupled import DeformableBodies, DeformableCoupledSolver
+        from riprap.deformable.system import DeformableSystem
+        from riprap.models.deformable import DeformableModel
+        from riprap.models.deformable_coupled import DeformableCoupledModel
+
+        solver = self.solver
+        if hasattr(self.fluid, "solids"):
+            raise CaseFileError("deformable bodies cannot join a CoupledSolver built by the caller: "
+                                "give the Simulation a FluidSolver")
+        if solver.n_bodies > 0:
+            raise CaseFileError(f"{solver.n_bodies} rigid bodies beside deformable ones in a flow: "
+                                "not available yet; make every body of a run with [fluid] "
+                                "deformable ([deformable] bodies = \"all\"), or none")
+        walls = [(wall.point, wall.normal,
+                  solver.materials[solver.material_index(wall.material)].friction_coefficient)
+                 for wall in solver.walls]
+        friction = min(b.material.friction_coefficient for b in self.deformable_bodies)
+        for wall in fluid_box_walls(self.fluid.grid, ""):
+            # a side that is already a wall (the same plane) is not added twice
+            if not any(np.allclose(wall.normal, w[1]) and
+                       abs(np.dot(np.subtract(wall.point, w[0]), wall.normal)) < 1e-9 for w in walls):
+                walls.append((wall.point, wall.normal, friction))
+        system = DeformableSystem(self.deformable_bodies, walls=walls,
+                                  contact_penalty=self.deformable_contact_penalty,
+                                  gravity=self.fluid.gravity,
+                                  mass_damping=self.deformable_mass_damping)
+        if self.requested_time_step > 0:
+            system.time_step = self.requested_time_step
+        coupled = DeformableCoupledSolver(self.fluid, DeformableBodies(system))
+        stresses = DeformableModel(system, case_numbers=self._case_numbers(),
+                                   accepted_depths=self.deformable_accepted_depths)
+        return DeformableCoupledModel(coupled, stresses)
 
     def _case_numbers(self):
         """(case number of each deformable body, of each rigid body): their own orders when the
@@ -685,6 +723,7 @@ class Simulation:
 # Checkpoint kinds a model restarts from: coupled runs were "fluid runs" before the one run loop.
 _ACCEPTED_KINDS = {"riprap rigid run": ("riprap rigid run",),
                    "riprap deformable run": ("riprap deformable run",),
+                   "riprap deformable coupled run": ("riprap deformable coupled run",),
                    "riprap fluid run": ("riprap fluid run",),
                    "riprap coupled run": ("riprap coupled run", "riprap fluid run")}
 

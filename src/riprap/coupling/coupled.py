@@ -165,8 +165,7 @@ class CoupledSolver:
         grid = fluid.grid
         self._lower = np.asarray(grid.lower, dtype=np.float64)
         self._cells = np.asarray(grid.cells, dtype=np.int64)
-        self._densities = np.array([solids.materials[m].density
-                                    for m in solids.material_index_of_body], dtype=np.float64)
+        self._densities = self._body_densities()
         self._blocks = None
         self._block_poses = None
         self._restart_block_poses = None
@@ -268,7 +267,8 @@ class CoupledSolver:
         some point of it has moved more than ``RECLIP_DISTANCE`` cells since it was last clipped
         (fixed bodies once), so the cost follows the moving bodies."""
         solids = self.solids
-        poses = np.concatenate([solids.positions, solids.quaternions], axis=1)
+        now = self._clip_reference()
+        clipped = 0
         if self._blocks is None:
             # an obstacle body holds no cells of the exchange: the fluid's own obstacle does
             self._blocks = [None] * solids.n_bodies
@@ -276,24 +276,18 @@ class CoupledSolver:
             for body in self.obstacle_bodies:
                 self._blocks[body] = (np.zeros(3, dtype=np.int64), np.zeros((0, 0, 0)),
                                       np.zeros((0, 0, 0, 3, 2)))
-            stale = np.setdiff1d(np.arange(solids.n_bodies), self.obstacle_bodies)
-            # a restart clips where the run it continues had clipped last (bit for bit)
-            if self._restart_block_poses is not None:
-                poses = self._restart_block_poses
-                self._restart_block_poses = None
-            self._block_poses = poses.copy()
-        else:
-            stale = np.flatnonzero(self._moved_since_clipped(poses)
-                                   > RECLIP_DISTANCE * self.fluid.h)
-            self._block_poses[stale] = poses[stale]
-        if len(stale):
-            fresh = rigid_body_half_cell_volumes(self.fluid.grid, solids, bodies=stale,
-                                                 poses=self._block_poses[stale])
-            for body, block in zip(stale, fresh):
-                self._blocks[body] = block
-                self._cell_lists[body] = self._cell_list(block)
-            self._faces = None
-        self.last_clipped_bodies = len(stale)
+            # a restart clips where the run it continues had clipped last, then, as that run
+            # would have, again what has moved too far since (bit for bit)
+            restart, self._restart_block_poses = self._restart_block_poses, None
+            self._block_poses = (now if restart is None else restart).copy()
+            everything = np.setdiff1d(np.arange(solids.n_bodies), self.obstacle_bodies)
+            clipped += self._clip_again(everything)
+        stale = np.flatnonzero(self._moved_since_clipped(now) > RECLIP_DISTANCE * self.fluid.h)
+        if len(self.obstacle_bodies):
+            stale = np.setdiff1d(stale, self.obstacle_bodies)
+        self._take_reference(stale, now)
+        clipped += self._clip_again(stale)
+        self.last_clipped_bodies = clipped
 
     def _moved_since_clipped(self, poses) -> np.ndarray:
         """Per body, a bound on how far any point of it has moved since its last clipping (m):
@@ -303,6 +297,35 @@ class CoupledSolver:
         alignment = np.abs(np.einsum("bi,bi->b", poses[:, 3:], self._block_poses[:, 3:]))
         angle = 2.0 * np.arccos(np.minimum(alignment, 1.0))
         return shift + angle * solids.bounding_radius[solids.shape_index]
+
+    def _clip_again(self, bodies) -> int:
+        """Clip ``bodies`` where ``_block_poses`` puts them; their blocks and cell lists anew."""
+        if len(bodies):
+            for body, block in zip(bodies, self._clip(bodies)):
+                self._blocks[body] = block
+                self._cell_lists[body] = self._cell_list(block)
+            self._faces = None
+        return len(bodies)
+
+    # What the bodies are made of and where their surfaces are: the hooks a coupling of other
+    # bodies (riprap.coupling.deformable_coupled) replaces.
+    def _body_densities(self) -> np.ndarray:
+        solids = self.solids
+        return np.array([solids.materials[m].density for m in solids.material_index_of_body],
+                        dtype=np.float64)
+
+    def _clip_reference(self) -> np.ndarray:
+        """Where the bodies are now, as the clipping remembers it: their poses (bodies, 7)."""
+        return np.concatenate([self.solids.positions, self.solids.quaternions], axis=1)
+
+    def _take_reference(self, stale, now) -> None:
+        """Remember ``now`` for the bodies about to be clipped again."""
+        self._block_poses[stale] = now[stale]
+
+    def _clip(self, stale) -> list:
+        """Half-cell volume blocks of the ``stale`` bodies where ``_block_poses`` puts them."""
+        return rigid_body_half_cell_volumes(self.fluid.grid, self.solids, bodies=stale,
+                                            poses=self._block_poses[stale])
 
     def _cell_list(self, block):
         """(flat grid index of every cell of a body's block that holds solid and is not an

@@ -25,7 +25,7 @@ from riprap.fluid.grid import FluidGrid
 from riprap.solid.kernels.geometry_ops import rotation_matrix
 
 __all__ = ["BodyCellVolumes", "body_cell_volumes", "surface_cell_volumes", "rigid_body_cell_volumes",
-           "rigid_body_half_cell_volumes", "merge_blocks"]
+           "rigid_body_half_cell_volumes", "half_cell_volumes", "merge_blocks"]
 
 
 @dataclass(frozen=True)
@@ -162,15 +162,27 @@ def rigid_body_cell_volumes(grid: FluidGrid, solver, bodies=None, poses=None) ->
 
 
 def rigid_body_half_cell_volumes(grid: FluidGrid, solver, bodies=None, poses=None) -> list:
+    """:func:`half_cell_volumes` of the bodies of a :class:`riprap.solid.solver.SolidSolver`
+    (all, or those in ``bodies``, at their present poses or at ``poses``)."""
+    fine_grid = _half_grid(grid)
+    return _halved(rigid_body_cell_volumes(fine_grid, solver, bodies=bodies, poses=poses))
+
+
+def half_cell_volumes(grid: FluidGrid, nodes, triangles, triangle_start) -> list:
     """Per body (origin (3,), cell volumes (bi, bj, bk), half-cell volumes (bi, bj, bk, 3, 2)):
-    :func:`rigid_body_cell_volumes` on the grid of half the cell size, summed to the cells and to
+    :func:`surface_cell_volumes` on the grid of half the cell size, summed to the cells and to
     each cell's lower and upper half along every axis. A face of the staggered grid owns the
     upper half of the cell below it and the lower half of the cell above it, so these give the
     exact solid fraction of every face's control volume (``rigid_coupling.touched_faces``), one
     cell wide, where the mean of the two cells' fractions would smear the body over two."""
-    fine_grid = FluidGrid(lower=grid.lower, upper=grid.upper,
-                          cells=tuple(2 * int(n) for n in grid.cells))
-    fine = rigid_body_cell_volumes(fine_grid, solver, bodies=bodies, poses=poses)
+    return _halved(surface_cell_volumes(_half_grid(grid), nodes, triangles, triangle_start))
+
+
+def _half_grid(grid: FluidGrid) -> FluidGrid:
+    return FluidGrid(lower=grid.lower, upper=grid.upper, cells=tuple(2 * int(n) for n in grid.cells))
+
+
+def _halved(fine: BodyCellVolumes) -> list:
     blocks = []
     for body in range(fine.n_bodies):
         fine_origin, volumes = fine.block(body)

@@ -93,6 +93,11 @@ class DeformableBody:
         self.materials = material_table([material])
         self.element_material = np.zeros(n_el, dtype=np.int64)
         self.contact_forces = np.zeros((n_nodes, 3))
+        #: A uniform pressure all round the body that its nodes do not carry (Pa): it neither
+        #: moves nor turns a closed body and strains it only isotropically (sigma = -p I, to
+        #: first order in p / E), so it is added to the stresses instead. A body in a flow takes
+        #: the mean pressure on its surface here (``riprap.coupling.deformable_coupled``).
+        self.ambient_pressure = 0.0
         self._stable_time_step = None
         self._time_step = None
 
@@ -206,11 +211,13 @@ class DeformableBody:
     # ------------------------------------------------------------------ outputs
     def cauchy_stresses(self) -> np.ndarray:
         """Cauchy stress of every element (n, 3, 3) in Pa (tension positive), the volume-weighted
-        mean over its integration points."""
+        mean over its integration points, with -``ambient_pressure`` I added."""
         stresses = np.zeros((self.n_elements, 3, 3))
         finite_strain.cauchy_stresses(self.positions, self.velocities, self.elements.elements,
                                       self.elements.gradients, self.elements.weights,
                                       self.materials, self.element_material, stresses)
+        if self.ambient_pressure:
+            stresses -= self.ambient_pressure * np.eye(3)
         return stresses
 
     def kinetic_energy(self, velocities=None) -> float:

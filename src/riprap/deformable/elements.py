@@ -169,6 +169,23 @@ def _strain_displacement(gradients: np.ndarray) -> np.ndarray:
 _OUTWARD_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]], dtype=np.int64)
 
 
+# The same faces of a 10-node tet with their mid-edge nodes: corners a, b, c, then the nodes of
+# edges ab, bc, ca.
+_OUTWARD_FACES_10 = np.array([[1, 2, 3, 5, 9, 8], [0, 3, 2, 7, 9, 6], [0, 1, 3, 4, 8, 7],
+                              [0, 2, 1, 6, 5, 4]], dtype=np.int64)
+
+
+def boundary_face_nodes(elements: np.ndarray) -> np.ndarray:
+    """The boundary faces of a body's elements, outward: (n, 3) corner nodes for 4-node tets,
+    (n, 6) for 10-node tets (corners a, b, c, then the mid nodes of ab, bc, ca)."""
+    corners, _ = boundary_faces_with_owners(elements[:, :4])
+    if elements.shape[1] == 4:
+        return corners
+    faces = elements[:, _OUTWARD_FACES_10].reshape(-1, 6)
+    order = {tuple(key): row for row, key in enumerate(np.sort(faces[:, :3], axis=1).tolist())}
+    return faces[[order[tuple(key)] for key in np.sort(corners, axis=1).tolist()]]
+
+
 def boundary_faces_with_owners(tets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(faces (n, 3) outward, owner tet of each): the faces used by exactly one tet."""
     faces = tets[:, _OUTWARD_FACES].reshape(-1, 3)

@@ -1,0 +1,365 @@
+"""Deformable bodies in the air-water flow (the seed's eq. 4: the fluid's force reaches the solid
+through its nodes, and the fluid feels the solid back).
+
+The exchange is the rigid bodies' (:class:`riprap.coupling.coupled.CoupledSolver`): the fluid on
+the grid sees each deformable body by the exact solid fraction of its deformed surface, moving with
+the body's rigid part of its motion (mean velocity and spin of its nodes); the projection solves
+body and fluid inertia together, and gives every body a force and a torque, equal and opposite to
+the fluid's momentum change. What differs is how that load enters the body: not at its centre but
+at its nodes,
+
+* the pressure as a traction on the deformed surface, -p n, with p interpolated from the cell
+  centres at six points of every boundary face, spread by the face's own shape functions (6-node
+  faces for 10-node tets): buoyancy, the stagnation pressure in front of a falling body and the
+  suction behind it load its surface where they act, so they strain it (the seed's Figure 1).
+  The mean of p over the body's surface is left out of the traction and added to the body's
+  stresses as -p I instead (``DeformableBody.ambient_pressure``): a uniform pressure neither
+  moves nor turns a closed body, at depth it is most of the pressure, and forces of that size
+  held fixed in space over a step while the body turns would drive the turn;
+* the rest of the load (viscous stress, the momentum of the no-slip blend, and the small
+  difference between the grid's and the surface's sum of the pressure) in proportion to the nodes'
+  masses, as a rigid acceleration a + alpha x r, which moves the body without straining it.
+
+The nodal forces sum exactly to the body's force, so the fluid and the body exchange equal and
+opposite momentum, and, about its centre, to its torque less the drift that forces held over the
+step pick up as the nodes move (taken off at the start: the angular impulse is the load's to first
+order in the step). The deformation velocity of the nodes (strain rate times the body's size:
+micrometres per second for concrete) does not enter the fluid: a grid of centimetre cells cannot
+carry it. Within a fluid step the bodies take their own central-difference steps (contacts with
+each other and with the walls throughout) with the nodal loads held.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from riprap.coupling.coupled import MINIMUM_CELLS_ACROSS, CoupledSolver
+from riprap.coupling.solid_volumes import half_cell_volumes
+from riprap.deformable.elements import boundary_face_nodes, boundary_faces_with_owners
+from riprap.errors import CaseFileError
+
+__all__ = ["DeformableBodies", "DeformableCoupledSolver", "surface_pressure_forces"]
+
+# Dunavant's 6-point rule on a triangle (exact to degree 4: a linear pressure times quadratic
+# shape functions on a curved 10-node tet face): barycentric points and weights (summing to 1).
+_A, _B = 0.445948490915965, 0.091576213509771
+_POINTS = np.array([[1 - 2 * _A, _A, _A], [_A, 1 - 2 * _A, _A], [_A, _A, 1 - 2 * _A],
+                    [1 - 2 * _B, _B, _B], [_B, 1 - 2 * _B, _B], [_B, _B, 1 - 2 * _B]])
+_WEIGHTS = np.array([0.223381589678011] * 3 + [0.109951743655322] * 3)
+
+
+def _face_shape_functions(n_nodes: int):
+    """At the rule's points: the face's shape functions (q, n) and their derivatives along the
+    two edges from the first corner (q, n, 2), for 3-node and 6-node (corners, then mid nodes
+    of ab, bc, ca) triangles."""
+    l1, l2, l3 = _POINTS.T
+    if n_nodes == 3:
+        values = _POINTS.copy()
+        slopes = np.broadcast_to(np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]), (len(l1), 3, 2))
+        return values, np.ascontiguousarray(slopes)
+    values = np.stack([l1 * (2 * l1 - 1), l2 * (2 * l2 - 1), l3 * (2 * l3 - 1),
+                       4 * l1 * l2, 4 * l2 * l3, 4 * l3 * l1], axis=1)
+    # d/dxi with l2 = xi and d/deta with l3 = eta (l1 = 1 - xi - eta)
+    d_xi = np.stack([-(4 * l1 - 1), 4 * l2 - 1, 0 * l1, 4 * (l1 - l2), 4 * l3, -4 * l3], axis=1)
+    d_eta = np.stack([-(4 * l1 - 1), 0 * l1, 4 * l3 - 1, -4 * l2, 4 * l2, 4 * (l1 - l3)], axis=1)
+    return values, np.stack([d_xi, d_eta], axis=2)
+
+
+def _body_sums(values: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Per body the sum of node rows (bodies own consecutive nodes from ``offsets``)."""
+    return np.add.reduceat(values, offsets[:-1], axis=0)
+
+
+def interpolate_cell_field(field: np.ndarray, lower, h: float, points: np.ndarray) -> np.ndarray:
+    """Trilinear interpolation of a cell-centred field at ``points`` (n, 3); points nearer a side
+    than half a cell take the side cells' values (constant extrapolation)."""
+    cells = np.asarray(field.shape)
+    where = (points - np.asarray(lower)) / h - 0.5
+    base = np.clip(np.floor(where).astype(np.int64), 0, np.maximum(cells - 2, 0))
+    t = np.clip(where - base, 0.0, 1.0)
+    upper = np.minimum(base + 1, cells - 1)
+    result = np.zeros(len(points))
+    for corner in range(8):
+        pick = [(corner >> axis) & 1 for axis in range(3)]
+        index = tuple(np.where(pick[axis], upper[:, axis], base[:, axis]) for axis in range(3))
+        weight = np.prod([t[:, axis] if pick[axis] else 1.0 - t[:, axis] for axis in range(3)], axis=0)
+        result += weight * field[index]
+    return result
+
+
+def surface_pressure_forces(positions: np.ndarray, faces: np.ndarray, pressure: np.ndarray,
+                            lower, h: float, reference=0.0) -> np.ndarray:
+    """Nodal forces (nodes, 3) of the traction -p n on a closed surface of outward faces (n, 3)
+    or, curved, (n, 6) (``riprap.deformable.elements.boundary_face_nodes``): the consistent
+    loads of the faces' own shape functions, p interpolated from the cell centres at the six
+    points of Dunavant's rule on every face, less ``reference`` (Pa: one value, or one per
+    face)."""
+    values, slopes = _face_shape_functions(faces.shape[1])
+    corners = positions[faces]                                        # (f, n, 3)
+    points = np.einsum("qn,fnd->fqd", values, corners)
+    tangents = np.einsum("qnk,fnd->fqkd", slopes, corners)            # (f, q, 2, 3)
+    # x_xi x x_eta over the reference triangle of area 1/2
+    area_normals = 0.5 * np.cross(tangents[:, :, 0], tangents[:, :, 1])
+    p = interpolate_cell_field(pressure, lower, h, points.reshape(-1, 3)).reshape(points.shape[:2])
+    p -= np.reshape(reference, (-1, 1))
+    traction = -(_WEIGHTS * p)[..., None] * area_normals             # (f, q, 3)
+    nodal = np.einsum("qn,fqd->fnd", values, traction)
+    forces = np.zeros_like(positions)
+    np.add.at(forces, faces.ravel(), nodal.reshape(-1, 3))
+    return forces
+
+
+def surface_mean_pressures(positions: np.ndarray, faces: np.ndarray, face_body: np.ndarray,
+                           n_bodies: int, pressure: np.ndarray, lower, h: float) -> np.ndarray:
+    """Per body the area-weighted mean of the interpolated pressure over its surface (Pa)."""
+    values, slopes = _face_shape_functions(faces.shape[1])
+    corners = positions[faces]
+    points = np.einsum("qn,fnd->fqd", values, corners)
+    tangents = np.einsum("qnk,fnd->fqkd", slopes, corners)
+    areas = 0.5 * _WEIGHTS * np.linalg.norm(np.cross(tangents[:, :, 0], tangents[:, :, 1]), axis=2)
+    p = interpolate_cell_field(pressure, lower, h, points.reshape(-1, 3)).reshape(points.shape[:2])
+    weighted = np.bincount(face_body, (areas * p).sum(axis=1), minlength=n_bodies)
+    return weighted / np.bincount(face_body, areas.sum(axis=1), minlength=n_bodies)
+
+
+class DeformableBodies:
+    """The deformable bodies of a :class:`riprap.deformable.system.DeformableSystem` as the
+    coupling sees them: per body its mass, centre, mean velocity, angular momentum and inertia
+    (sums over its nodes), the forces on it and the fluid's load; its deformed surface; and the
+    fluid's load handed to its nodes (:meth:`apply_fluid_loads`).
+
+    The system must hold deformable bodies only (rigid bodies in the same flow are not joined
+    here)."""
+
+    def __init__(self, system):
+        if system.n_rigid:
+            raise CaseFileError("deformable and rigid bodies in one flow are not available yet: "
+                                "make every body of a run with [fluid] deformable, or none")
+        self.system = system
+        self.n_bodies = len(system.bodies)
+        self.fixed = np.zeros(self.n_bodies, dtype=bool)
+        self.gravity = system.gravity
+        self.offsets = system.node_offsets
+        n = system.n_deformable_nodes
+        self.node_masses = system.masses[:n]
+        self.masses = _body_sums(self.node_masses, self.offsets)
+        self.densities = np.array([b.material.density for b in system.bodies], dtype=np.float64)
+        triangles, starts = [], [0]
+        for k, body in enumerate(system.bodies):
+            faces, _ = boundary_faces_with_owners(body.elements.contact_tets())
+            triangles.append(faces + self.offsets[k])
+            starts.append(starts[-1] + len(faces))
+        #: Outward boundary triangles of every body (the sub-tets' faces for 10-node bodies):
+        #: the surface the fluid grid sees.
+        self.triangles = np.concatenate(triangles).astype(np.int64)
+        self.triangle_start = np.asarray(starts, dtype=np.int64)
+        #: The bodies' element faces on their surfaces (6 nodes for 10-node tets): where the
+        #: pressure loads them.
+        faces = [boundary_face_nodes(body.elements.elements) + self.offsets[k]
+                 for k, body in enumerate(system.bodies)]
+        self.load_faces = np.concatenate(faces).astype(np.int64)
+        self.load_face_body = np.repeat(np.arange(self.n_bodies), [len(f) for f in faces])
+        self.node_body = np.repeat(np.arange(self.n_bodies), np.diff(self.offsets))
+        #: The fluid's force and torque on every body, held over the present step (N, N m).
+        self.external_loads = np.zeros((self.n_bodies, 6))
+        self.refresh()
+
+    def finalize(self) -> None:
+        """Nothing to do: the system was built whole (the coupling's SolidSolver interface)."""
+
+    @property
+    def time_step(self) -> float:
+        return self.system.time_step
+
+    # ------------------------------------------------------------------ per body
+    def refresh(self) -> None:
+        """Recompute the per-body sums from the nodes (after the nodes moved)."""
+        s, n = self.system, self.system.n_deformable_nodes
+        m = self.node_masses[:, None]
+        x, v = s.positions[:n], s.velocities[:n]
+        self.positions = _body_sums(m * x, self.offsets) / self.masses[:, None]
+        self.velocities = _body_sums(m * v, self.offsets) / self.masses[:, None]
+        arms = x - self.positions[self.node_body]
+        self.angular_momenta = _body_sums(np.cross(arms, m * v), self.offsets)
+        squared = np.einsum("ni,ni->n", arms, arms)
+        self.inertia = (_body_sums(m[:, 0, None, None] * (squared[:, None, None] * np.eye(3)
+                                                          - arms[:, :, None] * arms[:, None, :]),
+                                   self.offsets))
+        # the last step's force on every node (contacts, gravity, the fluid's load held);
+        # the internal forces sum to nothing
+        total = s.contact_forces[:n] + m * s.gravity + s.external_forces[:n]
+        self.forces = _body_sums(total, self.offsets)
+        self.torques = _body_sums(np.cross(arms, total), self.offsets)
+
+    def contact_forces(self) -> np.ndarray:
+        """Total contact force on every body at the last step (N)."""
+        return _body_sums(self.system.contact_forces[:self.system.n_deformable_nodes], self.offsets)
+
+    def nominal_diameters(self) -> np.ndarray:
+        """(mass / density)^(1/3) of every body (m)."""
+        return (self.masses / self.densities) ** (1.0 / 3.0)
+
+    # ------------------------------------------------------------------ loads
+    def apply_fluid_loads(self, loads: np.ndarray, pressure: np.ndarray, lower, h: float,
+                          reference: float = 0.0, duration: float = 0.0) -> None:
+        """Hand each body's load (bodies, 6: force, torque about its centre) to its nodes: the
+        pressure (less ``reference``) as surface traction, the rest as a rigid acceleration by
+        mass; held as the nodes' external forces for ``duration`` (s), until the next call.
+
+        Forces held fixed in space while the nodes move about the centre change their torque
+        (a uniform pressure all round, whose torque is nil, would give one in proportion to the
+        rotation, driving it further: a spin that grows by itself). The torque they will have on
+        average over ``duration``, from the nodes' present velocities relative to the body's, is
+        therefore taken off at the start, so that the body's angular impulse over the step is
+        its load's (to first order in the step; the force's impulse is exact)."""
+        s, n = self.system, self.system.n_deformable_nodes
+        x, v = s.positions[:n], s.velocities[:n]
+        # The mean pressure on each body's surface is left to its ambient_pressure: at depth it
+        # is most of the pressure, and held fixed while the body turns it would be most of the
+        # drift below.
+        ambient = surface_mean_pressures(x, self.load_faces, self.load_face_body, self.n_bodies,
+                                         pressure, lower, h)
+        nodal = surface_pressure_forces(x, self.load_faces, pressure, lower, h,
+                                        ambient[self.load_face_body])
+        for body, value in zip(s.bodies, ambient - reference):
+            body.ambient_pressure = float(value)
+        arms = x - self.positions[self.node_body]
+        relative = v - self.velocities[self.node_body]
+        rest_force = loads[:, :3] - _body_sums(nodal, self.offsets)
+        rest_torque = loads[:, 3:] - _body_sums(np.cross(arms, nodal), self.offsets)
+        acceleration = rest_force / self.masses[:, None]
+        angular = np.linalg.solve(self.inertia, rest_torque[..., None])[..., 0]
+        nodal += self.node_masses[:, None] * (acceleration[self.node_body]
+                                              + np.cross(angular[self.node_body], arms))
+        drift = 0.5 * duration * _body_sums(np.cross(relative, nodal), self.offsets)
+        correction = np.linalg.solve(self.inertia, -drift[..., None])[..., 0]
+        nodal += self.node_masses[:, None] * np.cross(correction[self.node_body], arms)
+        s.external_forces[:n] = nodal
+        self.external_loads[:] = loads
+
+    # ------------------------------------------------------------------ state
+    def state_arrays(self) -> dict:
+        s = self.system
+        return {"clock": np.array([s.time, float(s.step_count)]),
+                "positions": s.positions.copy(), "velocities": s.velocities.copy(),
+                "contact_forces": s.contact_forces.copy(), "external_forces": s.external_forces.copy(),
+                "ambient_pressures": np.array([b.ambient_pressure for b in s.bodies]),
+                "contact_pairs": s._pairs.copy(), "listed_positions": s._listed_positions.copy(),
+                "pair_springs": s.pair_springs.copy(),
+                "wall_triangle_springs": s.wall_triangle_springs.copy(),
+                "wall_tet_springs": s.wall_tet_springs.copy()}
+
+    def load_state_arrays(self, arrays: dict) -> None:
+        s = self.system
+        s.time = float(arrays["clock"][0])
+        s.step_count = int(arrays["clock"][1])
+        for name in ("positions", "velocities", "contact_forces", "external_forces"):
+            getattr(s, name)[:] = arrays[name]
+        s._pairs = np.array(arrays["contact_pairs"], dtype=np.int64).reshape(-1, 2)
+        s._listed_positions[:] = arrays["listed_positions"]
+        s.pair_springs = np.array(arrays["pair_springs"], dtype=np.float64).reshape(-1, 3)
+        s.wall_triangle_springs[:] = arrays["wall_triangle_springs"]
+        s.wall_tet_springs[:] = arrays["wall_tet_springs"]
+        for body, ambient in zip(s.bodies, arrays["ambient_pressures"]):
+            body.time = s.time
+            body.step_count = s.step_count
+            body.ambient_pressure = float(ambient)
+        self.refresh()
+
+
+class DeformableCoupledSolver(CoupledSolver):
+    """A :class:`riprap.fluid.solver.FluidSolver` and deformable bodies that push each other.
+
+    Parameters
+    ----------
+    fluid : FluidSolver
+    bodies : DeformableBodies
+        Around a DeformableSystem whose walls already include the fluid box's sides (the
+        coupling adds none: :func:`riprap.coupling.coupled.fluid_box_walls`).
+    check_momentum : bool
+        As for :class:`CoupledSolver`.
+    """
+
+    def __init__(self, fluid, bodies: DeformableBodies, *, check_momentum: bool = False):
+        if getattr(fluid, "obstacle_boxes", None):
+            raise CaseFileError("deformable bodies in a flow with [[fluid.obstacles]] are not "
+                                "available yet: give the obstacles as walls or leave them out")
+        super().__init__(fluid, bodies, wall_material=None, check_momentum=check_momentum)
+        #: Deformable steps in the last fluid step.
+        self.last_substeps = 0
+
+    # the hooks of CoupledSolver
+    def _body_densities(self) -> np.ndarray:
+        return self.solids.densities.copy()
+
+    def _clip_reference(self) -> np.ndarray:
+        s = self.solids.system
+        return s.positions[:s.n_deformable_nodes].copy()
+
+    def _moved_since_clipped(self, nodes) -> np.ndarray:
+        moved = np.linalg.norm(nodes - self._block_poses, axis=1)
+        return np.maximum.reduceat(moved, self.solids.offsets[:-1])
+
+    def _take_reference(self, stale, now) -> None:
+        offsets = self.solids.offsets
+        for body in stale:
+            self._block_poses[offsets[body]:offsets[body + 1]] = now[offsets[body]:offsets[body + 1]]
+
+    def _clip(self, stale) -> list:
+        bodies = self.solids
+        parts, starts = [], [0]
+        for body in stale:
+            part = bodies.triangles[bodies.triangle_start[body]:bodies.triangle_start[body + 1]]
+            parts.append(part)
+            starts.append(starts[-1] + len(part))
+        return half_cell_volumes(self.fluid.grid, self._block_poses, np.concatenate(parts),
+                                 np.asarray(starts, dtype=np.int64))
+
+    def _world_inertia(self):
+        return self.solids.inertia
+
+    def _check_bodies_in_grid(self) -> None:
+        bodies, grid = self.solids, self.fluid.grid
+        lower, upper = np.asarray(grid.lower), np.asarray(grid.upper)
+        x = bodies.system.positions
+        diameters = bodies.nominal_diameters()
+        for b, body in enumerate(bodies.system.bodies):
+            nodes = x[bodies.offsets[b]:bodies.offsets[b + 1]]
+            low, high = nodes.min(axis=0), nodes.max(axis=0)
+            if np.any(low < lower - 1e-12) or np.any(high > upper + 1e-12):
+                raise CaseFileError(
+                    f"coupling: deformable body '{body.name}' reaches {low.round(4).tolist()} .. "
+                    f"{high.round(4).tolist()} m, outside the fluid box {list(lower)} .. "
+                    f"{list(upper)}; move it inside or enlarge the box")
+            across = diameters[b] / grid.cell_size
+            if across < MINIMUM_CELLS_ACROSS:
+                raise CaseFileError(
+                    f"coupling: deformable body '{body.name}' is {across:.2g} cells across (nominal "
+                    f"diameter {diameters[b]:.3g} m, cells {grid.cell_size:.3g} m); a moving body "
+                    f"needs at least {MINIMUM_CELLS_ACROSS} cells across: cells of "
+                    f"{diameters[b] / MINIMUM_CELLS_ACROSS:.3g} m or smaller")
+
+    def _reference_pressure(self) -> float:
+        """The pressure the bodies' surfaces take as zero (Pa). Under an open top the solver's
+        pressure is already the atmosphere's gauge. A closed box fixes its pressure only up to a
+        constant (the solver's has zero mean): the mean of its top layer of cells is taken as
+        zero, as if the lid stood at atmospheric pressure. Only the stresses' isotropic part
+        depends on it: a constant pressure on a closed surface has no resultant."""
+        if self.fluid.grid.open_top:
+            return 0.0
+        top = ~self.fluid.solid[:, :, -1]
+        return float(self.fluid.pressure[:, :, -1][top].mean()) if top.any() else 0.0
+
+    def _advance_solids(self, dt: float) -> int:
+        bodies = self.solids
+        system = bodies.system
+        # the loads' torques are about the centres of the step's start, where the nodes still are
+        bodies.apply_fluid_loads(self.fluid_loads, self.fluid.pressure, self._lower, self.fluid.h,
+                                 self._reference_pressure(), duration=dt)
+        substeps = max(1, math.ceil(dt / self.solid_time_step - 1e-9))
+        system.time_step = dt / substeps
+        system.step(substeps)
+        bodies.refresh()
+        self.last_substeps = substeps
+        return substeps

@@ -1,0 +1,104 @@
+"""Deformable bodies in the flow as a model of the run loop: the coupled run's fluid steps
+(:class:`riprap.models.fluid.CoupledModel`), with the deformable run's stresses
+(:class:`riprap.models.deformable.DeformableModel`): ``bodies.pvd`` carries the stress fields,
+``units.csv`` the largest tensile stress of every unit (looked for after every fluid step), and
+``peak_stress.png``/``final_stress.png`` show them."""
+from __future__ import annotations
+
+import numpy as np
+
+from riprap.models.fluid import CoupledModel, FluidModel
+
+__all__ = ["DeformableCoupledModel"]
+
+
+class DeformableCoupledModel(CoupledModel):
+    """A :class:`riprap.coupling.deformable_coupled.DeformableCoupledSolver` stepped by the
+    fluid's steps; ``stresses`` (a DeformableModel of the same system) keeps the stress records
+    and writes the bodies' outputs."""
+
+    kind = "riprap deformable coupled run"
+    name = "deformable_coupled"
+
+    def __init__(self, coupled, stresses):
+        super().__init__(coupled)
+        self.stresses = stresses
+        self.deformable_steps = 0
+
+    @property
+    def system(self):
+        return self.stresses.system
+
+    def prepare(self, *, restarted: bool) -> None:
+        if not restarted:
+            self.stresses.check_start_overlaps()
+        self.stresses._record_stresses()
+
+    def advance(self, until: float) -> None:
+        super().advance(until)
+        self.deformable_steps += self.solver.last_substeps
+        self.stresses._record_stresses()
+
+    # ------------------------------------------------------------------ state
+    def state_arrays(self) -> dict:
+        arrays = super().state_arrays()
+        records = self.stresses.records
+        arrays.update({"record_stress": records.stress.copy(), "record_element": records.element.copy(),
+                       "record_point": records.point.copy(), "record_time": records.time.copy()})
+        return arrays
+
+    def load_state_arrays(self, arrays: dict) -> None:
+        super().load_state_arrays(arrays)
+        records = self.stresses.records
+        records.stress[:] = arrays["record_stress"]
+        records.element[:] = arrays["record_element"]
+        records.point[:] = arrays["record_point"]
+        records.time[:] = arrays["record_time"]
+
+    def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
+        arrays, metadata = super().checkpoint_content(state)
+        arrays["reference_nodes"] = np.concatenate([b.elements.reference_nodes
+                                                    for b in self.system.bodies])
+        metadata["body_names"] = self.stresses.body_names
+        return arrays, metadata
+
+    def check_checkpoint(self, path, arrays: dict, metadata: dict) -> None:
+        super().check_checkpoint(path, arrays, metadata)
+        self.stresses.check_checkpoint(path, arrays, {"bodies": metadata.get("body_names"),
+                                                      "rigid_bodies": 0})
+
+    # ------------------------------------------------------------------ outputs
+    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
+        super().open_outputs(directory, append=append, paraview=paraview, picture=picture)
+        self.stresses._directory = directory
+        self.stresses._picture = picture
+        # the bodies' frames carry the stresses, in the series run.pvd opens with the fluid's
+        self.stresses._series = self._body_series
+
+    def _write_bodies(self) -> None:
+        self.stresses.write_frame(0)
+
+    def close_outputs(self) -> dict:
+        outputs = super().close_outputs()
+        for key, value in self.stresses.close_outputs().items():
+            if key != "paraview":
+                outputs[key] = value
+        return outputs
+
+    def progress_text(self) -> str:
+        return super().progress_text() + "  " + self.stresses.progress_text().split("  dt")[0]
+
+    def summary_fields(self, wall_time: float, steps: int) -> dict:
+        fields = FluidModel.summary_fields(self, wall_time, steps)
+        bodies = self.solids
+        fields.update({"bodies": bodies.n_bodies, "solid_substeps": self.substeps,
+                       "time_step": self.system.time_step,
+                       "max_speed": float(np.linalg.norm(self.system.velocities, axis=1).max(initial=0.0)),
+                       "element_steps_per_second": (self.deformable_steps * len(self.system.elements)
+                                                    / max(wall_time, 1e-9)),
+                       "max_tensile_stress": float(self.stresses.records.stress.max())})
+        return fields
+
+    def failure_advice(self, good: dict) -> str:
+        return (super().failure_advice(good) + " An element that inverted: " +
+                self.stresses.failure_advice(good))
