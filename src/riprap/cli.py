@@ -36,7 +36,9 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
     if case.is_fluid:
         sim = build_fluid_run(case, output_directory=out, progress=not quiet)
         grid = sim.fluid.grid
-        bodies = f", {sim.solver.n_bodies} bodies coupled to the flow" if sim.coupled else ""
+        deformable = f" ({len(sim.deformable_bodies)} deformable)" if sim.deformable_bodies else ""
+        bodies = (f", {sim.solver.n_bodies + len(sim.deformable_bodies)} bodies{deformable} "
+                  "coupled to the flow" if sim.coupled else "")
         print(f"riprap: fluid case {path}: {grid.cells[0]} x {grid.cells[1]} x {grid.cells[2]} "
               f"cells of {grid.cell_size:.4g} m ({'2D' if grid.two_dimensional else '3D'}), water "
               f"{sim.fluid.water_volume():.4g} m^3{bodies}")

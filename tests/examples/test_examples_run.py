@@ -8,7 +8,8 @@ import pytest
 from riprap.cli import main
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-CASES = sorted(EXAMPLES.glob("*/case.toml"))
+# every folder's case.toml, and the variants beside it (e.g. 04's deformable sphere)
+CASES = sorted(EXAMPLES.glob("*/*.toml"))
 
 
 @pytest.fixture(autouse=True)
@@ -31,9 +32,10 @@ def test_demo_runs(tmp_path):
     _check_outputs(tmp_path / "demo", bodies=32)
 
 
-@pytest.mark.parametrize("case", CASES, ids=[c.parent.name for c in CASES])
+@pytest.mark.parametrize("case", CASES, ids=[f"{c.parent.name}/{c.stem}" for c in CASES])
 def test_example_runs(case, tmp_path):
-    assert main(["run", str(case), "--out", str(tmp_path / case.parent.name), "--quiet"]) == 0
+    assert main(["run", str(case), "--out", str(tmp_path / case.parent.name / case.stem),
+                 "--quiet"]) == 0
     text = case.read_text()
     assert "riprap run examples/" in text, "each example says how to run it"
 

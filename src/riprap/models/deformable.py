@@ -382,18 +382,26 @@ class DeformableModel(Model):
             values.append(sigma_1[owners + s.element_offsets[k]])
         triangles = np.concatenate(triangles)
         values = np.concatenate(values) / 1e6
-        reach = float(np.abs(values).max())
+        low, high = float(values.min()), float(values.max())
+        if low < 0.0 < high:
+            # tension and compression: white at zero
+            colour_map, value_range = "coolwarm", (-max(-low, high), max(-low, high))
+        else:
+            # one sign throughout (a body squeezed by the water all round): its own range
+            colour_map, value_range = "viridis", (low, high if high > low else low + 1e-9)
         if peak:
             worst = int(np.argmax(self.records.stress))
-            title = (f"t = {time:.4g} s: largest tensile stress of the run, "
-                     f"{self.records.stress[worst] / 1e6:.3g} MPa in {self.body_names[worst]}")
+            what = ("largest tensile stress of the run" if self.records.stress[worst] > 0.0
+                    else "least compression of the run (no tension)")
+            title = (f"t = {time:.4g} s: {what}, {self.records.stress[worst] / 1e6:.3g} MPa in "
+                     f"{self.body_names[worst]}")
         else:
-            title = (f"end of the run, t = {time:.4g} s: largest tensile stress "
-                     f"{float(sigma_1.max()) / 1e6:.3g} MPa")
+            what = "largest tensile stress" if sigma_1.max() > 0.0 else "all in compression, sigma_1 up to"
+            title = f"end of the run, t = {time:.4g} s: {what} {float(sigma_1.max()) / 1e6:.3g} MPa"
         return render_bodies_png(
             path, triangles_world=triangles, body_ids=np.arange(len(triangles)), values=values,
-            value_label="largest principal stress sigma_1 (MPa, tension +)", colour_map="coolwarm",
-            value_range=(-reach, reach), title=title)
+            value_label="largest principal stress sigma_1 (MPa, tension +)", colour_map=colour_map,
+            value_range=value_range, title=title)
 
     def progress_text(self) -> str:
         s = self.system

@@ -30,9 +30,10 @@ class DeformableCoupledModel(CoupledModel):
         return self.stresses.system
 
     def prepare(self, *, restarted: bool) -> None:
+        # no stress record at the start: the bodies are put in the water unloaded, a state the
+        # run never has once the water's pressure is on them (records follow every fluid step)
         if not restarted:
             self.stresses.check_start_overlaps()
-        self.stresses._record_stresses()
 
     def advance(self, until: float) -> None:
         super().advance(until)
