@@ -296,32 +296,16 @@ class Simulation:
         return CoupledModel(CoupledSolver(self.fluid, self.solver, obstacle_bodies=obstacle_bodies))
 
     def _deformable_model(self):
-        from riprap.deformable.system import DeformableSystem
         from riprap.models.deformable import DeformableModel
 
         if self.fluid is not None:
             return self._deformable_coupled_model()
         solver = self.solver
-        rigid_surfaces = []
         if solver.n_bodies > 0:
             # rigid bodies too: they keep their own solver, stepped with the deformable bodies'
             # step, and meet the deformable bodies through their surface layers
             self.build_without_checks()
-            for b in range(solver.n_bodies):
-                shape = solver.shapes[int(solver.shape_index[b])]
-                material = solver.materials[int(solver.material_index_of_body[b])]
-                mass = np.inf if solver.fixed[b] else float(solver.masses[b])
-                rigid_surfaces.append((shape.mesh.nodes, shape.mesh.tets,
-                                       material.friction_coefficient, mass,
-                                       material.damping_ratio))
-        walls = [(wall.point, wall.normal,
-                  solver.materials[solver.material_index(wall.material)].friction_coefficient)
-                 for wall in solver.walls]
-        system = DeformableSystem(self.deformable_bodies, walls=walls,
-                                  contact_penalty=self.deformable_contact_penalty,
-                                  gravity=solver.gravity,
-                                  mass_damping=self.deformable_mass_damping,
-                                  rigid_surfaces=rigid_surfaces)
+        system = self._deformable_system(solver.gravity)
         step = self.requested_time_step if self.requested_time_step > 0 else system.time_step
         if solver.n_bodies > 0:
             step = min(step, solver.time_step)
@@ -331,12 +315,38 @@ class Simulation:
                                case_numbers=self._case_numbers(),
                                accepted_depths=self.deformable_accepted_depths)
 
-    def _deformable_coupled_model(self):
-        """Deformable bodies in the flow (``riprap.coupling.deformable_coupled``); the fluid box's
-        sides (all but an open top) and the case's walls bound them."""
-        from riprap.coupling.coupled import fluid_box_walls
-        from riprap.coupling.deformable_coupled import DeformableBodies, DeformableCoupledSolver
+    def _deformable_system(self, gravity, extra_walls=()):
+        """The deformable bodies joined in one system, with the rigid solver's bodies (built
+        already) as surfaces they touch, its walls, and ``extra_walls`` not already among them
+        (with the deformable bodies' smallest friction coefficient)."""
+        from riprap.coupling.coupled import _same_plane
         from riprap.deformable.system import DeformableSystem
+
+        solver = self.solver
+        rigid_surfaces = []
+        for b in range(solver.n_bodies):
+            shape = solver.shapes[int(solver.shape_index[b])]
+            material = solver.materials[int(solver.material_index_of_body[b])]
+            mass = np.inf if solver.fixed[b] else float(solver.masses[b])
+            rigid_surfaces.append((shape.mesh.nodes, shape.mesh.tets, material.friction_coefficient,
+                                   mass, material.damping_ratio))
+        walls = [(wall.point, wall.normal,
+                  solver.materials[solver.material_index(wall.material)].friction_coefficient)
+                 for wall in solver.walls]
+        friction = min(b.material.friction_coefficient for b in self.deformable_bodies)
+        walls += [(wall.point, wall.normal, friction) for wall in extra_walls
+                  if not any(_same_plane(wall, other) for other in solver.walls)]
+        return DeformableSystem(self.deformable_bodies, walls=walls,
+                                contact_penalty=self.deformable_contact_penalty, gravity=gravity,
+                                mass_damping=self.deformable_mass_damping,
+                                rigid_surfaces=rigid_surfaces)
+
+    def _deformable_coupled_model(self):
+        """Deformable bodies (and rigid ones, if any) in the flow
+        (``riprap.coupling.deformable_coupled``); the fluid box's sides (all but an open top) and
+        the case's walls bound them."""
+        from riprap.coupling.coupled import _same_plane, fluid_box_walls
+        from riprap.coupling.deformable_coupled import DeformableBodies, DeformableCoupledSolver
         from riprap.models.deformable import DeformableModel
         from riprap.models.deformable_coupled import DeformableCoupledModel
 
@@ -345,26 +355,19 @@ class Simulation:
             raise CaseFileError("deformable bodies cannot join a CoupledSolver built by the caller: "
                                 "give the Simulation a FluidSolver")
         if solver.n_bodies > 0:
-            raise CaseFileError(f"{solver.n_bodies} rigid bodies beside deformable ones in a flow: "
-                                "not available yet; make every body of a run with [fluid] "
-                                "deformable ([deformable] bodies = \"all\"), or none")
-        walls = [(wall.point, wall.normal,
-                  solver.materials[solver.material_index(wall.material)].friction_coefficient)
-                 for wall in solver.walls]
-        friction = min(b.material.friction_coefficient for b in self.deformable_bodies)
-        for wall in fluid_box_walls(self.fluid.grid, ""):
-            # a side that is already a wall (the same plane) is not added twice
-            if not any(np.allclose(wall.normal, w[1]) and
-                       abs(np.dot(np.subtract(wall.point, w[0]), wall.normal)) < 1e-9 for w in walls):
-                walls.append((wall.point, wall.normal, friction))
-        system = DeformableSystem(self.deformable_bodies, walls=walls,
-                                  contact_penalty=self.deformable_contact_penalty,
-                                  gravity=self.fluid.gravity,
-                                  mass_damping=self.deformable_mass_damping)
+            # the sides of the box are walls for the rigid bodies too (unless already there)
+            material = solver.materials[0].name
+            solver.add_walls([wall for wall in fluid_box_walls(self.fluid.grid, material)
+                              if not any(_same_plane(wall, other) for other in solver.walls)])
+            self._prepare_bodies()
+        system = self._deformable_system(self.fluid.gravity,
+                                         extra_walls=fluid_box_walls(self.fluid.grid, ""))
         if self.requested_time_step > 0:
             system.time_step = self.requested_time_step
-        coupled = DeformableCoupledSolver(self.fluid, DeformableBodies(system))
-        stresses = DeformableModel(system, case_numbers=self._case_numbers(),
+        coupled = DeformableCoupledSolver(self.fluid, DeformableBodies(
+            system, rigid=solver if solver.n_bodies > 0 else None))
+        stresses = DeformableModel(system, rigid=self if solver.n_bodies > 0 else None,
+                                   case_numbers=self._case_numbers(),
                                    accepted_depths=self.deformable_accepted_depths)
         return DeformableCoupledModel(coupled, stresses)
 

@@ -1,15 +1,12 @@
 """Deformable bodies in the flow through the run loop and case files: a case with [fluid] and
 [deformable] runs coupled and writes the fluid's and the bodies' outputs (stresses in bodies.pvd,
-units.csv, body_forces.csv, run.pvd); a restart continues bit for bit; what is not available yet
-is refused with a message that says what to do."""
+units.csv, body_forces.csv, run.pvd); rigid bodies beside them in the same flow; a restart
+continues bit for bit."""
 import csv
 
 import numpy as np
-import pytest
-
 from riprap.case.build_fluid import build_fluid_run
 from riprap.case.load import load_case
-from riprap.errors import CaseFileError
 
 CASE = """
 format_version = 1
@@ -94,10 +91,38 @@ def test_restart_continues_bit_for_bit(tmp_path):
         assert np.array_equal(a[key], b[key]), key
 
 
-def test_rigid_bodies_beside_deformable_ones_in_a_flow_are_refused(tmp_path):
-    rigid = ('[[bodies]]\nshape = "block"\nmaterial = "block"\nposition = [0.15, 0.15, 0.05]\n')
-    path = tmp_path / "case.toml"
-    text = CASE.format(end_time=0.02, more_bodies=rigid).replace('bodies = "all"', "bodies = [0]")
+RIGID_BLOCK = '[[bodies]]\nshape = "block"\nmaterial = "block"\nposition = [0.15, 0.15, 0.035]\nfixed = true\n'
+
+
+def _mixed(tmp_path, name, end_time, *, restart=None):
+    path = tmp_path / f"{name}.toml"
+    text = CASE.format(end_time=end_time, more_bodies=RIGID_BLOCK).replace(
+        'bodies = "all"', "bodies = [0]").replace("position = [0.15, 0.15, 0.15]",
+                                                  "position = [0.15, 0.15, 0.0951]")
     path.write_text(text)
-    with pytest.raises(CaseFileError, match="rigid bodies beside deformable ones in a flow"):
-        build_fluid_run(load_case(path), output_directory=tmp_path / "out", progress=False).run()
+    sim = build_fluid_run(load_case(path), output_directory=tmp_path / name, progress=False)
+    return sim, sim.run(restart_from=restart)
+
+
+def test_rigid_and_deformable_bodies_in_one_flow(tmp_path):
+    sim, summary = _mixed(tmp_path, "out", 0.04)
+    out = tmp_path / "out"
+    assert summary.model == "deformable_coupled" and summary.bodies == 2
+    for name in ("bodies.pvd", "rigid_bodies.pvd", "run.pvd", "units.csv"):
+        assert (out / name).is_file(), name
+    assert (out / "run.pvd").read_text().count('part="2"') >= 2, "fluid, deformable and rigid"
+    bodies = sim.model.solids
+    assert bodies.n_rigid == 1 and bodies.fixed.tolist() == [True, False]
+    # the deformable block lands on the rigid one: the forces cross between the two solvers
+    assert bodies.rigid_contact_loads[0, 2] < 0.0
+    assert bodies.contact_forces()[0, 2] == bodies.rigid_contact_loads[0, 2]
+
+
+def test_mixed_run_in_a_flow_restarts_bit_for_bit(tmp_path):
+    whole, _ = _mixed(tmp_path, "whole", 0.04)
+    _mixed(tmp_path, "part", 0.02)
+    second, _ = _mixed(tmp_path, "part", 0.04, restart=tmp_path / "part" / "checkpoint.npz")
+    a, b = whole.model.state_arrays(), second.model.state_arrays()
+    for key in ("bodies_positions", "bodies_velocities", "bodies_rigid_contact_loads", "u", "w",
+                "record_stress"):
+        assert np.array_equal(a[key], b[key]), key

@@ -17,6 +17,10 @@ Sources and tolerances:
 - Archimedes: a sphere twice as dense as water sinks to the floor and rests on its contact, which
   carries its submerged weight (rho_s - rho_w) g V within ``REST_LOAD_TOLERANCE`` = 10 % (the
   rigid spheres' figure, ``test_coupling_still_water.py``; measured 5 %).
+- A stack under water, a rigid cube on a deformable one on a fixed rigid slab, after 0.5 s: the slab carries both cubes' submerged weights within ``STACK_TOLERANCE`` = 5 %
+  (measured +1.0 %), each contact its share within ``REST_LOAD_TOLERANCE`` (measured: the
+  deformable cube pushes the rigid one up with +6 % of its submerged weight, and itself rests
+  on the slab with -4 % of its own): the forces pass between the two solvers and the fluid.
 - The same sphere rigid and deformable (stiff, so it hardly deforms) falls the same: speed within
   ``FALL_SPEED_TOLERANCE`` = 1 % after 0.6 s (measured 0.1 %); a small initial spin is kept as
   the rigid sphere keeps it, within a factor ``SPIN_FACTOR`` = 2 (measured 1.3; before the
@@ -26,6 +30,7 @@ Sources and tolerances:
 import numpy as np
 import pytest
 
+import riprap as rr
 from riprap import FluidGrid, FluidSolver
 from riprap.coupling.coupled import CoupledSolver, fluid_box_walls
 from riprap.coupling.deformable_coupled import DeformableBodies, DeformableCoupledSolver
@@ -43,6 +48,7 @@ MEAN_STRESS_TOLERANCE = 0.02
 DIFFERENTIAL_TET4 = 0.06
 DIFFERENTIAL_TET10 = 0.03
 REST_LOAD_TOLERANCE = 0.10
+STACK_TOLERANCE = 0.05
 FALL_SPEED_TOLERANCE = 0.01
 SPIN_FACTOR = 2.0
 WATER = 998.2
@@ -126,6 +132,29 @@ def test_sphere_sinks_and_rests_on_its_submerged_weight():
     assert abs(bodies.velocities[0, 2]) < 5e-3, "it has come to rest"
     assert bodies.positions[0, 2] < 0.06, "on the floor"
     assert abs(np.mean(contact) / submerged - 1.0) < REST_LOAD_TOLERANCE
+
+
+def test_stack_of_rigid_and_deformable_cubes_rests_on_its_submerged_weights(tmp_path):
+    sim = rr.Simulation(end_time=0.5, output_interval=0.5, output_directory=tmp_path,
+                        progress=False, picture=False, paraview=False)
+    sim.add_fluid(_tank((0.4, 0.4, 0.4), (16, 16, 16), level=0.3))
+    sim.add_shape("slab", shapes.box(lengths=(0.2, 0.2, 0.1), mesh_size=0.05))
+    sim.add_shape("cube", shapes.cube(side=0.1, mesh_size=0.035))
+    sim.add_material(rr.Material(name="rock", density=2000.0, contact_penalty=1e7,
+                                 restitution=0.3))
+    sim.add_body(shape="slab", material="rock", position=(0.2, 0.2, 0.05), fixed=True)
+    sim.add_body(shape="cube", material="rock", position=(0.2, 0.2, 0.2502))
+    sim.add_deformable_body(shape="cube", material=ElasticMaterial(
+        density=2000.0, young_modulus=1e6, poisson_ratio=0.25, viscosity=50.0),
+        position=(0.2, 0.2, 0.1501), name="middle")
+    sim.run()
+    bodies = sim.model.solids          # the slab, the rigid cube, the deformable cube
+    submerged = (2000.0 - WATER) * 9.81 * 1e-3
+    assert np.abs(bodies.velocities).max() < 1e-3, "at rest"
+    contact = bodies.contact_forces()[:, 2]
+    assert -contact[0] == pytest.approx(2 * submerged, rel=STACK_TOLERANCE)
+    assert contact[1] == pytest.approx(submerged, rel=REST_LOAD_TOLERANCE)
+    assert contact[2] == pytest.approx(submerged, rel=REST_LOAD_TOLERANCE)
 
 
 def test_deformable_sphere_falls_and_keeps_its_spin_as_the_rigid_one():

@@ -254,8 +254,8 @@ TABLES: tuple[Table, ...] = (
           "Deformable bodies (`riprap run`): which bodies deform, their elastic material (density, "
           "friction coefficient and restitution are their `[[materials]]` entry's), elements and "
           "contact. The other bodies stay rigid. Explicit finite-strain tetrahedra "
-          "(docs/deformable.md); stresses in every frame and units.csv. With `[fluid]` every body "
-          "must deform; the water loads their surfaces."),
+          "(docs/deformable.md); stresses in every frame and units.csv. With `[fluid]` the water "
+          "loads their surfaces."),
     Table("output", False, 1, None, "Where and what riprap writes."),
 )
 

@@ -432,7 +432,10 @@ class CoupledSolver:
     def _check_bodies_in_grid(self) -> None:
         """Refuse a body that reaches outside the fluid box, or a moving body narrower than
         ``MINIMUM_CELLS_ACROSS`` cells (its drag and buoyancy would be noise)."""
-        solids, grid = self.solids, self.fluid.grid
+        self._check_rigid_bodies_in_grid(self.solids)
+
+    def _check_rigid_bodies_in_grid(self, solids) -> None:
+        grid = self.fluid.grid
         lower, upper = np.asarray(grid.lower), np.asarray(grid.upper)
         rotations = solids.rotation_matrices()
         table = solids.table

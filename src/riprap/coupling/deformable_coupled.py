@@ -26,7 +26,9 @@ step pick up as the nodes move (taken off at the start: the angular impulse is t
 order in the step). The deformation velocity of the nodes (strain rate times the body's size:
 micrometres per second for concrete) does not enter the fluid: a grid of centimetre cells cannot
 carry it. Within a fluid step the bodies take their own central-difference steps (contacts with
-each other and with the walls throughout) with the nodal loads held.
+each other and with the walls throughout) with the nodal loads held. Rigid bodies in the same
+flow take the rigid exchange as in a rigid coupled run and step with the deformable ones, step by
+step, the contact forces between them passed over at every step (as in a dry mixed run).
 """
 from __future__ import annotations
 
@@ -35,7 +37,7 @@ import math
 import numpy as np
 
 from riprap.coupling.coupled import MINIMUM_CELLS_ACROSS, CoupledSolver
-from riprap.coupling.solid_volumes import half_cell_volumes
+from riprap.coupling.solid_volumes import half_cell_volumes, rigid_body_half_cell_volumes
 from riprap.deformable.elements import boundary_face_nodes, boundary_faces_with_owners
 from riprap.errors import CaseFileError
 
@@ -124,45 +126,63 @@ def surface_mean_pressures(positions: np.ndarray, faces: np.ndarray, face_body: 
 
 
 class DeformableBodies:
-    """The deformable bodies of a :class:`riprap.deformable.system.DeformableSystem` as the
-    coupling sees them: per body its mass, centre, mean velocity, angular momentum and inertia
-    (sums over its nodes), the forces on it and the fluid's load; its deformed surface; and the
-    fluid's load handed to its nodes (:meth:`apply_fluid_loads`).
+    """The bodies of a :class:`riprap.deformable.system.DeformableSystem` as the coupling sees
+    them: per body its mass, centre, mean velocity, angular momentum and inertia (sums over its
+    nodes), the forces on it and the fluid's load; its deformed surface; and the fluid's load
+    handed to its nodes (:meth:`apply_fluid_loads`).
 
-    The system must hold deformable bodies only (rigid bodies in the same flow are not joined
-    here)."""
+    With ``rigid`` (the :class:`riprap.solid.solver.SolidSolver` whose bodies are the system's
+    rigid surfaces, in the same order), the rigid bodies come first (0 .. n_rigid - 1, their
+    numbers in the solver) and the deformable ones after them; both take the same steps
+    (:meth:`advance`), the contact forces between them passed over every step."""
 
-    def __init__(self, system):
-        if system.n_rigid:
-            raise CaseFileError("deformable and rigid bodies in one flow are not available yet: "
-                                "make every body of a run with [fluid] deformable, or none")
+    def __init__(self, system, rigid=None):
+        n_rigid = rigid.n_bodies if rigid is not None else 0
+        if system.n_rigid != n_rigid:
+            raise CaseFileError(f"the deformable system has {system.n_rigid} rigid surfaces, the rigid "
+                                f"solver {n_rigid} bodies")
         self.system = system
-        self.n_bodies = len(system.bodies)
-        self.fixed = np.zeros(self.n_bodies, dtype=bool)
+        self.rigid = rigid
+        self.n_rigid = n_rigid
+        n_deformable = len(system.bodies)
+        self.n_bodies = n_rigid + n_deformable
         self.gravity = system.gravity
         self.offsets = system.node_offsets
         n = system.n_deformable_nodes
         self.node_masses = system.masses[:n]
-        self.masses = _body_sums(self.node_masses, self.offsets)
-        self.densities = np.array([b.material.density for b in system.bodies], dtype=np.float64)
+        self._deformable_masses = _body_sums(self.node_masses, self.offsets)
+        deformable_densities = np.array([b.material.density for b in system.bodies], dtype=np.float64)
+        if rigid is not None:
+            rigid.finalize()
+            self.fixed = np.concatenate([rigid.fixed, np.zeros(n_deformable, dtype=bool)])
+            self.masses = np.concatenate([rigid.masses, self._deformable_masses])
+            self.densities = np.concatenate([[rigid.materials[m].density
+                                              for m in rigid.material_index_of_body],
+                                             deformable_densities])
+        else:
+            self.fixed = np.zeros(n_deformable, dtype=bool)
+            self.masses = self._deformable_masses.copy()
+            self.densities = deformable_densities
         triangles, starts = [], [0]
         for k, body in enumerate(system.bodies):
             faces, _ = boundary_faces_with_owners(body.elements.contact_tets())
             triangles.append(faces + self.offsets[k])
             starts.append(starts[-1] + len(faces))
-        #: Outward boundary triangles of every body (the sub-tets' faces for 10-node bodies):
-        #: the surface the fluid grid sees.
+        #: Outward boundary triangles of every deformable body (the sub-tets' faces for 10-node
+        #: bodies): the surface the fluid grid sees; body k's from triangle_start[k].
         self.triangles = np.concatenate(triangles).astype(np.int64)
         self.triangle_start = np.asarray(starts, dtype=np.int64)
-        #: The bodies' element faces on their surfaces (6 nodes for 10-node tets): where the
-        #: pressure loads them.
+        #: The deformable bodies' element faces on their surfaces (6 nodes for 10-node tets):
+        #: where the pressure loads them.
         faces = [boundary_face_nodes(body.elements.elements) + self.offsets[k]
                  for k, body in enumerate(system.bodies)]
         self.load_faces = np.concatenate(faces).astype(np.int64)
-        self.load_face_body = np.repeat(np.arange(self.n_bodies), [len(f) for f in faces])
-        self.node_body = np.repeat(np.arange(self.n_bodies), np.diff(self.offsets))
+        self.load_face_body = np.repeat(np.arange(n_deformable), [len(f) for f in faces])
+        self.node_body = np.repeat(np.arange(n_deformable), np.diff(self.offsets))
         #: The fluid's force and torque on every body, held over the present step (N, N m).
         self.external_loads = np.zeros((self.n_bodies, 6))
+        #: Force and torque of the deformable bodies' contacts on each rigid body, last step.
+        self.rigid_contact_loads = np.zeros((n_rigid, 6))
         self.refresh()
 
     def finalize(self) -> None:
@@ -170,7 +190,14 @@ class DeformableBodies:
 
     @property
     def time_step(self) -> float:
-        return self.system.time_step
+        """The longest step both kinds of body take (s)."""
+        if self.rigid is None:
+            return self.system.time_step
+        return min(self.system.time_step, self.rigid.time_step)
+
+    def deformable(self, body: int) -> int:
+        """The system's number of body ``body`` (which must be deformable)."""
+        return body - self.n_rigid
 
     # ------------------------------------------------------------------ per body
     def refresh(self) -> None:
@@ -178,27 +205,76 @@ class DeformableBodies:
         s, n = self.system, self.system.n_deformable_nodes
         m = self.node_masses[:, None]
         x, v = s.positions[:n], s.velocities[:n]
-        self.positions = _body_sums(m * x, self.offsets) / self.masses[:, None]
-        self.velocities = _body_sums(m * v, self.offsets) / self.masses[:, None]
-        arms = x - self.positions[self.node_body]
-        self.angular_momenta = _body_sums(np.cross(arms, m * v), self.offsets)
+        mass = self._deformable_masses[:, None]
+        positions = _body_sums(m * x, self.offsets) / mass
+        velocities = _body_sums(m * v, self.offsets) / mass
+        arms = x - positions[self.node_body]
+        angular_momenta = _body_sums(np.cross(arms, m * v), self.offsets)
         squared = np.einsum("ni,ni->n", arms, arms)
-        self.inertia = (_body_sums(m[:, 0, None, None] * (squared[:, None, None] * np.eye(3)
-                                                          - arms[:, :, None] * arms[:, None, :]),
-                                   self.offsets))
+        inertia = _body_sums(m[:, 0, None, None] * (squared[:, None, None] * np.eye(3)
+                                                    - arms[:, :, None] * arms[:, None, :]),
+                             self.offsets)
         # the last step's force on every node (contacts, gravity, the fluid's load held);
         # the internal forces sum to nothing
         total = s.contact_forces[:n] + m * s.gravity + s.external_forces[:n]
-        self.forces = _body_sums(total, self.offsets)
-        self.torques = _body_sums(np.cross(arms, total), self.offsets)
+        forces = _body_sums(total, self.offsets)
+        torques = _body_sums(np.cross(arms, total), self.offsets)
+        self._deformable_positions = positions
+        self._deformable_velocities = velocities
+        if self.rigid is not None:
+            r = self.rigid
+            rotations = r.rotation_matrices()
+            world = np.einsum("bij,bj,bkj->bik", rotations, r.principal_inertia, rotations)
+            positions = np.concatenate([r.positions, positions])
+            velocities = np.concatenate([r.velocities, velocities])
+            angular_momenta = np.concatenate([r.angular_momenta, angular_momenta])
+            inertia = np.concatenate([world, inertia])
+            forces = np.concatenate([r.forces, forces])
+            torques = np.concatenate([r.torques, torques])
+            self._rotations = rotations
+        self.positions, self.velocities, self.angular_momenta = positions, velocities, angular_momenta
+        self.inertia, self.forces, self.torques = inertia, forces, torques
 
     def contact_forces(self) -> np.ndarray:
         """Total contact force on every body at the last step (N)."""
-        return _body_sums(self.system.contact_forces[:self.system.n_deformable_nodes], self.offsets)
+        deformable = _body_sums(self.system.contact_forces[:self.system.n_deformable_nodes],
+                                self.offsets)
+        if self.rigid is None:
+            return deformable
+        # the rigid solver's own contacts (its loads less gravity and the fluid's) and the
+        # deformable bodies' on them; a fixed body only has the latter (its solver sums none)
+        rigid = np.where(self.rigid.fixed[:, None], self.rigid_contact_loads[:, :3],
+                         self.rigid.contact_forces() + self.rigid_contact_loads[:, :3])
+        return np.concatenate([rigid, deformable])
 
     def nominal_diameters(self) -> np.ndarray:
-        """(mass / density)^(1/3) of every body (m)."""
-        return (self.masses / self.densities) ** (1.0 / 3.0)
+        """(mass / density)^(1/3) of every deformable body (m)."""
+        return (self._deformable_masses / self.densities[self.n_rigid:]) ** (1.0 / 3.0)
+
+    # ------------------------------------------------------------------ steps
+    def advance(self, n_steps: int, time_step: float) -> None:
+        """``n_steps`` steps of ``time_step`` (s) for all bodies, with the fluid's loads held:
+        without rigid bodies in one call; with them step by step, the rigid bodies' surfaces
+        placed in the system before each step and the deformable bodies' contact forces on them
+        handed back as loads (beside the fluid's) for their own step."""
+        system = self.system
+        system.time_step = time_step
+        if self.rigid is None:
+            system.step(n_steps)
+            return
+        rigid = self.rigid
+        rigid.set_time_step(time_step)
+        moving = ~rigid.fixed
+        fluid = self.external_loads[:self.n_rigid]
+        for _ in range(n_steps):
+            system.set_rigid_poses(rigid.rotation_matrices(), rigid.positions, rigid.velocities,
+                                   rigid.angular_velocities, moving=moving)
+            system.step(1)
+            forces, torques = system.rigid_loads(rigid.positions)
+            self.rigid_contact_loads[:, :3] = forces
+            self.rigid_contact_loads[:, 3:] = torques
+            rigid.external_loads[:] = fluid + self.rigid_contact_loads
+            rigid.advance(1)
 
     # ------------------------------------------------------------------ loads
     def apply_fluid_loads(self, loads: np.ndarray, pressure: np.ndarray, lower, h: float,
@@ -213,30 +289,40 @@ class DeformableBodies:
         average over ``duration``, from the nodes' present velocities relative to the body's, is
         therefore taken off at the start, so that the body's angular impulse over the step is
         its load's (to first order in the step; the force's impulse is exact)."""
+        if self.rigid is not None:
+            # the rigid bodies take theirs whole; the last sub-step's forces (used by the first
+            # half kick) take the change too
+            change = loads[:self.n_rigid] - self.external_loads[:self.n_rigid]
+            self.rigid.forces += change[:, :3]
+            self.rigid.torques += change[:, 3:]
+            self.rigid.external_loads[:] = loads[:self.n_rigid] + self.rigid_contact_loads
+        self.external_loads[:] = loads
+        loads = loads[self.n_rigid:]
         s, n = self.system, self.system.n_deformable_nodes
         x, v = s.positions[:n], s.velocities[:n]
+        centres, mean_velocities = self._deformable_positions, self._deformable_velocities
         # The mean pressure on each body's surface is left to its ambient_pressure: at depth it
         # is most of the pressure, and held fixed while the body turns it would be most of the
         # drift below.
-        ambient = surface_mean_pressures(x, self.load_faces, self.load_face_body, self.n_bodies,
+        ambient = surface_mean_pressures(x, self.load_faces, self.load_face_body, len(s.bodies),
                                          pressure, lower, h)
         nodal = surface_pressure_forces(x, self.load_faces, pressure, lower, h,
                                         ambient[self.load_face_body])
         for body, value in zip(s.bodies, ambient - reference):
             body.ambient_pressure = float(value)
-        arms = x - self.positions[self.node_body]
-        relative = v - self.velocities[self.node_body]
+        arms = x - centres[self.node_body]
+        relative = v - mean_velocities[self.node_body]
         rest_force = loads[:, :3] - _body_sums(nodal, self.offsets)
         rest_torque = loads[:, 3:] - _body_sums(np.cross(arms, nodal), self.offsets)
-        acceleration = rest_force / self.masses[:, None]
-        angular = np.linalg.solve(self.inertia, rest_torque[..., None])[..., 0]
+        inertia = self.inertia[self.n_rigid:]
+        acceleration = rest_force / self._deformable_masses[:, None]
+        angular = np.linalg.solve(inertia, rest_torque[..., None])[..., 0]
         nodal += self.node_masses[:, None] * (acceleration[self.node_body]
                                               + np.cross(angular[self.node_body], arms))
         drift = 0.5 * duration * _body_sums(np.cross(relative, nodal), self.offsets)
-        correction = np.linalg.solve(self.inertia, -drift[..., None])[..., 0]
+        correction = np.linalg.solve(inertia, -drift[..., None])[..., 0]
         nodal += self.node_masses[:, None] * np.cross(correction[self.node_body], arms)
         s.external_forces[:n] = nodal
-        self.external_loads[:] = loads
 
     # ------------------------------------------------------------------ state
     def state_arrays(self) -> dict:
@@ -248,7 +334,12 @@ class DeformableBodies:
                 "contact_pairs": s._pairs.copy(), "listed_positions": s._listed_positions.copy(),
                 "pair_springs": s.pair_springs.copy(),
                 "wall_triangle_springs": s.wall_triangle_springs.copy(),
-                "wall_tet_springs": s.wall_tet_springs.copy()}
+                "wall_tet_springs": s.wall_tet_springs.copy(),
+                "rigid_contact_loads": self.rigid_contact_loads.copy(),
+                **({f"rigid_{key}": value for key, value in self.rigid.state_arrays().items()}
+                   if self.rigid is not None else {}),
+                **({"rigid_external_loads": self.rigid.external_loads.copy()}
+                   if self.rigid is not None else {})}
 
     def load_state_arrays(self, arrays: dict) -> None:
         s = self.system
@@ -265,6 +356,12 @@ class DeformableBodies:
             body.time = s.time
             body.step_count = s.step_count
             body.ambient_pressure = float(ambient)
+        self.rigid_contact_loads[:] = arrays["rigid_contact_loads"]
+        if self.rigid is not None:
+            self.rigid.load_state_arrays({key[len("rigid_"):]: value for key, value in arrays.items()
+                                          if key.startswith("rigid_") and key != "rigid_contact_loads"})
+            self.rigid._contacts = None
+            self.rigid.external_loads[:] = arrays["rigid_external_loads"]
         self.refresh()
 
 
@@ -275,8 +372,9 @@ class DeformableCoupledSolver(CoupledSolver):
     ----------
     fluid : FluidSolver
     bodies : DeformableBodies
-        Around a DeformableSystem whose walls already include the fluid box's sides (the
-        coupling adds none: :func:`riprap.coupling.coupled.fluid_box_walls`).
+        Around a DeformableSystem (and the SolidSolver of its rigid surfaces, if any) whose
+        walls already include the fluid box's sides (the coupling adds none:
+        :func:`riprap.coupling.coupled.fluid_box_walls`).
     check_momentum : bool
         As for :class:`CoupledSolver`.
     """
@@ -289,38 +387,75 @@ class DeformableCoupledSolver(CoupledSolver):
         #: Deformable steps in the last fluid step.
         self.last_substeps = 0
 
-    # the hooks of CoupledSolver
+    # the hooks of CoupledSolver. What the clipping remembers is one flat array: the rigid
+    # bodies' poses (7 each), then every deformable node's position (3 each).
     def _body_densities(self) -> np.ndarray:
         return self.solids.densities.copy()
 
-    def _clip_reference(self) -> np.ndarray:
-        s = self.solids.system
-        return s.positions[:s.n_deformable_nodes].copy()
+    def _split(self, flat):
+        n_rigid = self.solids.n_rigid
+        return flat[:7 * n_rigid].reshape(-1, 7), flat[7 * n_rigid:].reshape(-1, 3)
 
-    def _moved_since_clipped(self, nodes) -> np.ndarray:
-        moved = np.linalg.norm(nodes - self._block_poses, axis=1)
-        return np.maximum.reduceat(moved, self.solids.offsets[:-1])
+    def _clip_reference(self) -> np.ndarray:
+        bodies = self.solids
+        nodes = bodies.system.positions[:bodies.system.n_deformable_nodes]
+        if bodies.rigid is None:
+            return nodes.ravel().copy()
+        poses = np.concatenate([bodies.rigid.positions, bodies.rigid.quaternions], axis=1)
+        return np.concatenate([poses.ravel(), nodes.ravel()])
+
+    def _moved_since_clipped(self, now) -> np.ndarray:
+        bodies = self.solids
+        (poses, nodes), (clipped_poses, clipped_nodes) = self._split(now), self._split(self._block_poses)
+        moved = np.linalg.norm(nodes - clipped_nodes, axis=1)
+        deformable = np.maximum.reduceat(moved, bodies.offsets[:-1])
+        if bodies.rigid is None:
+            return deformable
+        rigid = bodies.rigid
+        shift = np.linalg.norm(poses[:, :3] - clipped_poses[:, :3], axis=1)
+        alignment = np.abs(np.einsum("bi,bi->b", poses[:, 3:], clipped_poses[:, 3:]))
+        angle = 2.0 * np.arccos(np.minimum(alignment, 1.0))
+        return np.concatenate([shift + angle * rigid.bounding_radius[rigid.shape_index], deformable])
 
     def _take_reference(self, stale, now) -> None:
-        offsets = self.solids.offsets
+        n_rigid, offsets = self.solids.n_rigid, self.solids.offsets
+        (poses, nodes), (clipped_poses, clipped_nodes) = self._split(now), self._split(self._block_poses)
         for body in stale:
-            self._block_poses[offsets[body]:offsets[body + 1]] = now[offsets[body]:offsets[body + 1]]
+            if body < n_rigid:
+                clipped_poses[body] = poses[body]
+            else:
+                k = body - n_rigid
+                clipped_nodes[offsets[k]:offsets[k + 1]] = nodes[offsets[k]:offsets[k + 1]]
 
     def _clip(self, stale) -> list:
         bodies = self.solids
-        parts, starts = [], [0]
-        for body in stale:
-            part = bodies.triangles[bodies.triangle_start[body]:bodies.triangle_start[body + 1]]
-            parts.append(part)
-            starts.append(starts[-1] + len(part))
-        return half_cell_volumes(self.fluid.grid, self._block_poses, np.concatenate(parts),
-                                 np.asarray(starts, dtype=np.int64))
+        stale = np.asarray(stale, dtype=np.int64)
+        poses, nodes = self._split(self._block_poses)
+        rigid = stale[stale < bodies.n_rigid]
+        deformable = stale[stale >= bodies.n_rigid] - bodies.n_rigid
+        blocks = {}
+        if len(rigid):
+            fresh = rigid_body_half_cell_volumes(self.fluid.grid, bodies.rigid, bodies=rigid,
+                                                 poses=poses[rigid])
+            blocks.update(zip(rigid.tolist(), fresh))
+        if len(deformable):
+            parts, starts = [], [0]
+            for k in deformable:
+                part = bodies.triangles[bodies.triangle_start[k]:bodies.triangle_start[k + 1]]
+                parts.append(part)
+                starts.append(starts[-1] + len(part))
+            fresh = half_cell_volumes(self.fluid.grid, nodes, np.concatenate(parts),
+                                      np.asarray(starts, dtype=np.int64))
+            blocks.update(zip((deformable + bodies.n_rigid).tolist(), fresh))
+        return [blocks[int(body)] for body in stale]
 
     def _world_inertia(self):
         return self.solids.inertia
 
     def _check_bodies_in_grid(self) -> None:
         bodies, grid = self.solids, self.fluid.grid
+        if bodies.rigid is not None:
+            self._check_rigid_bodies_in_grid(bodies.rigid)
         lower, upper = np.asarray(grid.lower), np.asarray(grid.upper)
         x = bodies.system.positions
         diameters = bodies.nominal_diameters()
@@ -353,13 +488,11 @@ class DeformableCoupledSolver(CoupledSolver):
 
     def _advance_solids(self, dt: float) -> int:
         bodies = self.solids
-        system = bodies.system
         # the loads' torques are about the centres of the step's start, where the nodes still are
         bodies.apply_fluid_loads(self.fluid_loads, self.fluid.pressure, self._lower, self.fluid.h,
                                  self._reference_pressure(), duration=dt)
         substeps = max(1, math.ceil(dt / self.solid_time_step - 1e-9))
-        system.time_step = dt / substeps
-        system.step(substeps)
+        bodies.advance(substeps, dt / substeps)
         bodies.refresh()
         self.last_substeps = substeps
         return substeps

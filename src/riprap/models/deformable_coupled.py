@@ -32,6 +32,8 @@ class DeformableCoupledModel(CoupledModel):
     def prepare(self, *, restarted: bool) -> None:
         # no stress record at the start: the bodies are put in the water unloaded, a state the
         # run never has once the water's pressure is on them (records follow every fluid step)
+        if self.stresses.rigid is not None:
+            self.stresses._place_rigid()       # the rigid bodies' surfaces, where they start
         if not restarted:
             self.stresses.check_start_overlaps()
 
@@ -61,20 +63,31 @@ class DeformableCoupledModel(CoupledModel):
         arrays["reference_nodes"] = np.concatenate([b.elements.reference_nodes
                                                     for b in self.system.bodies])
         metadata["body_names"] = self.stresses.body_names
+        metadata["rigid_bodies"] = self.solids.n_rigid
         return arrays, metadata
 
     def check_checkpoint(self, path, arrays: dict, metadata: dict) -> None:
         super().check_checkpoint(path, arrays, metadata)
         self.stresses.check_checkpoint(path, arrays, {"bodies": metadata.get("body_names"),
-                                                      "rigid_bodies": 0})
+                                                      "rigid_bodies": metadata.get("rigid_bodies", 0)})
 
     # ------------------------------------------------------------------ outputs
     def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
+        from riprap.io import vtk
+
         super().open_outputs(directory, append=append, paraview=paraview, picture=picture)
-        self.stresses._directory = directory
-        self.stresses._picture = picture
-        # the bodies' frames carry the stresses, in the series run.pvd opens with the fluid's
-        self.stresses._series = self._body_series
+        stresses = self.stresses
+        stresses._directory = directory
+        stresses._picture = picture
+        # the deformable bodies' frames carry the stresses, in the series run.pvd opens with the
+        # fluid's; rigid bodies have their own series, opened there too
+        stresses._series = self._body_series
+        if paraview and stresses.rigid is not None:
+            stresses._rigid_series = vtk.ParaViewSeries(directory, "rigid_bodies", append=append)
+            stresses._rigid_contact_series = vtk.ParaViewSeries(directory, "rigid_contacts",
+                                                                append=append)
+            self._combined = vtk.CombinedSeries(directory / "run.pvd", [
+                self._series, self._body_series, stresses._rigid_series])
 
     def _write_bodies(self) -> None:
         self.stresses.write_frame(0)
@@ -84,6 +97,8 @@ class DeformableCoupledModel(CoupledModel):
         for key, value in self.stresses.close_outputs().items():
             if key != "paraview":
                 outputs[key] = value
+        if self.stresses._rigid_contact_series is not None:
+            outputs["rigid_contacts"] = str(self.stresses._rigid_contact_series.pvd_path)
         return outputs
 
     def progress_text(self) -> str:
