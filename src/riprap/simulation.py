@@ -638,15 +638,18 @@ class Simulation:
                 "max_contact_force": stats.max_contact_force,
                 "factor_of_safety_sliding": sliding_factor_of_safety(s.n_bodies, contacts, friction)}
 
-    def _write_frame(self, series, contact_series) -> None:
+    def _write_frame(self, series, contact_series, time: float | None = None) -> None:
+        """One frame of the rigid bodies and their contacts, at ``time`` (default the rigid
+        solver's clock; a run that steps them inside another model gives its own)."""
         s = self.solver
+        time = s.time if time is None else time
         points, triangles, owners = self.surface_arrays()
         omegas = s.angular_velocities
         contact = self.contact_forces_on_bodies()
         statistics = self.contact_statistics()
         # ParaView colours inf badly; a huge finite number reads as "nothing pushes it sideways".
         safety = np.minimum(statistics["factor_of_safety_sliding"], 1.0e30)
-        series.add(s.time, points=points, cells=triangles, cell_type="triangle",
+        series.add(time, points=points, cells=triangles, cell_type="triangle",
                    cell_data={"body_id": owners, "velocity": s.velocities[owners],
                               "speed": np.linalg.norm(s.velocities, axis=1)[owners],
                               "angular_velocity": omegas[owners],
@@ -656,7 +659,7 @@ class Simulation:
                               "max_contact_force": statistics["max_contact_force"][owners],
                               "factor_of_safety_sliding": safety[owners]})
         c = s.contacts
-        contact_series.add(s.time, points=c.points, cells=np.arange(len(c)).reshape(-1, 1),
+        contact_series.add(time, points=c.points, cells=np.arange(len(c)).reshape(-1, 1),
                            cell_type="vertex",
                            point_data={"normal_force": c.normal_forces,
                                        "tangential_force": c.tangential_forces,

@@ -266,6 +266,17 @@ class DeformableBodies:
         rigid.set_time_step(time_step)
         moving = ~rigid.fixed
         fluid = self.external_loads[:self.n_rigid]
+        if not moving.any():
+            # fixed rigid bodies only (a bed, a slope, an underlayer): their surfaces stay where
+            # they are, so the deformable bodies take all the steps in one call
+            system.set_rigid_poses(rigid.rotation_matrices(), rigid.positions, rigid.velocities,
+                                   rigid.angular_velocities, moving=moving)
+            system.step(n_steps)
+            forces, torques = system.rigid_loads(rigid.positions)
+            self.rigid_contact_loads[:, :3] = forces
+            self.rigid_contact_loads[:, 3:] = torques
+            rigid.external_loads[:] = fluid + self.rigid_contact_loads
+            return
         for _ in range(n_steps):
             system.set_rigid_poses(rigid.rotation_matrices(), rigid.positions, rigid.velocities,
                                    rigid.angular_velocities, moving=moving)
@@ -386,6 +397,11 @@ class DeformableCoupledSolver(CoupledSolver):
         super().__init__(fluid, bodies, wall_material=None, check_momentum=check_momentum)
         #: Deformable steps in the last fluid step.
         self.last_substeps = 0
+        #: Called (no arguments) whenever the bodies' step count reaches a multiple of
+        #: ``steps_between_calls`` inside a fluid step: the stress records of an impact that
+        #: lasts a fraction of a fluid step (``riprap.models.deformable_coupled``).
+        self.on_steps = None
+        self.steps_between_calls = 50
 
     # the hooks of CoupledSolver. What the clipping remembers is one flat array: the rigid
     # bodies' poses (7 each), then every deformable node's position (3 each).
@@ -492,7 +508,17 @@ class DeformableCoupledSolver(CoupledSolver):
         bodies.apply_fluid_loads(self.fluid_loads, self.fluid.pressure, self._lower, self.fluid.h,
                                  self._reference_pressure(), duration=dt)
         substeps = max(1, math.ceil(dt / self.solid_time_step - 1e-9))
-        bodies.advance(substeps, dt / substeps)
+        system, every, done = bodies.system, self.steps_between_calls, 0
+        while done < substeps:
+            chunk = min(substeps - done, every - system.step_count % every)
+            bodies.advance(chunk, dt / substeps)
+            done += chunk
+            if self.on_steps is not None and system.step_count % every == 0:
+                self.on_steps()
+        # the bodies' clock is the fluid's (their own sum of sub-steps differs in the last bits)
+        bodies.system.time = self.fluid.time
+        for body in bodies.system.bodies:
+            body.time = self.fluid.time
         bodies.refresh()
         self.last_substeps = substeps
         return substeps

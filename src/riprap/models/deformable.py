@@ -325,7 +325,7 @@ class DeformableModel(Model):
                              cell_data=fields["cell_data"],
                              point_data={k: v[:n] for k, v in fields["point_data"].items()})
         if self._rigid_series is not None:
-            self.rigid._write_frame(self._rigid_series, self._rigid_contact_series)
+            self.rigid._write_frame(self._rigid_series, self._rigid_contact_series, time=self.time)
 
     def unit_rows(self) -> list[dict]:
         """One row per body for ``units.csv``."""

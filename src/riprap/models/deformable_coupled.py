@@ -1,12 +1,14 @@
 """Deformable bodies in the flow as a model of the run loop: the coupled run's fluid steps
 (:class:`riprap.models.fluid.CoupledModel`), with the deformable run's stresses
 (:class:`riprap.models.deformable.DeformableModel`): ``bodies.pvd`` carries the stress fields,
-``units.csv`` the largest tensile stress of every unit (looked for after every fluid step), and
+``units.csv`` the largest tensile stress of every unit (looked for every 50 of the bodies' steps
+and after every fluid step), and
 ``peak_stress.png``/``final_stress.png`` show them."""
 from __future__ import annotations
 
 import numpy as np
 
+from riprap.models.deformable import RECORD_EVERY_STEPS
 from riprap.models.fluid import CoupledModel, FluidModel
 
 __all__ = ["DeformableCoupledModel"]
@@ -24,6 +26,11 @@ class DeformableCoupledModel(CoupledModel):
         super().__init__(coupled)
         self.stresses = stresses
         self.deformable_steps = 0
+        # the largest tensile stresses are looked for every RECORD_EVERY_STEPS of the bodies'
+        # steps, as in a dry run (an impact lasts a fraction of a fluid step), and at the end of
+        # every fluid step
+        coupled.on_steps = stresses._record_stresses
+        coupled.steps_between_calls = RECORD_EVERY_STEPS
 
     @property
     def system(self):
