@@ -5,6 +5,7 @@ continues bit for bit."""
 import csv
 
 import numpy as np
+import pytest
 from riprap.case.build_fluid import build_fluid_run
 from riprap.case.load import load_case
 
@@ -116,6 +117,10 @@ def test_rigid_and_deformable_bodies_in_one_flow(tmp_path):
     # the deformable block lands on the rigid one: the forces cross between the two solvers
     assert bodies.rigid_contact_loads[0, 2] < 0.0
     assert bodies.contact_forces()[0, 2] == bodies.rigid_contact_loads[0, 2]
+    # body_forces.csv numbers the bodies as the case does (the deformable block is body 0)
+    rows = list(csv.DictReader(open(out / "body_forces.csv")))
+    deformable = [row for row in rows if row["body"] == "0"]
+    assert float(deformable[0]["z_m"]) == pytest.approx(0.0951)
 
 
 def test_mixed_run_in_a_flow_restarts_bit_for_bit(tmp_path):

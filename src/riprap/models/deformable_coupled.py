@@ -99,6 +99,14 @@ class DeformableCoupledModel(CoupledModel):
     def _write_bodies(self) -> None:
         self.stresses.write_frame(0)
 
+    def _body_force_rows(self) -> list[str]:
+        """As a coupled run's, with each body's number in the case (the coupling puts the rigid
+        bodies first)."""
+        deformable, rigid = self.stresses.case_numbers
+        numbers = list(rigid[:self.solids.n_rigid]) + list(deformable)
+        rows = super()._body_force_rows()
+        return [f"{numbers[int(row.split(',', 1)[0])]},{row.split(',', 1)[1]}" for row in rows]
+
     def close_outputs(self) -> dict:
         outputs = super().close_outputs()
         for key, value in self.stresses.close_outputs().items():
