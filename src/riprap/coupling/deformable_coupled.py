@@ -265,27 +265,31 @@ class DeformableBodies:
         rigid = self.rigid
         rigid.set_time_step(time_step)
         moving = ~rigid.fixed
-        fluid = self.external_loads[:self.n_rigid]
         if not moving.any():
             # fixed rigid bodies only (a bed, a slope, an underlayer): their surfaces stay where
             # they are, so the deformable bodies take all the steps in one call
-            system.set_rigid_poses(rigid.rotation_matrices(), rigid.positions, rigid.velocities,
-                                   rigid.angular_velocities, moving=moving)
+            self._place_rigid(moving)
             system.step(n_steps)
-            forces, torques = system.rigid_loads(rigid.positions)
-            self.rigid_contact_loads[:, :3] = forces
-            self.rigid_contact_loads[:, 3:] = torques
-            rigid.external_loads[:] = fluid + self.rigid_contact_loads
+            self._pass_contact_loads()
             return
         for _ in range(n_steps):
-            system.set_rigid_poses(rigid.rotation_matrices(), rigid.positions, rigid.velocities,
-                                   rigid.angular_velocities, moving=moving)
+            self._place_rigid(moving)
             system.step(1)
-            forces, torques = system.rigid_loads(rigid.positions)
-            self.rigid_contact_loads[:, :3] = forces
-            self.rigid_contact_loads[:, 3:] = torques
-            rigid.external_loads[:] = fluid + self.rigid_contact_loads
+            self._pass_contact_loads()
             rigid.advance(1)
+
+    def _place_rigid(self, moving) -> None:
+        rigid = self.rigid
+        self.system.set_rigid_poses(rigid.rotation_matrices(), rigid.positions, rigid.velocities,
+                                    rigid.angular_velocities, moving=moving)
+
+    def _pass_contact_loads(self) -> None:
+        """The deformable bodies' contact forces on the rigid ones at the last step, beside the
+        fluid's load, as the rigid solver's external loads."""
+        forces, torques = self.system.rigid_loads(self.rigid.positions)
+        self.rigid_contact_loads[:, :3] = forces
+        self.rigid_contact_loads[:, 3:] = torques
+        self.rigid.external_loads[:] = self.external_loads[:self.n_rigid] + self.rigid_contact_loads
 
     # ------------------------------------------------------------------ loads
     def apply_fluid_loads(self, loads: np.ndarray, pressure: np.ndarray, lower, h: float,
