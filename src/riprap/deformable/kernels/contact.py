@@ -24,7 +24,9 @@ Polygon columns: 0-2 position, then the linear attributes of each use.
 """
 import numpy as np
 
-from riprap._jit import kernel
+from numba import prange
+
+from riprap._jit import kernel, parallel_kernel
 from riprap.solid.kernels.contact import plane_section
 
 MAX_VERTICES = 16
@@ -369,6 +371,37 @@ def pair_forces(positions, triangles, tets, pairs, penalty, forces, velocities, 
         weight += w
         area += a
     return weight, area
+
+
+#: The pairs are cut into this many runs for the parallel evaluation (a fixed number, not the
+#: number of threads, so that the forces' sums, and a run, do not depend on the machine).
+PAIR_CHUNKS = 4
+
+
+@parallel_kernel
+def pair_forces_parallel(positions, triangles, tets, pairs, penalty, forces, velocities, masses,
+                         triangle_friction, tet_friction, triangle_damping, tet_damping,
+                         tet_stiffness, time_step, springs):
+    """:func:`pair_forces` on ``PAIR_CHUNKS`` runs of the pairs at once, each into a force buffer
+    of its own (a node may sit in pairs of several runs), summed in a fixed order."""
+    n_pairs = pairs.shape[0]
+    buffers = np.zeros((PAIR_CHUNKS, positions.shape[0], 3))
+    weights = np.zeros(PAIR_CHUNKS)
+    areas = np.zeros(PAIR_CHUNKS)
+    for c in prange(PAIR_CHUNKS):
+        first = c * n_pairs // PAIR_CHUNKS
+        last = (c + 1) * n_pairs // PAIR_CHUNKS
+        weights[c], areas[c] = pair_forces(positions, triangles, tets, pairs[first:last], penalty,
+                                           buffers[c], velocities, masses, triangle_friction,
+                                           tet_friction, triangle_damping, tet_damping,
+                                           tet_stiffness, time_step, springs[first:last])
+    for n in prange(positions.shape[0]):
+        for i in range(3):
+            total = forces[n, i]
+            for c in range(PAIR_CHUNKS):
+                total += buffers[c, n, i]
+            forces[n, i] = total
+    return weights.sum(), areas.sum()
 
 
 @kernel

@@ -375,6 +375,9 @@ def smallest_jacobian(jacobians):
 DONE = 0
 INVERTED = 1
 REBUILD_CONTACTS = 2
+#: Contact pairs are evaluated in parallel from this many on (below, threads cost more than
+#: they give: a pair takes about 0.2 microseconds).
+PARALLEL_PAIRS = 2000
 
 
 @kernel
@@ -411,11 +414,16 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
                     return step, REBUILD_CONTACTS, -1, 1.0
             contact_forces[:] = 0.0
             totals[:] = 0.0
-            weight, _ = contact_kernels.pair_forces(positions, triangles, contact_tets, pairs, penalty,
-                                                    contact_forces, velocities, masses,
-                                                    triangle_friction, tet_friction,
-                                                    triangle_damping, tet_damping, tet_stiffness,
-                                                    time_step, pair_springs)
+            if pairs.shape[0] >= PARALLEL_PAIRS:
+                weight, _ = contact_kernels.pair_forces_parallel(
+                    positions, triangles, contact_tets, pairs, penalty, contact_forces, velocities,
+                    masses, triangle_friction, tet_friction, triangle_damping, tet_damping,
+                    tet_stiffness, time_step, pair_springs)
+            else:
+                weight, _ = contact_kernels.pair_forces(
+                    positions, triangles, contact_tets, pairs, penalty, contact_forces, velocities,
+                    masses, triangle_friction, tet_friction, triangle_damping, tet_damping,
+                    tet_stiffness, time_step, pair_springs)
             totals[walls.shape[0]] = weight
             for w in range(walls.shape[0]):
                 force, _ = contact_kernels.wall_forces(positions, wall_triangles, wall_tets,
