@@ -12,7 +12,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, KernelOverflowError, OverlapError
 from riprap.solid.kernels import integrate, interactions, stepper
-from riprap.solid.kernels.geometry_ops import rotation_matrix
+from riprap.solid.kernels.geometry_ops import rotation_matrices, rotation_matrix
 from riprap.solid.materials import Material, pair_tables
 from riprap.solid.shape import RigidShape, ShapeTable
 from riprap.solid.walls import Wall
@@ -368,7 +368,7 @@ class SolidSolver:
         return float(-np.sum(self.masses[~self.fixed] * (self.positions[~self.fixed] @ self.gravity)))
 
     def rotation_matrices(self) -> np.ndarray:
-        return np.array([rotation_matrix(q) for q in self.quaternions]).reshape(-1, 3, 3)
+        return rotation_matrices(np.ascontiguousarray(self.quaternions))
 
     def overlaps(self, tolerance: float = 0.0) -> list[tuple[int, int, float]]:
         """Touching pairs whose mean overlap depth (potential force / stiffness) exceeds

@@ -29,6 +29,15 @@ def rotation_matrix(q):
 
 
 @kernel
+def rotation_matrices(quaternions):
+    """Rotation matrices (n, 3, 3) of n unit quaternions (n, 4), each as :func:`rotation_matrix`."""
+    out = np.empty((quaternions.shape[0], 3, 3))
+    for b in range(quaternions.shape[0]):
+        out[b] = rotation_matrix(quaternions[b])
+    return out
+
+
+@kernel
 def clip_polygon(polygon, n_vertices, signed, out):
     """Keep the part of a convex polygon where ``signed`` (one value per vertex) is >= 0.
 
