@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, OverlapError, RiprapError
-from riprap.work_estimate import check_rigid_run
+from riprap.work_estimate import check_deformable_run, check_rigid_run
 from riprap.geometry.tetmesh import TetMesh
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
@@ -311,6 +311,7 @@ class Simulation:
             step = min(step, solver.time_step)
             solver.set_time_step(step)
         system.time_step = step
+        check_deformable_run(end_time=self.end_time, time_step=step, elements=len(system.elements))
         return DeformableModel(system, rigid=self if solver.n_bodies > 0 else None,
                                case_numbers=self._case_numbers(),
                                accepted_depths=self.deformable_accepted_depths)
@@ -364,6 +365,8 @@ class Simulation:
                                          extra_walls=fluid_box_walls(self.fluid.grid, ""))
         if self.requested_time_step > 0:
             system.time_step = self.requested_time_step
+        check_deformable_run(end_time=self.end_time, time_step=system.time_step,
+                             elements=len(system.elements))
         coupled = DeformableCoupledSolver(self.fluid, DeformableBodies(
             system, rigid=solver if solver.n_bodies > 0 else None))
         stresses = DeformableModel(system, rigid=self if solver.n_bodies > 0 else None,

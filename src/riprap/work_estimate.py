@@ -16,6 +16,9 @@ from riprap.errors import RiprapError
 
 #: Measured speed of a rigid run (body-steps per second), the low end of bench/README.md.
 RIGID_BODY_STEPS_PER_SECOND = 3.0e4
+#: Measured speed of deformable bodies (element-steps per second), the low end: five Core-Loc-like
+#: units sliding in contact in water (examples/05 deformable); 1e7-3e7 without contact.
+DEFORMABLE_ELEMENT_STEPS_PER_SECOND = 2.0e6
 #: Memory of one fluid cell (bytes): velocities, fraction, pressure, work arrays, multigrid.
 FLUID_BYTES_PER_CELL = 250.0
 #: A run estimated to take longer than this (s of wall-clock time) is refused: 30 days.
@@ -58,6 +61,22 @@ def check_rigid_run(*, end_time: float, time_step: float, moving_bodies: int,
             f"the run would take {figure}. The time step comes from the smallest, lightest body "
             "and the contact stiffness: check the sizes (in metres), densities and contact_penalty, "
             "or shorten end_time")
+    if seconds > WARN_WALL_SECONDS:
+        warnings.warn(f"this run will take {figure}", RiprapWarning, stacklevel=3)
+
+
+def check_deformable_run(*, end_time: float, time_step: float, elements: int) -> None:
+    """Refuse (or warn about) ``end_time / time_step`` steps of ``elements`` finite elements."""
+    steps = max(end_time, 0.0) / time_step
+    seconds = steps * max(elements, 1) / DEFORMABLE_ELEMENT_STEPS_PER_SECOND
+    figure = (f"{steps:.3g} steps of {time_step:.3g} s for {end_time:.3g} s of simulated time with "
+              f"{elements} elements: about {_duration(seconds)} at "
+              f"{DEFORMABLE_ELEMENT_STEPS_PER_SECOND:.0e} element-steps/s")
+    if steps > REFUSE_STEPS or seconds > REFUSE_WALL_SECONDS:
+        raise WorkTooLargeError(
+            f"the run would take {figure}. The deformable bodies' step is their smallest element "
+            "over its wave speed sqrt(E / rho): check the sizes (in metres), young_modulus and "
+            "mesh_size, or shorten end_time")
     if seconds > WARN_WALL_SECONDS:
         warnings.warn(f"this run will take {figure}", RiprapWarning, stacklevel=3)
 

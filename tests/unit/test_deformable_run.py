@@ -216,3 +216,11 @@ def test_mixed_run_restarts_bit_for_bit(tmp_path):
     a, b = whole.model.state_arrays(), second.model.state_arrays()
     for key in ("positions", "velocities", "rigid_positions", "rigid_velocities"):
         assert np.array_equal(a[key], b[key]), key
+
+
+def test_absurd_run_length_is_refused_with_the_figure(tmp_path):
+    from riprap.work_estimate import WorkTooLargeError
+
+    sim = _two_cubes(tmp_path, 1.0e9)
+    with pytest.raises(WorkTooLargeError, match="element-steps/s"):
+        sim.run()
