@@ -47,7 +47,8 @@ class DeformableCoupledModel(CoupledModel):
     def advance(self, until: float) -> None:
         super().advance(until)
         self.deformable_steps += self.solver.last_substeps
-        self.stresses._record_stresses()
+        if self.system.step_count % RECORD_EVERY_STEPS:     # else on_steps has just looked
+            self.stresses._record_stresses()
 
     # ------------------------------------------------------------------ state
     def state_arrays(self) -> dict:
