@@ -45,6 +45,10 @@ def build_fluid_solver(case) -> FluidSolver:
     if not case.water_regions:
         raise CaseFileError(f"{case.source}: a [fluid] case needs at least one [[water_regions]] "
                             "entry (a box of water or a still-water level)")
+    if case.waves is not None or case.gauges:
+        from riprap.case.build_waves import build_waves
+
+        build_waves(case, solver)
     if not solver.water_volume() > 0.0:
         raise CaseFileError(f"{case.source}: no water is left: the [[obstacles]] cover every cell of "
                             "the [[water_regions]] (or the regions hold less than a cell of water); "

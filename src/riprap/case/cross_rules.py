@@ -32,6 +32,12 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
                 f"longer than end_time = {simulation['end_time']:g} s: the run would make no "
                 "step; 0 chooses the step automatically", simulation["time_step"])
 
+    for name in ("waves", "gauges"):
+        if tables.get(name) and tables.get("fluid") is None:
+            header = "[waves]" if name == "waves" else "[[gauges]]"
+            add((name,), f"{header} belongs to a flume: it needs a [fluid] table (the air and water "
+                "the waves run in)")
+
     given_placement = [name for name in PLACEMENT_TABLES if tables.get(name) is not None]
     has_bodies = bool(tables.get("bodies")) or bool(tables.get("body_grids"))
     if given_placement:

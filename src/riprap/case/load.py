@@ -248,6 +248,27 @@ class RegionSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class WavesSpec:
+    """``[waves]``: the common keys; ``parameters`` holds its type's keys."""
+
+    type: str
+    still_water_level: float
+    generation_zone: float = _default("waves", "generation_zone")
+    absorption_zone: float = _default("waves", "absorption_zone")
+    ramp_periods: float = _default("waves", "ramp_periods")
+    parameters: dict
+
+
+@dataclass(frozen=True, kw_only=True)
+class GaugeSpec:
+    """One ``[[gauges]]`` entry; ``parameters`` holds its type's keys (``position``)."""
+
+    type: str
+    name: str
+    parameters: dict
+
+
+@dataclass(frozen=True, kw_only=True)
 class OutputSettings:
     """``[output]``."""
 
@@ -288,6 +309,8 @@ class Case:
     deformable: DeformableSpec | None = None
     water_regions: tuple[RegionSpec, ...] = ()
     obstacles: tuple[RegionSpec, ...] = ()
+    waves: WavesSpec | None = None
+    gauges: tuple[GaugeSpec, ...] = ()
 
     @property
     def is_fluid(self) -> bool:
@@ -1025,6 +1048,9 @@ class _Validator:
                                 for values in tables["water_regions"]),
             obstacles=tuple(_with_parameters(RegionSpec, "obstacles", values)
                             for values in tables["obstacles"]),
+            waves=(None if tables["waves"] is None
+                   else _with_parameters(WavesSpec, "waves", tables["waves"])),
+            gauges=tuple(_with_parameters(GaugeSpec, "gauges", values) for values in tables["gauges"]),
         )
         if top.get("pack"):
             case = _with_pack(case, top["pack"])

@@ -250,6 +250,13 @@ TABLES: tuple[Table, ...] = (
           "Fixed solid boxes in the fluid (every cell whose centre is inside; `[fluid]` cases). "
           "With bodies, each box is also a fixed body of the same cells, so that bodies meet it "
           "(contact, with the first material); a body may not start inside one."),
+    Table("waves", False, 0, "type",
+          "Waves made in a relaxation zone at the flume's x = lower end and absorbed in one at its "
+          "x = upper end (`[fluid]` cases; docs/waves.md). The flume runs along +x over a flat bed "
+          "at the fluid box's bottom."),
+    Table("gauges", True, 0, "type",
+          "Wave gauges (surface elevation) and velocity probes, read after every fluid step and "
+          "written to gauges.csv, with the wave analysis in waves_report.json (`[fluid]` cases)."),
     Table("deformable", False, 0, None,
           "Deformable bodies (`riprap run`): which bodies deform, their elastic material (density, "
           "friction coefficient and restitution are their `[[materials]]` entry's), elements and "
@@ -561,6 +568,53 @@ KEYS: tuple[Key, ...] = (
     Key("obstacles", "lower", "vector", "m", "Lower corner of the solid box.", variant="box"),
     Key("obstacles", "upper", "vector", "m", "Upper corner of the solid box.", variant="box",
         greater_than="lower"),
+    # [waves]
+    Key("waves", "type", "string", "-",
+        "Wave theory: linear (Airy), stokes2 (Stokes second order), irregular (JONSWAP sea of "
+        "linear components, random phases).", choices=("linear", "stokes2", "irregular")),
+    Key("waves", "still_water_level", "number", "m",
+        "z of the still water surface; the water depth is measured from the box's bottom."),
+    Key("waves", "generation_zone", "number", "m",
+        "Length of the generation zone from x = lower; 0: one wave length.", default=0.0,
+        valid_range=_NON_NEGATIVE),
+    Key("waves", "absorption_zone", "number", "m",
+        "Length of the absorption zone up to x = upper; 0: two wave lengths.", default=0.0,
+        valid_range=_NON_NEGATIVE),
+    Key("waves", "ramp_periods", "number", "-",
+        "Wave periods over which the generated wave grows from still water.", default=2.0,
+        valid_range=_NON_NEGATIVE),
+    Key("waves", "height", "number", "m", "Wave height H, crest to trough.", variant="linear",
+        valid_range=_POSITIVE),
+    Key("waves", "period", "number", "s", "Wave period T.", variant="linear",
+        valid_range=_POSITIVE),
+    Key("waves", "phase", "number", "rad", "Phase at the generation zone's inner edge at t = 0.",
+        default=0.0, variant="linear"),
+    Key("waves", "height", "number", "m", "Wave height H, crest to trough.", variant="stokes2",
+        valid_range=_POSITIVE),
+    Key("waves", "period", "number", "s", "Wave period T.", variant="stokes2",
+        valid_range=_POSITIVE),
+    Key("waves", "phase", "number", "rad", "Phase at the generation zone's inner edge at t = 0.",
+        default=0.0, variant="stokes2"),
+    Key("waves", "significant_height", "number", "m", "Spectral significant wave height Hm0.",
+        variant="irregular", valid_range=_POSITIVE),
+    Key("waves", "peak_period", "number", "s", "Peak period Tp.", variant="irregular",
+        valid_range=_POSITIVE),
+    Key("waves", "peak_enhancement", "number", "-", "JONSWAP peak enhancement factor gamma.",
+        default=3.3, variant="irregular", valid_range=Range(minimum=1.0)),
+    Key("waves", "seed", "integer", "-", "Seed of the random phases.", default=0,
+        variant="irregular", valid_range=_NON_NEGATIVE),
+    Key("waves", "duration", "number", "s",
+        "The sea does not repeat within this time (frequency spacing 1/duration); 0: end_time.",
+        default=0.0, variant="irregular", valid_range=_NON_NEGATIVE),
+    # [[gauges]]
+    Key("gauges", "type", "string", "-",
+        "surface: elevation above the still water level at (x, y); velocity: (u, v, w) at the "
+        "point.", choices=("surface", "velocity")),
+    Key("gauges", "name", "string", "-", "Name of the gauge (columns of gauges.csv).",
+        unique=True),
+    Key("gauges", "position", "vector", "m", "Where the gauge is (a surface gauge uses x and y).",
+        variant="surface"),
+    Key("gauges", "position", "vector", "m", "The point read.", variant="velocity"),
     # [output]
     # [deformable]
     Key("deformable", "bodies", "body_selection", "-", "Which bodies deform.", default="all"),

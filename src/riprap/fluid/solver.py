@@ -130,6 +130,11 @@ class FluidSolver:
         self.pressure_solver = PressureSolver((nx, ny, nz), self.h, tolerance=pressure_tolerance)
         self.last_report = None
         self.last_pressure_seconds = 0.0
+        #: Wave-making and absorbing zones (``riprap.waves.relaxation.WaveRelaxation``) blended in
+        #: after every step, or None.
+        self.relaxation = None
+        #: Gauges (``riprap.waves.gauges.GaugeSet``) read after every step, or None.
+        self.gauges = None
 
     # ------------------------------------------------------------------ set-up
     def add_water_box(self, lower, upper) -> None:
@@ -341,6 +346,10 @@ class FluidSolver:
         self.time += dt
         self.step_count += 1
         self.time_step = dt
+        if self.relaxation is not None:
+            self.relaxation.apply(self)
+        if self.gauges is not None:
+            self.gauges.record(self)
         error = (self.water_volume() - self.initial_water_volume) / max(self.initial_water_volume, 1e-300)
         self.last_report = StepReport(time=self.time, time_step=dt, courant_number=courant,
                                       pressure_iterations=report.iterations,
@@ -401,10 +410,13 @@ class FluidSolver:
 
     # ------------------------------------------------------------------ state
     def state_arrays(self) -> dict:
-        return {"fraction": self.fraction.copy(), "u": self.u.copy(), "v": self.v.copy(),
-                "w": self.w.copy(), "pressure": self.pressure.copy(), "solid": self.solid.copy(),
-                "clock": np.array([self.time, float(self.step_count), self.time_step,
-                                   self.initial_water_volume or 0.0])}
+        arrays = {"fraction": self.fraction.copy(), "u": self.u.copy(), "v": self.v.copy(),
+                  "w": self.w.copy(), "pressure": self.pressure.copy(), "solid": self.solid.copy(),
+                  "clock": np.array([self.time, float(self.step_count), self.time_step,
+                                     self.initial_water_volume or 0.0])}
+        if self.gauges is not None:
+            arrays.update(self.gauges.record_arrays())
+        return arrays
 
     def load_state_arrays(self, arrays: dict) -> None:
         for name in ("fraction", "u", "v", "w", "pressure", "solid"):
@@ -419,3 +431,5 @@ class FluidSolver:
         self.step_count = int(arrays["clock"][1])
         self.time_step = float(arrays["clock"][2])
         self.initial_water_volume = float(arrays["clock"][3]) or None
+        if self.gauges is not None:
+            self.gauges.load_record_arrays(arrays)

@@ -107,8 +107,15 @@ class FluidModel(Model):
     def _body_fraction(self):
         return None
 
+    def _write_gauges(self) -> None:
+        if self.fluid.gauges is not None and self._directory is not None:
+            from riprap.io.gauge_files import write_gauges_csv
+
+            write_gauges_csv(self._directory / "gauges.csv", self.fluid.gauges)
+
     def write_frame(self, frame_index: int) -> None:
         s = self.fluid
+        self._write_gauges()
         velocity = s.cell_velocity()
         if self._series is not None:
             self._series.add_image(s.time, origin=s.grid.lower, spacing=s.h, cells=s.grid.cells,
@@ -123,6 +130,19 @@ class FluidModel(Model):
 
     def close_outputs(self) -> dict:
         outputs = {}
+        gauges = self.fluid.gauges
+        if gauges is not None and self._directory is not None:
+            from riprap.io.gauge_files import gauges_png, write_waves_report
+            from riprap.waves.report import flume_report
+
+            self._write_gauges()
+            outputs["gauges"] = str(self._directory / "gauges.csv")
+            report = flume_report(gauges, self.fluid.relaxation)
+            outputs["waves_report"] = str(write_waves_report(self._directory / "waves_report.json",
+                                                             report))
+            if self._picture:
+                outputs["gauges_picture"] = str(gauges_png(self._directory / "gauges.png", gauges,
+                                                           report))
         if self._series is not None:
             outputs["paraview"] = str(self._series.pvd_path)
         if self._picture:

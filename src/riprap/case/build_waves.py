@@ -1,0 +1,77 @@
+"""Build a case's ``[waves]`` and ``[[gauges]]`` onto its fluid: the relaxation zones, the wave
+they make, the gauges; and the checks that the flume can carry those waves (``riprap.waves.checks``)."""
+from __future__ import annotations
+
+from riprap.errors import CaseFileError
+from riprap.waves.checks import check_flume
+from riprap.waves.gauges import Gauge, GaugeSet
+from riprap.waves.relaxation import ABSORPTION, GENERATION, RelaxationZone, WaveRelaxation
+from riprap.waves.theory import IrregularWave, LinearWave, StokesSecondOrderWave
+
+__all__ = ["build_waves", "wave_of"]
+
+# An absorption zone of this many wave lengths when the case gives none (docs/waves.md: measured
+# reflection against zone length).
+DEFAULT_ABSORPTION_WAVE_LENGTHS = 2.0
+
+
+def wave_of(spec, depth: float, end_time: float, gravity: float):
+    """The wave theory object of a ``[waves]`` table."""
+    p = spec.parameters
+    if spec.type == "irregular":
+        return IrregularWave(significant_height=p["significant_height"], peak_period=p["peak_period"],
+                             depth=depth, duration=p["duration"] or end_time,
+                             peak_enhancement=p["peak_enhancement"], seed=p["seed"], gravity=gravity)
+    kind = StokesSecondOrderWave if spec.type == "stokes2" else LinearWave
+    return kind(height=p["height"], period=p["period"], depth=depth, phase=p["phase"],
+                gravity=gravity)
+
+
+def build_waves(case, solver) -> None:
+    """Give ``solver`` (a FluidSolver) the case's relaxation zones and gauges, checked."""
+    grid = solver.grid
+    where = f"{case.source} [waves]"
+    spec = case.waves
+    level = spec.still_water_level if spec is not None else None
+    if spec is not None:
+        bottom, top = grid.lower[2], grid.upper[2]
+        if not bottom < level < top:
+            raise CaseFileError(f"{where}: still_water_level = {level:g} m must lie inside the fluid "
+                                f"box's height {bottom:g} .. {top:g} m")
+        gravity = float(-case.simulation.gravity[2])
+        if not gravity > 0:
+            raise CaseFileError(f"{where}: waves need gravity pointing down (-z); [simulation] "
+                                f"gravity is {list(case.simulation.gravity)}")
+        try:
+            wave = wave_of(spec, level - bottom, case.simulation.end_time, gravity)
+        except CaseFileError as error:
+            raise CaseFileError(f"{where}: {error}") from None
+        wave_length = wave.wave_length
+        generation = spec.generation_zone or wave_length
+        absorption = spec.absorption_zone or DEFAULT_ABSORPTION_WAVE_LENGTHS * wave_length
+        x_low, x_high = grid.lower[0], grid.upper[0]
+        if generation + absorption >= x_high - x_low:
+            raise CaseFileError(
+                f"{where}: the zones ({generation:.3g} m to make the waves + {absorption:.3g} m to "
+                f"absorb them; L = {wave_length:.3g} m) fill the whole flume of {x_high - x_low:.3g} "
+                f"m; lengthen [fluid] along x or shorten the zones")
+        zones = [RelaxationZone(GENERATION, x_low, x_low + generation),
+                 RelaxationZone(ABSORPTION, x_high - absorption, x_high)]
+        check_flume(wave, solver.h, zones, where=where)
+        solver.relaxation = WaveRelaxation(wave, level, zones,
+                                           ramp_time=spec.ramp_periods * wave.period)
+    if case.gauges:
+        if level is None:
+            levels = [r.parameters["level"] for r in case.water_regions if r.type == "level"]
+            if not levels:
+                raise CaseFileError(f"{case.source} [[gauges]]: surface gauges measure from the still "
+                                    "water level: give [waves] still_water_level or a [[water_regions]] "
+                                    "entry of type level")
+            level = levels[0]
+        gauges = GaugeSet([Gauge(g.name, g.type, tuple(g.parameters["position"])) for g in case.gauges],
+                          level)
+        try:
+            gauges.check_in_grid(grid)
+        except CaseFileError as error:
+            raise CaseFileError(f"{case.source} [[gauges]]: {error}") from None
+        solver.gauges = gauges

@@ -1,0 +1,177 @@
+"""Gauges of a numerical flume: surface elevation and velocity at named places, every fluid step.
+
+A surface gauge (a wave gauge of the laboratory) reads the water depth of its cell column: the sum
+of the column's water fractions times the cell size, less the still water depth, i.e. the
+elevation eta (m) above the still water level, exact for a single-valued surface (a column that
+holds a plunging jet's air pocket counts only its water). A velocity gauge reads (u, v, w) at its
+point, each component interpolated linearly between the faces that carry it.
+
+The records live in the fluid's state (``FluidSolver.state_arrays``): a restart continues them.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from riprap.errors import CaseFileError
+
+__all__ = ["Gauge", "GaugeSet", "SURFACE", "VELOCITY"]
+
+SURFACE = "surface"
+VELOCITY = "velocity"
+
+
+@dataclass(frozen=True)
+class Gauge:
+    """``kind`` "surface" (eta at x, y of ``position``; its z is not used) or "velocity" (u, v, w
+    at ``position``), named ``name``."""
+
+    name: str
+    kind: str
+    position: tuple
+
+    @property
+    def columns(self) -> list[str]:
+        if self.kind == SURFACE:
+            return [f"{self.name}_eta_m"]
+        return [f"{self.name}_u_m_s", f"{self.name}_v_m_s", f"{self.name}_w_m_s"]
+
+
+def _index_and_weight(coordinate, first, spacing, count):
+    """(i, weight of i + 1) for linear interpolation on points first + i spacing, i < count."""
+    s = (coordinate - first) / spacing
+    i = int(min(max(math.floor(s), 0), max(count - 2, 0)))
+    return i, (min(max(s - i, 0.0), 1.0) if count > 1 else 0.0)
+
+
+class GaugeSet:
+    """The gauges of a flume and their records. ``still_water_level`` (m) is the z from which
+    surface gauges measure eta."""
+
+    def __init__(self, gauges, still_water_level: float):
+        self.gauges = list(gauges)
+        names = [g.name for g in self.gauges]
+        repeated = sorted({n for n in names if names.count(n) > 1})
+        if repeated:
+            raise CaseFileError(f"gauges: names must differ; repeated: {', '.join(repeated)}")
+        for gauge in self.gauges:
+            if gauge.kind not in (SURFACE, VELOCITY):
+                raise CaseFileError(f"gauge {gauge.name!r}: kind must be 'surface' or 'velocity', "
+                                    f"got {gauge.kind!r}")
+        self.still_water_level = float(still_water_level)
+        self.columns = [c for g in self.gauges for c in g.columns]
+        # Append-only buffers: the first ``count`` rows never change, so the state handed to the
+        # run loop after every step can be views of them (no copy of a growing record per step).
+        self.count = 0
+        self._times = np.zeros(1024)
+        self._values = np.zeros((1024, len(self.columns)))
+        self._where = None
+
+    def check_in_grid(self, grid) -> None:
+        """Refuse a gauge outside the fluid box, naming it."""
+        lower, upper = np.asarray(grid.lower), np.asarray(grid.upper)
+        for gauge in self.gauges:
+            p = np.asarray(gauge.position, dtype=float)
+            axes = (0, 1) if gauge.kind == SURFACE else (0, 1, 2)
+            outside = [a for a in axes if not lower[a] <= p[a] <= upper[a]]
+            if outside:
+                raise CaseFileError(f"gauge {gauge.name!r} at {list(gauge.position)} m is outside the "
+                                    f"fluid box {list(grid.lower)} .. {list(grid.upper)} m")
+
+    def _locate(self, fluid):
+        grid = fluid.grid
+        h = fluid.h
+        lower = np.asarray(grid.lower, dtype=float)
+        cells = grid.cells
+        where = []
+        for gauge in self.gauges:
+            p = np.asarray(gauge.position, dtype=float)
+            column = [int(min(max((p[a] - lower[a]) // h, 0), cells[a] - 1)) for a in range(3)]
+            if gauge.kind == SURFACE:
+                where.append(column[:2])
+                continue
+            # component a on faces along a (first face at lower[a]), at centres across
+            stencils = []
+            for a in range(3):
+                stencil = []
+                for b in range(3):
+                    if b == a:
+                        stencil.append(_index_and_weight(p[b], lower[b], h, cells[b] + 1))
+                    else:
+                        stencil.append(_index_and_weight(p[b], lower[b] + 0.5 * h, h, cells[b]))
+                stencils.append(stencil)
+            where.append(stencils)
+        self._where = (where, h, float(lower[2]))
+
+    def read(self, fluid) -> np.ndarray:
+        """The gauges' values now, in ``columns`` order."""
+        if self._where is None:
+            self._locate(fluid)
+        where, h, bottom = self._where
+        values = []
+        for gauge, place in zip(self.gauges, where):
+            if gauge.kind == SURFACE:
+                i, j = place
+                values.append(bottom + h * float(fluid.fraction[i, j].sum()) - self.still_water_level)
+                continue
+            for array, stencil in zip((fluid.u, fluid.v, fluid.w), place):
+                value = 0.0
+                (i, wi), (j, wj), (k, wk) = stencil
+                for di, fi in ((0, 1.0 - wi), (1, wi)):
+                    for dj, fj in ((0, 1.0 - wj), (1, wj)):
+                        for dk, fk in ((0, 1.0 - wk), (1, wk)):
+                            weight = fi * fj * fk
+                            if weight:
+                                value += weight * array[min(i + di, array.shape[0] - 1),
+                                                        min(j + dj, array.shape[1] - 1),
+                                                        min(k + dk, array.shape[2] - 1)]
+                values.append(float(value))
+        return np.array(values)
+
+    def _grow(self, needed: int) -> None:
+        if needed > self._times.size:
+            capacity = max(needed, 2 * self._times.size)
+            times, values = np.zeros(capacity), np.zeros((capacity, len(self.columns)))
+            times[:self.count], values[:self.count] = self._times[:self.count], self._values[:self.count]
+            self._times, self._values = times, values
+
+    def record(self, fluid) -> None:
+        self._grow(self.count + 1)
+        self._times[self.count] = fluid.time
+        self._values[self.count] = self.read(fluid)
+        self.count += 1
+
+    @property
+    def times(self) -> np.ndarray:
+        return self._times[:self.count]
+
+    @property
+    def values(self) -> np.ndarray:
+        """(records, columns)."""
+        return self._values[:self.count]
+
+    def record_arrays(self) -> dict:
+        """The records as checkpoint arrays (views: valid until the records are reloaded)."""
+        return {"gauge_times": self.times, "gauge_values": self.values}
+
+    def load_record_arrays(self, arrays: dict) -> None:
+        values = arrays.get("gauge_values")
+        if values is None:
+            self.count = 0
+            return
+        if values.ndim != 2 or values.shape[1] != len(self.columns):
+            raise CaseFileError(f"checkpoint: gauge records have {values.shape[-1]} columns, this "
+                                f"case's gauges {len(self.columns)}")
+        count = values.shape[0]
+        times = np.array(arrays["gauge_times"], dtype=float)
+        values = np.array(values, dtype=float)
+        self.count = 0
+        self._grow(count)
+        self._times[:count], self._values[:count] = times, values
+        self.count = count
+
+    def series(self, column: str) -> tuple[np.ndarray, np.ndarray]:
+        """(times, values) of one column."""
+        return self.times.copy(), self.values[:, self.columns.index(column)].copy()

@@ -1,0 +1,82 @@
+"""The flume's wave analysis: per surface gauge its heights and periods, per pair of neighbouring
+surface gauges the incident and reflected waves, beside the target wave (``waves_report.json``).
+
+Each record is analysed from the time the wave train has arrived: the ramp, plus the travel from
+the generation zone at the group velocity of the (peak) period, plus two periods.
+"""
+from __future__ import annotations
+
+import math
+
+
+from riprap.errors import CaseFileError
+from riprap.waves.analysis import (separate_incident_reflected, separate_regular_wave,
+                                   wave_statistics)
+from riprap.waves.gauges import SURFACE
+
+__all__ = ["flume_report", "group_velocity", "arrival_time"]
+
+
+def group_velocity(period: float, depth: float, wave_length: float) -> float:
+    """c_g = c/2 (1 + 2kd / sinh(2kd)) (m/s)."""
+    k = 2.0 * math.pi / wave_length
+    c = wave_length / period
+    return 0.5 * c * (1.0 + 2.0 * k * depth / math.sinh(2.0 * k * depth))
+
+
+def arrival_time(relaxation, x: float) -> float:
+    """When the steady wave train has reached ``x`` (s)."""
+    wave = relaxation.wave
+    speed = group_velocity(wave.period, wave.depth, wave.wave_length)
+    return relaxation.ramp_time + max(x - relaxation.origin, 0.0) / speed + 2.0 * wave.period
+
+
+def flume_report(gauges, relaxation=None) -> dict:
+    """The analysis of ``gauges`` (a GaugeSet) as a dict for JSON; ``relaxation`` (the flume's
+    WaveRelaxation, optional) gives the target and the analysis windows."""
+    report = {"gauges": {}, "reflection": []}
+    wave = relaxation.wave if relaxation is not None and relaxation.wave is not None else None
+    if wave is not None:
+        target = {"type": type(wave).__name__, "height_m": wave.height, "period_s": wave.period,
+                  "depth_m": wave.depth, "wave_length_m": wave.wave_length}
+        report["target"] = target
+    surface = [g for g in gauges.gauges if g.kind == SURFACE]
+    windows = {}
+    for gauge in surface:
+        times, eta = gauges.series(gauge.columns[0])
+        start = arrival_time(relaxation, gauge.position[0]) if wave is not None else times[0] if times.size else 0.0
+        chosen = times >= start
+        windows[gauge.name] = (times[chosen], eta[chosen])
+        entry = {"x_m": gauge.position[0], "analysed_from_s": float(start),
+                 "samples": int(chosen.sum())}
+        if chosen.sum() >= 8 and (wave is None or times[-1] - start >= 2.0 * wave.period):
+            entry.update(wave_statistics(times[chosen], eta[chosen]).as_dict())
+        else:
+            entry["note"] = "record too short after the wave train's arrival"
+        report["gauges"][gauge.name] = entry
+    if wave is not None:
+        regular = not hasattr(wave, "significant_height")
+        ordered = sorted(surface, key=lambda g: g.position[0])
+        for first, second in zip(ordered[:-1], ordered[1:]):
+            t1, e1 = windows[second.name]
+            if t1.size < 8 or t1[-1] - t1[0] < 4.0 * wave.period:
+                continue
+            _, eta_1 = gauges.series(first.columns[0])
+            times = gauges.times
+            chosen = times >= t1[0]
+            spacing = second.position[0] - first.position[0]
+            try:
+                if regular:     # at its own frequency: its bound harmonics are not free waves
+                    split = separate_regular_wave(times[chosen], eta_1[chosen], e1, spacing,
+                                                  wave.depth, wave.period)
+                else:
+                    split = separate_incident_reflected(times[chosen], eta_1[chosen], e1, spacing,
+                                                        wave.depth, wave.period)
+            except CaseFileError:
+                continue        # spacing outside 0.05 .. 0.45 wave lengths: no split for this pair
+            entry = {"gauges": [first.name, second.name], "spacing_m": spacing, **split.as_dict()}
+            if regular:
+                entry["incident_height_m"] = entry.pop("incident_Hm0_m")
+                entry["reflected_height_m"] = entry.pop("reflected_Hm0_m")
+            report["reflection"].append(entry)
+    return report
