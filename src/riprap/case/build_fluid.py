@@ -42,6 +42,8 @@ def build_fluid_solver(case) -> FluidSolver:
             solver.add_obstacle_box(obstacle.parameters["lower"], obstacle.parameters["upper"])
         except CaseFileError as error:
             raise CaseFileError(f"{case.source} [[obstacles]] entry {number + 1}: {error}") from None
+    if case.porous_zones:
+        _add_porous_zones(case, solver)
     if not case.water_regions:
         raise CaseFileError(f"{case.source}: a [fluid] case needs at least one [[water_regions]] "
                             "entry (a box of water or a still-water level)")
@@ -54,6 +56,21 @@ def build_fluid_solver(case) -> FluidSolver:
                             "the [[water_regions]] (or the regions hold less than a cell of water); "
                             "move the obstacles or the water")
     return solver
+
+
+def _add_porous_zones(case, solver) -> None:
+    from riprap.fluid.porous import PorousZone
+
+    zones = []
+    for number, spec in enumerate(case.porous_zones):
+        p = spec.parameters
+        name = f"{case.source} [[porous_zones]] entry {number + 1}"
+        shape = ({"polygon": p["points"]} if spec.type == "polygon"
+                 else {"lower": p["lower"], "upper": p["upper"]})
+        zones.append(PorousZone(porosity=spec.porosity, stone_diameter=spec.stone_diameter,
+                                linear=spec.linear_friction, quadratic=spec.quadratic_friction,
+                                added_mass=spec.added_mass, name=name, **shape))
+    solver.add_porous_zones(zones)
 
 
 def build_fluid_run(case, *, output_directory=None, progress: bool = True):

@@ -32,9 +32,9 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
                 f"longer than end_time = {simulation['end_time']:g} s: the run would make no "
                 "step; 0 chooses the step automatically", simulation["time_step"])
 
-    for name in ("waves", "gauges"):
+    for name in ("waves", "gauges", "porous_zones"):
         if tables.get(name) and tables.get("fluid") is None:
-            header = "[waves]" if name == "waves" else "[[gauges]]"
+            header = "[waves]" if name == "waves" else f"[[{name}]]"
             add((name,), f"{header} belongs to a flume: it needs a [fluid] table (the air and water "
                 "the waves run in)")
 

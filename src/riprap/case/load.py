@@ -269,6 +269,19 @@ class GaugeSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class PorousZoneSpec:
+    """One ``[[porous_zones]]`` entry; ``parameters`` holds its type's keys (box or polygon)."""
+
+    type: str
+    porosity: float
+    stone_diameter: float
+    linear_friction: float = _default("porous_zones", "linear_friction")
+    quadratic_friction: float = _default("porous_zones", "quadratic_friction")
+    added_mass: float = _default("porous_zones", "added_mass")
+    parameters: dict
+
+
+@dataclass(frozen=True, kw_only=True)
 class OutputSettings:
     """``[output]``."""
 
@@ -311,6 +324,7 @@ class Case:
     obstacles: tuple[RegionSpec, ...] = ()
     waves: WavesSpec | None = None
     gauges: tuple[GaugeSpec, ...] = ()
+    porous_zones: tuple[PorousZoneSpec, ...] = ()
 
     @property
     def is_fluid(self) -> bool:
@@ -748,6 +762,20 @@ class _Validator:
                 if not isinstance(item, str) or not item.strip():
                     return _INVALID, f"{_type_name(item)} at item {number}"
             return tuple(value), ""
+        if kind == "polygon_xz":
+            if not isinstance(value, list):
+                return _INVALID, _type_name(value)
+            if len(value) < 3:
+                return _INVALID, f"a list of {len(value)} point(s)"
+            points = []
+            for number, point in enumerate(value):
+                if not isinstance(point, list) or len(point) != 2:
+                    return _INVALID, f"{_type_name(point)} at point {number} (want [x, z])"
+                pair = [_as_number(item) for item in point]
+                if any(converted is _INVALID for converted, _ in pair):
+                    return _INVALID, f"a non-number at point {number}"
+                points.append((pair[0][0], pair[1][0]))
+            return tuple(points), ""
         length = 4 if kind == "quaternion" else 3
         if not isinstance(value, list):
             return _INVALID, _type_name(value)
@@ -1051,6 +1079,8 @@ class _Validator:
             waves=(None if tables["waves"] is None
                    else _with_parameters(WavesSpec, "waves", tables["waves"])),
             gauges=tuple(_with_parameters(GaugeSpec, "gauges", values) for values in tables["gauges"]),
+            porous_zones=tuple(_with_parameters(PorousZoneSpec, "porous_zones", values)
+                               for values in tables["porous_zones"]),
         )
         if top.get("pack"):
             case = _with_pack(case, top["pack"])

@@ -76,6 +76,7 @@ KINDS = {
     "body_selection": '"all", or a non-empty list of body indices (integers from 0, in the order '
                       'the case creates its bodies)',
     "path": "a file path (string)",
+    "polygon_xz": "a list of at least 3 points [x, z]",
 }
 
 _VECTOR_KINDS = frozenset({"vector", "integer_vector", "quaternion", "direction"})
@@ -257,6 +258,10 @@ TABLES: tuple[Table, ...] = (
     Table("gauges", True, 0, "type",
           "Wave gauges (surface elevation) and velocity probes, read after every fluid step and "
           "written to gauges.csv, with the wave analysis in waves_report.json (`[fluid]` cases)."),
+    Table("porous_zones", True, 0, "type",
+          "Porous media in the flow: a breakwater's core and filter layers (`[fluid]` cases; "
+          "Darcy-Forchheimer friction, the water fills only the pores; docs/waves.md, Porous "
+          "zones). A later zone replaces an earlier one where they overlap."),
     Table("deformable", False, 0, None,
           "Deformable bodies (`riprap run`): which bodies deform, their elastic material (density, "
           "friction coefficient and restitution are their `[[materials]]` entry's), elements and "
@@ -615,6 +620,28 @@ KEYS: tuple[Key, ...] = (
     Key("gauges", "position", "vector", "m", "Where the gauge is (a surface gauge uses x and y).",
         variant="surface"),
     Key("gauges", "position", "vector", "m", "The point read.", variant="velocity"),
+    # [[porous_zones]]
+    Key("porous_zones", "type", "string", "-",
+        "box: an axis-aligned box; polygon: a cross-section in the x-z plane, the same along y.",
+        choices=("box", "polygon")),
+    Key("porous_zones", "porosity", "number", "-", "Porosity n (volume of pores / total).",
+        valid_range=Range(minimum=0.0, maximum=1.0, minimum_inclusive=False,
+                          maximum_inclusive=False)),
+    Key("porous_zones", "stone_diameter", "number", "m", "Stone diameter D50.",
+        valid_range=_POSITIVE),
+    Key("porous_zones", "linear_friction", "number", "-",
+        "a of the linear (laminar) friction a (1-n)^3/n^3 mu/D50^2.", default=50.0,
+        valid_range=_NON_NEGATIVE),
+    Key("porous_zones", "quadratic_friction", "number", "-",
+        "b of the quadratic (turbulent) friction b (1-n)/n^3 rho/D50 |u|.", default=2.0,
+        valid_range=_NON_NEGATIVE),
+    Key("porous_zones", "added_mass", "number", "-", "c of the added mass (1 + c)/n.",
+        default=0.34, valid_range=_NON_NEGATIVE),
+    Key("porous_zones", "lower", "vector", "m", "Lower corner of the box.", variant="box"),
+    Key("porous_zones", "upper", "vector", "m", "Upper corner of the box.", variant="box",
+        greater_than="lower"),
+    Key("porous_zones", "points", "polygon_xz", "m",
+        "Corners [x, z] of the cross-section, in order.", variant="polygon"),
     # [output]
     # [deformable]
     Key("deformable", "bodies", "body_selection", "-", "Which bodies deform.", default="all"),

@@ -56,6 +56,16 @@ class StepReport:
     water_volume_error: float     # (V - V0) / V0
 
 
+def _face_values(cells, axis) -> np.ndarray:
+    """Cell values at the faces along ``axis``: the mean of the two cells (a boundary face its
+    one cell)."""
+    padded = np.concatenate([cells.take([0], axis=axis), cells, cells.take([-1], axis=axis)], axis=axis)
+    low = [slice(None)] * 3
+    high = [slice(None)] * 3
+    low[axis], high[axis] = slice(0, -1), slice(1, None)
+    return 0.5 * (padded[tuple(low)] + padded[tuple(high)])
+
+
 def _box_overlap_fractions(grid: FluidGrid, lower, upper) -> np.ndarray:
     """Fraction of each cell inside the axis-aligned box lower..upper (exact)."""
     fractions = []
@@ -135,6 +145,10 @@ class FluidSolver:
         self.relaxation = None
         #: Gauges (``riprap.waves.gauges.GaugeSet``) read after every step, or None.
         self.gauges = None
+        #: Porous zones (``riprap.fluid.porous.PorousMedium``) or None; ``add_porous_zones``.
+        self.porous = None
+        self._open_part = np.ones((nx, ny, nz))
+        self._porous_factors = None
 
     # ------------------------------------------------------------------ set-up
     def add_water_box(self, lower, upper) -> None:
@@ -191,9 +205,26 @@ class FluidSolver:
             box_lower[1], box_upper[1] = g.lower[1], g.upper[1]
         self.obstacle_boxes.append((box_lower, box_upper))
 
+    def add_porous_zones(self, zones) -> None:
+        """Porous zones (``riprap.fluid.porous.PorousZone``: a core, filter layers) in the flow;
+        ``fraction`` becomes the water fraction of their pore space. Replaces earlier zones."""
+        from riprap.fluid.porous import PorousMedium
+
+        self.porous = PorousMedium(self.grid, zones)
+        self._open_part = self.porous.porosity
+        self.initial_water_volume = None
+
     # ------------------------------------------------------------------ properties
     def water_volume(self) -> float:
+        """Water in the box (m^3): in porous zones only their pores hold it."""
+        if self.porous is not None:
+            return self.porous.water_volume(self.fraction, self.h ** 3)
         return float(self.fraction.sum()) * self.h ** 3
+
+    def _pore_speed(self) -> float:
+        """Largest speed the water moves at: in a porous zone the filtration velocity over n."""
+        speed = self.max_speed()
+        return speed / self.porous.minimum_porosity if self.porous is not None else speed
 
     def cell_density(self, fraction=None) -> np.ndarray:
         f = self.fraction if fraction is None else fraction
@@ -213,7 +244,7 @@ class FluidSolver:
 
     def stable_time_step(self) -> float:
         h = self.h
-        speed = self.max_speed()
+        speed = self._pore_speed()
         limits = [self.max_time_step]
         if speed > 0:
             limits.append(self.courant_number * h / speed)
@@ -236,7 +267,8 @@ class FluidSolver:
         from riprap.fluid.kernels import plic
 
         u, v, w = velocities or (self.u, self.v, self.w)
-        return plic.advect(self.fraction, u, v, w, dt, self.h, self.step_count)
+        return plic.advect(self.fraction, u, v, w, dt, self.h, self.step_count,
+                           porosity=self._open_part)
 
     def _face_coefficients(self, densities):
         """1/rho on every face: transported densities inside, walls 0, the open top 1/rho of the
@@ -253,6 +285,10 @@ class FluidSolver:
             betas[2][:, :, -1] = 1.0 / rho[:, :, -1]
         if self.grid.two_dimensional:
             betas[1][:] = 0.0
+        if self._porous_factors is not None:
+            for axis in range(3):
+                faces = self.porous.faces[axis]
+                betas[axis].reshape(-1)[faces] *= self._porous_factors[axis]
         if self.solid.any():
             for axis in range(3):
                 low = [slice(None)] * 3
@@ -276,7 +312,7 @@ class FluidSolver:
         if self.initial_water_volume is None:
             self.initial_water_volume = self.water_volume()
         dt = self.stable_time_step() if dt is None else float(dt)
-        courant = self.max_speed() * dt / self.h
+        courant = self._pore_speed() * dt / self.h
         if courant > 0.5 + 1e-12:
             raise InstabilityError(f"fluid: Courant number {courant:.3f} > 0.5 at t = {self.time:.6g} s "
                                    f"(dt = {dt:.3e} s, largest speed {self.max_speed():.3g} m/s)")
@@ -316,6 +352,8 @@ class FluidSolver:
                                              float(self.gravity[axis]), two_d, out, density)
             new_velocities.append(out)
             densities.append(density)
+        if self.porous is not None:
+            self._porous_friction(new_velocities, densities, viscosity_start, dt)
         u, v, w = new_velocities
         if self.grid.open_top:
             # Zero gradient across the open top; the pressure correction then fixes its flux.
@@ -324,6 +362,31 @@ class FluidSolver:
             self._add_surface_tension(u, v, w, densities, dt)
         self._zero_solid_faces(u, v, w)
         return u, v, w, densities
+
+    def _porous_friction(self, new_velocities, densities, viscosity, dt) -> None:
+        """On porous faces: the predictor's increment scaled by s = n/(1 + c), the friction taken
+        implicitly; the factors s / (1 + dt K) wait for the pressure's face coefficients
+        (``riprap/fluid/porous.py``)."""
+        porous = self.porous
+        speed = np.linalg.norm(self.cell_velocity(), axis=-1)
+        factors = []
+        for axis, (out, old) in enumerate(zip(new_velocities, (self.u, self.v, self.w))):
+            faces = porous.faces[axis]
+            if faces.size == 0 or (axis == 1 and self.grid.two_dimensional):
+                factors.append(np.ones(faces.size))
+                continue
+            face_speed = _face_values(speed, axis).reshape(-1)[faces]
+            face_viscosity = _face_values(viscosity, axis).reshape(-1)[faces]
+            density = densities[axis].reshape(-1)[faces]
+            scale = porous.scale[axis].reshape(-1)[faces]
+            friction = scale * (porous.linear_coefficient[axis].reshape(-1)[faces] * face_viscosity
+                                + porous.quadratic_coefficient[axis].reshape(-1)[faces] * density
+                                * face_speed) / density
+            factor = 1.0 / (1.0 + dt * friction)
+            flat_out, flat_old = out.reshape(-1), old.reshape(-1)
+            flat_out[faces] = (flat_old[faces] + scale * (flat_out[faces] - flat_old[faces])) * factor
+            factors.append(scale * factor)
+        self._porous_factors = factors
 
     def project(self, u, v, w, betas, dt: float, listed_cells=None):
         """Make (u, v, w) divergence free in place with face coefficients ``betas`` (1/rho);

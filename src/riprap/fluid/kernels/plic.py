@@ -388,7 +388,7 @@ def _slab_water_fraction(f, i, j, k, direction, courant, velocity_positive):
 
 
 @parallel_kernel
-def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_flux_out):
+def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_flux_out, porosity):
     """One direction-split sweep of Weymouth & Yue (2010) along axis ``direction`` (0 x, 1 y, 2 z).
 
     Arguments: ``f`` (nx, ny, nz) water fractions, updated in place; ``face_velocity`` the normal
@@ -397,7 +397,10 @@ def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_f
     whole step and 0.0 elsewhere, the same array for every sweep of the step; ``dt`` (s); ``h``
     cell side (m); ``water_flux_out`` (shape of ``face_velocity``) receives the water volume (m^3,
     positive along +axis) that crossed each face in this sweep, exactly the volumes used in the
-    update. Requires |u| dt / h <= 1/2 (checked by ``advect``).
+    update. ``porosity`` (nx, ny, nz): the part of each cell open to the fluid (1 outside porous
+    zones); ``f`` is then the water fraction of the pore space, the face velocity the filtration
+    (Darcy) velocity, the slab of a mixed upwind cell |u| dt / (n h) thick (the pore velocity's)
+    and each update divided by n. Requires |u| dt / (n h) <= 1/2 (checked by ``advect``).
 
     Returns the largest distance of any updated fraction outside [0, 1] before clipping (0.0 if
     none); values within ``CLIP_TOLERANCE`` of the range are clipped, larger ones are left.
@@ -449,8 +452,9 @@ def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_f
                 elif upwind_fraction >= 1.0:
                     water_flux_out[i, j, k] = velocity * swept_per_velocity
                 else:
-                    courant = abs(velocity) * courant_per_velocity
-                    slab = _slab_water_fraction(f, ci, cj, ck, direction, courant, positive)
+                    open_part = porosity[ci, cj, ck]
+                    courant = abs(velocity) * courant_per_velocity / open_part
+                    slab = _slab_water_fraction(f, ci, cj, ck, direction, courant, positive) * open_part
                     water_flux_out[i, j, k] = slab * cell_volume if positive else -slab * cell_volume
     overshoots = np.zeros(nx)
     for outer in prange(nx):
@@ -478,7 +482,7 @@ def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_f
                 change = ((flux_low - flux_high)
                           + dilation_indicator[i, j, k] * (velocity_high * swept_per_velocity
                                                            - velocity_low * swept_per_velocity))
-                value = f[i, j, k] + change / cell_volume
+                value = f[i, j, k] + change / (porosity[i, j, k] * cell_volume)
                 if value < 0.0:
                     largest = max(largest, -value)
                     if value > -CLIP_TOLERANCE:
@@ -518,7 +522,7 @@ def sweep_order(step_index: int, two_dimensional: bool) -> tuple:
 
 
 def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
-           water_flux_z=None) -> AdvectionFluxes:
+           water_flux_z=None, porosity=None) -> AdvectionFluxes:
     """Move the water fraction ``f`` (nx, ny, nz, in place) by the face velocities ``u``, ``v``,
     ``w`` (m/s, MAC layout of the module docstring) over ``dt`` (s) on cubic cells of side ``h``
     (m): all sweeps of one step, in the order ``sweep_order(step_index, ny == 1)``.
@@ -529,8 +533,11 @@ def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
     must be discretely divergence-free for the dilation terms to cancel (mass then changes only
     by what crosses open boundaries).
 
-    Raises ``InstabilityError`` if the Courant number max |u| dt / h exceeds 1/2 (the scheme's
-    bound), ``ValueError`` for arrays of the wrong shape or type.
+    ``porosity`` (nx, ny, nz, optional; default 1): porous zones (``advect_sweep``), where f is
+    the pore space's water fraction.
+
+    Raises ``InstabilityError`` if the Courant number max |u| dt / (n h) exceeds 1/2 (the
+    scheme's bound; n the smallest porosity), ``ValueError`` for arrays of the wrong shape or type.
     """
     if f.ndim != 3 or f.dtype != np.float64 or not f.flags.c_contiguous:
         raise ValueError("advect: f must be a C-ordered float64 array (nx, ny, nz); "
@@ -551,8 +558,12 @@ def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
                              f"shape {expected[name]}; got {fluxes[axis].dtype} "
                              f"{fluxes[axis].shape}")
     two_dimensional = ny == 1
+    if porosity is None:
+        porosity = np.ones(f.shape)
+    elif porosity.shape != f.shape or porosity.dtype != np.float64:
+        raise ValueError(f"advect: porosity must be float64 with shape {f.shape}")
     courant = max(float(np.abs(u).max()), float(np.abs(w).max()),
-                  0.0 if two_dimensional else float(np.abs(v).max())) * dt / h
+                  0.0 if two_dimensional else float(np.abs(v).max())) * dt / (h * float(porosity.min()))
     if not math.isfinite(courant) or courant > MAXIMUM_COURANT_NUMBER + _COURANT_ROUND_OFF:
         raise InstabilityError(
             f"volume-of-fluid advection: Courant number max|u| dt / h = {courant:.4g} exceeds "
@@ -563,6 +574,6 @@ def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
     largest_overshoot = 0.0
     for axis in sweep_order(step_index, two_dimensional):
         overshoot = advect_sweep(f, velocities["uvw"[axis]], dilation_indicator, float(dt),
-                                 float(h), axis, fluxes[axis])
+                                 float(h), axis, fluxes[axis], porosity)
         largest_overshoot = max(largest_overshoot, float(overshoot))
     return AdvectionFluxes(fluxes[0], fluxes[1], fluxes[2], largest_overshoot)

@@ -1,0 +1,171 @@
+"""Porous zones: a breakwater's core and filter layers as a porous medium in the flow.
+
+Model (the volume-averaged equations as olaFlow/IHFOAM code them: Higuera, Lara & Losada 2014,
+Coastal Eng. 83: 243; closure of Engelund 1953 / Van Gent 1995 with the coefficients of Jensen,
+Jacobsen & Christensen 2014, Coastal Eng. 84: 56). In a zone of porosity n and stone diameter
+D50 the velocity is the filtration (Darcy) velocity U, the water fraction is that of the pore
+space, and
+
+    (1 + c)/n d(rho U)/dt + ... = -grad p + rho g - A U - B |U| U,
+    A = a (1 - n)^3 / n^3  mu / D50^2,   B = b (1 - n) / n^3  rho / D50,
+
+with ``a`` the linear (laminar) and ``b`` the quadratic (turbulent) friction coefficients and
+``c`` the added mass. Defaults a = 50, b = 2.0, c = 0.34: the values olaFlow's tutorial runs the
+porous dam break of Liu et al. (1999) with (``shared/research/coupling-waves-deformable.md`` §2.2);
+the transient KC term of olaFlow is left out.
+
+How it enters riprap's step (``FluidSolver``): the water fraction moves with the pore velocity U/n
+and fills n of each cell (``plic.advect(porosity=...)``); the predictor's increment on a porous
+face is scaled by s = n / (1 + c) and the friction is taken implicitly,
+u* = (u^n + s (u*_0 - u^n)) / (1 + dt K), K = s (A + B |U^n|) / rho; the pressure's face
+coefficient 1/rho becomes s / (rho (1 + dt K)), so the projection makes U divergence free with the
+same factors. The scaling of the whole increment by s weighs gravity and pressure exactly and the
+advection and viscous terms approximately (by n and n^2 against 1/(1+c) and 1/(n (1+c))), which
+the slow flow in a core makes small against the friction.
+
+Cells partly inside a zone get its properties in proportion to the covered part: porosity
+1 - cover (1 - n), friction coefficients times the cover. A face takes the mean of its two cells.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from riprap.errors import CaseFileError
+
+__all__ = ["PorousZone", "PorousMedium", "DEFAULT_LINEAR", "DEFAULT_QUADRATIC", "DEFAULT_ADDED_MASS"]
+
+DEFAULT_LINEAR = 50.0
+DEFAULT_QUADRATIC = 2.0
+DEFAULT_ADDED_MASS = 0.34
+# Sub-samples per cell and axis for the cover of a polygon zone.
+_SAMPLES = 4
+
+
+@dataclass(frozen=True)
+class PorousZone:
+    """A porous zone: an axis-aligned box (``lower``, ``upper``, m) or a polygon in the x-z plane
+    (``polygon``: [(x, z), ...], m) extruded along y; ``porosity`` n, ``stone_diameter`` D50 (m),
+    friction coefficients ``linear`` a and ``quadratic`` b, ``added_mass`` c; ``name`` for
+    messages."""
+
+    porosity: float
+    stone_diameter: float
+    lower: tuple | None = None
+    upper: tuple | None = None
+    polygon: tuple | None = None
+    linear: float = DEFAULT_LINEAR
+    quadratic: float = DEFAULT_QUADRATIC
+    added_mass: float = DEFAULT_ADDED_MASS
+    name: str = "porous zone"
+
+    def __post_init__(self):
+        if not 0.0 < self.porosity < 1.0:
+            raise CaseFileError(f"{self.name}: porosity must lie in (0, 1), got {self.porosity!r}")
+        for key in ("stone_diameter",):
+            value = getattr(self, key)
+            if not (math.isfinite(value) and value > 0):
+                raise CaseFileError(f"{self.name}: {key} must be a positive length (m), got {value!r}")
+        for key in ("linear", "quadratic", "added_mass"):
+            value = getattr(self, key)
+            if not (math.isfinite(value) and value >= 0):
+                raise CaseFileError(f"{self.name}: {key} must be >= 0, got {value!r}")
+        if (self.polygon is None) == (self.lower is None or self.upper is None):
+            raise CaseFileError(f"{self.name}: give a box (lower and upper) or a polygon, not both "
+                                "or neither")
+        if self.polygon is not None and len(self.polygon) < 3:
+            raise CaseFileError(f"{self.name}: a polygon needs at least 3 points (x, z)")
+
+    def cover(self, grid) -> np.ndarray:
+        """Fraction of every cell of ``grid`` inside the zone (nx, ny, nz)."""
+        if self.polygon is None:
+            fractions = []
+            for axis in range(3):
+                faces = grid.faces(axis)
+                low = np.clip(self.lower[axis], faces[:-1], faces[1:])
+                high = np.clip(self.upper[axis], faces[:-1], faces[1:])
+                fractions.append(np.maximum(high - low, 0.0) / np.diff(faces))
+            if grid.two_dimensional:
+                fractions[1] = np.ones(1)
+            return fractions[0][:, None, None] * fractions[1][None, :, None] * fractions[2][None, None, :]
+        from matplotlib.path import Path
+
+        h = grid.cell_size
+        nx, ny, nz = grid.cells
+        offsets = (np.arange(_SAMPLES) + 0.5) / _SAMPLES * h
+        xs = (grid.faces(0)[:-1, None] + offsets[None, :]).reshape(-1)
+        zs = (grid.faces(2)[:-1, None] + offsets[None, :]).reshape(-1)
+        points = np.stack(np.meshgrid(xs, zs, indexing="ij"), axis=-1).reshape(-1, 2)
+        inside = Path(np.asarray(self.polygon, dtype=float)).contains_points(points)
+        cover = inside.reshape(nx, _SAMPLES, nz, _SAMPLES).mean(axis=(1, 3))
+        return np.broadcast_to(cover[:, None, :], (nx, ny, nz)).copy()
+
+
+class PorousMedium:
+    """The porous zones of a fluid grid as cell and face arrays.
+
+    ``porosity`` (nx, ny, nz) cell porosity (1 outside every zone); per axis face arrays:
+    ``face_porosity``, ``scale`` s = n/(1 + c), ``linear_coefficient`` a (1-n)^3/(n^3 D50^2)
+    (1/m^2; times mu gives A), ``quadratic_coefficient`` b (1-n)/(n^3 D50) (1/m; times rho |U|
+    gives B |U|); ``faces`` per axis the flat indices of the interior faces with any porous part."""
+
+    def __init__(self, grid, zones):
+        self.zones = list(zones)
+        shape = grid.cells
+        porosity = np.ones(shape)
+        linear = np.zeros(shape)
+        quadratic = np.zeros(shape)
+        added = np.zeros(shape)
+        for zone in self.zones:
+            cover = zone.cover(grid)
+            if not cover.any():
+                raise CaseFileError(f"{zone.name}: covers no part of the fluid grid "
+                                    f"{list(grid.lower)} .. {list(grid.upper)} m")
+            n, d = zone.porosity, zone.stone_diameter
+            # overlapping zones: the later one replaces the earlier on the part it covers
+            porosity = porosity * (1.0 - cover) + cover * n
+            linear = linear * (1.0 - cover) + cover * zone.linear * (1.0 - n) ** 3 / (n ** 3 * d * d)
+            quadratic = quadratic * (1.0 - cover) + cover * zone.quadratic * (1.0 - n) / (n ** 3 * d)
+            added = added * (1.0 - cover) + cover * zone.added_mass
+        self.porosity = porosity
+        self.minimum_porosity = float(porosity.min())
+        self.face_porosity, self.scale, self.linear_coefficient = [], [], []
+        self.quadratic_coefficient, self.faces = [], []
+        for axis in range(3):
+            n_face = _face_mean(porosity, axis, 1.0)
+            c_face = _face_mean(added, axis, 0.0)
+            self.face_porosity.append(n_face)
+            self.scale.append(n_face / (1.0 + c_face))
+            self.linear_coefficient.append(_face_mean(linear, axis, 0.0))
+            self.quadratic_coefficient.append(_face_mean(quadratic, axis, 0.0))
+            # interior faces only: walls carry no flow, and the open top's face keeps its own
+            # coefficient (1/rho of the top cell)
+            porous_face = (n_face < 1.0) | (c_face > 0.0)
+            boundary = [slice(None)] * 3
+            for end in (0, -1):
+                boundary[axis] = end
+                porous_face[tuple(boundary)] = False
+            self.faces.append(np.flatnonzero(porous_face))
+
+    def water_volume(self, fraction, cell_volume: float) -> float:
+        return float(np.sum(self.porosity * fraction)) * cell_volume
+
+
+def _face_mean(cells, axis, outside):
+    """Face values (one more along ``axis``): the mean of the two cells; a boundary face takes
+    its one cell's value (``outside`` only fills the array first)."""
+    shape = list(cells.shape)
+    shape[axis] += 1
+    faces = np.full(shape, outside, dtype=float)
+    low = [slice(None)] * 3
+    high = [slice(None)] * 3
+    mid = [slice(None)] * 3
+    low[axis], high[axis], mid[axis] = slice(0, -1), slice(1, None), slice(1, -1)
+    faces[tuple(mid)] = 0.5 * (cells[tuple(low)] + cells[tuple(high)])
+    first, last = [slice(None)] * 3, [slice(None)] * 3
+    first[axis], last[axis] = 0, -1
+    faces[tuple(first)] = cells[tuple(first)]
+    faces[tuple(last)] = cells[tuple(last)]
+    return faces
