@@ -132,6 +132,9 @@ def test_a_coupled_run_gives_each_units_displacement_and_rotation_since_frame_0(
     assert layer["units_moved"] == [0]
     assert layer["max_rotation_deg"] == pytest.approx(ANGLE_DEG, abs=1e-6)
     assert layer["displacement_reference_time_s"] == 0.0
+    # damage: moved less than one D_n, so nothing displaced (N_od 0); turned once, never back
+    assert layer["units_displaced"] == [] and layer["damage_number_nod"] == 0.0
+    assert list(units["rocking_events"]) == [0, 0] and layer["rocking_events"] == 0
     # The same numbers in units.csv; the contact columns are empty, not zero.
     lines = (out / "units.csv").read_text().splitlines()
     rows = [dict(zip(lines[0].split(","), line.split(","))) for line in lines[1:]]

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from riprap.analysis.damage import damage_number_nod, displaced_units, rocking_events
 from riprap.analysis.displacements import DISPLACEMENT_COLUMNS, unit_displacements
 from riprap.analysis.orientations import equal_area_points, lower_hemisphere, trend_plunge
 from riprap.analysis.rocking import rocking_factor_of_safety
@@ -42,6 +43,12 @@ CONTACT_COLUMNS = ("coordination_number", "unit_contacts", "underlayer_contacts"
                    "factor_of_safety", "factor_of_safety_sliding", "factor_of_safety_rocking")
 #: A unit counts as moved in the layer summary when its centroid moved more than this many D_n.
 MOVED_THRESHOLD_DN = 0.1
+#: A unit counts as displaced (damage, N_od) when its centroid moved more than this many D_n:
+#: out of its place in the layer (Van der Meer 1988 counts units moved out of the layer).
+DISPLACED_THRESHOLD_DN = 1.0
+#: A rocking event: the unit's rotation from its reference pose rises above this (degrees) and
+#: falls back below half of it (``riprap.analysis.damage.rocking_events``).
+ROCKING_ANGLE_DEG = 2.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -147,6 +154,9 @@ def analyse_layer(state) -> LayerAnalysis:
         "factor_of_safety_rocking": rocking,
     }
     columns.update(_displacement_columns(state, bodies))
+    columns["rocking_events"] = (rocking_events(state.rotation_history[:, bodies], ROCKING_ANGLE_DEG)
+                                 if state.rotation_history is not None
+                                 else np.full(n_units, np.nan))
     nose_axes = None
     for name, axis in layer.unit_axes.items():
         world = state.rotations[bodies] @ np.asarray(axis, dtype=float)
@@ -240,7 +250,16 @@ def _displacement_summary(state, columns) -> dict:
     distance, over_dn = columns["displacement_m"], columns["displacement_over_dn"]
     turned = columns["rotation_deg"]
     moved = np.flatnonzero(over_dn > MOVED_THRESHOLD_DN)
+    displaced = displaced_units(over_dn, DISPLACED_THRESHOLD_DN)
+    layer = state.layer
     return {"displacement_reference": state.reference_note,
+            "damage_threshold_over_dn": DISPLACED_THRESHOLD_DN,
+            "units_displaced": [int(k) for k in displaced],
+            "damage_number_nod": damage_number_nod(len(displaced), layer.slope.width,
+                                                   layer.nominal_diameter),
+            "rocking_angle_deg": ROCKING_ANGLE_DEG,
+            "rocking_events": (int(np.nansum(columns["rocking_events"]))
+                               if state.rotation_history is not None else None),
             "displacement_reference_time_s": float(state.reference_time),
             "max_displacement_m": float(distance.max(initial=0.0)),
             "max_displacement_over_dn": float(over_dn.max(initial=0.0)),

@@ -137,6 +137,9 @@ class LayerState:
     contacts_recorded : bool
         False when the source recorded no contacts (a coupled run writes no ``contacts.pvd``):
         ``contacts`` is then empty because nothing was recorded, not because nothing touches.
+    rotation_history : (frames, n) float or None
+        Each body's rotation (degrees) from its reference pose in every frame up to this state's
+        (a run's frames 0..frame), for counting rocking; None without frames.
     """
 
     positions: np.ndarray
@@ -161,6 +164,7 @@ class LayerState:
     reference_time: float = float("nan")
     reference_note: str = ""
     contacts_recorded: bool = True
+    rotation_history: np.ndarray | None = None
     _faces: dict = field(default_factory=dict, repr=False)
 
     @property

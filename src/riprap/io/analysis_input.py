@@ -313,9 +313,26 @@ def load_run_state(run_folder, *, frame: int = -1):
     else:
         contacts = _read_contacts_vtu(run_folder / contact_frames[time],
                                       f"the contacts frame at t = {time:g} s (contacts.pvd)")
+    history = _rotation_history(run_folder, frames, frame, pack, pack_file, reference, rotations)
     return _layer_state(pack, positions=positions, rotations=rotations, contacts=contacts,
                         time=time, source=f"{run_folder} frame {frame} (t = {time:g} s)",
-                        contacts_recorded=not coupled, **reference)
+                        contacts_recorded=not coupled, rotation_history=history, **reference)
+
+
+def _rotation_history(run_folder, frames, frame, pack, pack_file, reference, now_rotations):
+    """(frames 0..frame, bodies) rotation angles (degrees) from frame 0's poses, or None when
+    frame 0 could not be read."""
+    if "reference_rotations" not in reference:
+        return None
+    last = frame % len(frames)
+    reference_rotations = np.asarray(reference["reference_rotations"])
+    history = []
+    for index in range(last + 1):
+        rotations = now_rotations if index == last else _frame_poses(run_folder, frames, index,
+                                                                     pack, pack_file)[1]
+        relative = rotations @ np.transpose(reference_rotations, (0, 2, 1))
+        history.append(np.degrees(Rotation.from_matrix(relative).magnitude()))
+    return np.array(history)
 
 
 def _run_case_file(run_folder: Path) -> Path:
