@@ -68,8 +68,11 @@ def build_waves(case, solver) -> None:
                                     "water level: give [waves] still_water_level or a [[water_regions]] "
                                     "entry of type level")
             level = levels[0]
-        gauges = GaugeSet([Gauge(g.name, g.type, tuple(g.parameters["position"])) for g in case.gauges],
-                          level)
+        try:
+            gauges = GaugeSet([Gauge(g.name, g.type, tuple(g.parameters["position"]),
+                                     to_x=g.parameters.get("to_x")) for g in case.gauges], level)
+        except CaseFileError as error:
+            raise CaseFileError(f"{case.source} [[gauges]]: {error}") from None
         try:
             gauges.check_in_grid(grid)
         except CaseFileError as error:

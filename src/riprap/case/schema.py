@@ -614,12 +614,21 @@ KEYS: tuple[Key, ...] = (
     # [[gauges]]
     Key("gauges", "type", "string", "-",
         "surface: elevation above the still water level at (x, y); velocity: (u, v, w) at the "
-        "point.", choices=("surface", "velocity")),
+        "point; overtopping: discharge per metre width through the plane x (the crest's landward "
+        "edge) and its volume; run_up: the highest level the water reaches from x to to_x.",
+        choices=("surface", "velocity", "overtopping", "run_up")),
     Key("gauges", "name", "string", "-", "Name of the gauge (columns of gauges.csv).",
         unique=True),
     Key("gauges", "position", "vector", "m", "Where the gauge is (a surface gauge uses x and y).",
         variant="surface"),
     Key("gauges", "position", "vector", "m", "The point read.", variant="velocity"),
+    Key("gauges", "position", "vector", "m", "A point of the plane x = const (y, z unused).",
+        variant="overtopping"),
+    Key("gauges", "position", "vector", "m",
+        "Where the run-up is looked for from (x; y picks the cell row; z unused).",
+        variant="run_up"),
+    Key("gauges", "to_x", "number", "m", "... up to this x (the top of the slope).",
+        variant="run_up"),
     # [[porous_zones]]
     Key("porous_zones", "type", "string", "-",
         "box: an axis-aligned box; polygon: a cross-section in the x-z plane, the same along y.",

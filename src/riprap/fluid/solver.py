@@ -149,6 +149,7 @@ class FluidSolver:
         self.porous = None
         self._open_part = np.ones((nx, ny, nz))
         self._porous_factors = None
+        self.last_water_fluxes = None
 
     # ------------------------------------------------------------------ set-up
     def add_water_box(self, lower, upper) -> None:
@@ -332,6 +333,8 @@ class FluidSolver:
         viscosity_start = self.cell_viscosity()
         carriers = advecting or (self.u, self.v, self.w)
         water_fluxes = self._advect_water(dt, carriers)
+        #: The water volumes (m^3) that crossed every face in the last step (overtopping gauges).
+        self.last_water_fluxes = water_fluxes
         area = h * h
         masses = [momentum.mass_fluxes(water_fluxes[a], velocity, dt, area, self.water.density,
                                        self.air.density)

@@ -6,6 +6,17 @@ elevation eta (m) above the still water level, exact for a single-valued surface
 holds a plunging jet's air pocket counts only its water). A velocity gauge reads (u, v, w) at its
 point, each component interpolated linearly between the faces that carry it.
 
+An overtopping gauge stands on a plane x = const (the crest's landward edge): it reads the water
+volume that crossed the plane in each step per metre of flume width (the volume-of-fluid step's
+own face fluxes, so exactly the water that went over), summed into the overtopped volume per
+metre V (m^3/m), and that step's mean discharge q (m^3/s per m). A
+run-up gauge reads, between x = ``position`` x and ``to_x``, the highest level the water reaches
+on the slope: in each cell column the top of the water resting on the column's bed (its obstacle
+cells, or the box's bottom; cells more than half water counted up from there, plus the part of
+the next), the highest over the columns, above the still water level (m). Spray above the tongue
+and films thinner than half a cell are not counted; in a porous zone the water in the pores
+counts (the surface inside the core).
+
 The records live in the fluid's state (``FluidSolver.state_arrays``): a restart continues them.
 """
 from __future__ import annotations
@@ -17,25 +28,34 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 
-__all__ = ["Gauge", "GaugeSet", "SURFACE", "VELOCITY"]
+__all__ = ["Gauge", "GaugeSet", "SURFACE", "VELOCITY", "OVERTOPPING", "RUN_UP", "KINDS"]
 
 SURFACE = "surface"
 VELOCITY = "velocity"
+OVERTOPPING = "overtopping"
+RUN_UP = "run_up"
+KINDS = (SURFACE, VELOCITY, OVERTOPPING, RUN_UP)
 
 
 @dataclass(frozen=True)
 class Gauge:
-    """``kind`` "surface" (eta at x, y of ``position``; its z is not used) or "velocity" (u, v, w
-    at ``position``), named ``name``."""
+    """``kind`` "surface" (eta at x, y of ``position``; its z is not used), "velocity" (u, v, w
+    at ``position``), "overtopping" (through the plane x = ``position`` x) or "run_up" (from
+    ``position`` x to ``to_x``, in the cell row at ``position`` y), named ``name``."""
 
     name: str
     kind: str
     position: tuple
+    to_x: float | None = None
 
     @property
     def columns(self) -> list[str]:
         if self.kind == SURFACE:
             return [f"{self.name}_eta_m"]
+        if self.kind == OVERTOPPING:
+            return [f"{self.name}_q_m3_s_m", f"{self.name}_volume_m3_m"]
+        if self.kind == RUN_UP:
+            return [f"{self.name}_level_m"]
         return [f"{self.name}_u_m_s", f"{self.name}_v_m_s", f"{self.name}_w_m_s"]
 
 
@@ -57,9 +77,13 @@ class GaugeSet:
         if repeated:
             raise CaseFileError(f"gauges: names must differ; repeated: {', '.join(repeated)}")
         for gauge in self.gauges:
-            if gauge.kind not in (SURFACE, VELOCITY):
-                raise CaseFileError(f"gauge {gauge.name!r}: kind must be 'surface' or 'velocity', "
+            if gauge.kind not in KINDS:
+                raise CaseFileError(f"gauge {gauge.name!r}: kind must be one of {', '.join(KINDS)}, "
                                     f"got {gauge.kind!r}")
+            if gauge.kind == RUN_UP and not (gauge.to_x is not None and gauge.to_x > gauge.position[0]):
+                raise CaseFileError(f"gauge {gauge.name!r}: a run-up gauge reads from x = "
+                                    f"{gauge.position[0]} m to to_x, which must be larger; got "
+                                    f"{gauge.to_x!r}")
         self.still_water_level = float(still_water_level)
         self.columns = [c for g in self.gauges for c in g.columns]
         # Append-only buffers: the first ``count`` rows never change, so the state handed to the
@@ -74,8 +98,10 @@ class GaugeSet:
         lower, upper = np.asarray(grid.lower), np.asarray(grid.upper)
         for gauge in self.gauges:
             p = np.asarray(gauge.position, dtype=float)
-            axes = (0, 1) if gauge.kind == SURFACE else (0, 1, 2)
+            axes = (0, 1, 2) if gauge.kind == VELOCITY else (0, 1)
             outside = [a for a in axes if not lower[a] <= p[a] <= upper[a]]
+            if gauge.kind == RUN_UP and not gauge.to_x <= upper[0]:
+                outside.append(0)
             if outside:
                 raise CaseFileError(f"gauge {gauge.name!r} at {list(gauge.position)} m is outside the "
                                     f"fluid box {list(grid.lower)} .. {list(grid.upper)} m")
@@ -91,6 +117,14 @@ class GaugeSet:
             column = [int(min(max((p[a] - lower[a]) // h, 0), cells[a] - 1)) for a in range(3)]
             if gauge.kind == SURFACE:
                 where.append(column[:2])
+                continue
+            if gauge.kind == OVERTOPPING:
+                # the x face nearest the plane
+                where.append(int(min(max(round((p[0] - lower[0]) / h), 0), cells[0])))
+                continue
+            if gauge.kind == RUN_UP:
+                last = int(min(max((gauge.to_x - lower[0]) // h, 0), cells[0] - 1))
+                where.append((column[0], last, column[1]))
                 continue
             # component a on faces along a (first face at lower[a]), at centres across
             stencils = []
@@ -111,10 +145,22 @@ class GaugeSet:
             self._locate(fluid)
         where, h, bottom = self._where
         values = []
-        for gauge, place in zip(self.gauges, where):
+        for index, (gauge, place) in enumerate(zip(self.gauges, where)):
             if gauge.kind == SURFACE:
                 i, j = place
                 values.append(bottom + h * float(fluid.fraction[i, j].sum()) - self.still_water_level)
+                continue
+            if gauge.kind == OVERTOPPING:
+                column = self.columns.index(gauge.columns[0])
+                crossed = _water_crossed_per_width(fluid, place)
+                previous = self._values[self.count - 1, column + 1] if self.count else 0.0
+                step = fluid.time_step
+                values.extend((crossed / step if step > 0 else 0.0, previous + crossed))
+                continue
+            if gauge.kind == RUN_UP:
+                first, last, j = place
+                values.append(_highest_contiguous_water(fluid, first, last, j, h, bottom)
+                              - self.still_water_level)
                 continue
             for array, stencil in zip((fluid.u, fluid.v, fluid.w), place):
                 value = 0.0
@@ -138,6 +184,7 @@ class GaugeSet:
             self._times, self._values = times, values
 
     def record(self, fluid) -> None:
+        """Append the gauges' readings at the fluid's present time."""
         self._grow(self.count + 1)
         self._times[self.count] = fluid.time
         self._values[self.count] = self.read(fluid)
@@ -175,3 +222,38 @@ class GaugeSet:
     def series(self, column: str) -> tuple[np.ndarray, np.ndarray]:
         """(times, values) of one column."""
         return self.times.copy(), self.values[:, self.columns.index(column)].copy()
+
+
+def _water_crossed_per_width(fluid, face: int) -> float:
+    """Water volume per metre of width (m^3/m) that crossed the x faces of index ``face`` in the
+    fluid's last step: the volume-of-fluid step's own fluxes, so that it is exactly the water that
+    left one side and reached the other. 0 before the first step."""
+    fluxes = getattr(fluid, "last_water_fluxes", None)
+    if fluxes is None or fluid.step_count == 0:
+        return 0.0
+    width = fluid.h * fluid.fraction.shape[1]
+    return float(np.sum(fluxes[0][face])) / width
+
+
+def _highest_contiguous_water(fluid, first: int, last: int, j: int, h: float, bottom: float) -> float:
+    """The highest water level (z, m) over columns first..last (row j): in each column the top of
+    the water resting on its bed (the obstacle cells at its foot), counted up through the cells
+    more than half water and the part of the first one above them; a column whose first cell
+    above the bed is not half water is dry (a film thinner than half a cell is not seen). The
+    bottom of the box if every column is dry."""
+    fractions = fluid.fraction[first:last + 1, j, :]
+    solid = fluid.solid[first:last + 1, j, :]
+    nz = fractions.shape[1]
+    highest = bottom
+    for column in range(fractions.shape[0]):
+        k = 0
+        while k < nz and solid[column, k]:
+            k += 1
+        start = k
+        while k < nz and fractions[column, k] > 0.5 and not solid[column, k]:
+            k += 1
+        if k == start:
+            continue                                   # dry (or solid to the top)
+        top = k + (fractions[column, k] if k < nz and not solid[column, k] else 0.0)
+        highest = max(highest, bottom + h * top)
+    return highest

@@ -1,5 +1,6 @@
 """The flume's wave analysis: per surface gauge its heights and periods, per pair of neighbouring
-surface gauges the incident and reflected waves, beside the target wave (``waves_report.json``).
+surface gauges the incident and reflected waves, per overtopping gauge the overtopped volume and
+mean discharge, per run-up gauge R_max and R2%, beside the target wave (``waves_report.json``).
 
 Each record is analysed from the time the wave train has arrived: the ramp, plus the travel from
 the generation zone at the group velocity of the (peak) period, plus two periods.
@@ -8,13 +9,15 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 
 from riprap.errors import CaseFileError
 from riprap.waves.analysis import (separate_incident_reflected, separate_regular_wave,
                                    wave_statistics)
-from riprap.waves.gauges import SURFACE
+from riprap.waves.gauges import OVERTOPPING, RUN_UP, SURFACE
 
-__all__ = ["flume_report", "group_velocity", "arrival_time"]
+__all__ = ["flume_report", "group_velocity", "arrival_time", "run_up_statistics",
+           "overtopping_statistics"]
 
 
 def group_velocity(period: float, depth: float, wave_length: float) -> float:
@@ -29,6 +32,36 @@ def arrival_time(relaxation, x: float) -> float:
     wave = relaxation.wave
     speed = group_velocity(wave.period, wave.depth, wave.wave_length)
     return relaxation.ramp_time + max(x - relaxation.origin, 0.0) / speed + 2.0 * wave.period
+
+
+def run_up_statistics(times, level) -> dict:
+    """R_max and R2% (m above the still water level) of a run-up record: the peaks are the highest
+    levels between successive up-crossings of the record's mean; R2% is exceeded by 2 % of them."""
+    times, level = np.asarray(times, dtype=float), np.asarray(level, dtype=float)
+    if level.size < 3:
+        return {"note": "record too short"}
+    mean = level.mean()
+    crossings = np.flatnonzero((level[:-1] < mean) & (level[1:] >= mean))
+    peaks = np.array([level[a:b + 1].max() for a, b in zip(crossings[:-1], crossings[1:])])
+    result = {"R_max_m": float(level.max()), "run_up_waves": int(peaks.size)}
+    if peaks.size:
+        ranked = np.sort(peaks)[::-1]
+        position = 0.02 * ranked.size - 0.5
+        result["R2%_m"] = (float(np.interp(position, np.arange(ranked.size), ranked))
+                           if position > 0 else float(ranked[0]))
+    return result
+
+
+def overtopping_statistics(times, volume) -> dict:
+    """Overtopped volume per metre (m^3/m) over the record and the mean discharge q (m^3/s per m,
+    and in l/s per m as EurOtop tabulates it)."""
+    times, volume = np.asarray(times, dtype=float), np.asarray(volume, dtype=float)
+    if times.size < 2 or times[-1] <= times[0]:
+        return {"note": "record too short"}
+    overtopped = float(volume[-1] - volume[0])
+    q = overtopped / float(times[-1] - times[0])
+    return {"volume_m3_per_m": overtopped, "q_m3_s_per_m": q, "q_l_s_per_m": 1e3 * q,
+            "duration_s": float(times[-1] - times[0])}
 
 
 def flume_report(gauges, relaxation=None) -> dict:
@@ -54,6 +87,20 @@ def flume_report(gauges, relaxation=None) -> dict:
         else:
             entry["note"] = "record too short after the wave train's arrival"
         report["gauges"][gauge.name] = entry
+    for gauge in gauges.gauges:
+        if gauge.kind not in (OVERTOPPING, RUN_UP):
+            continue
+        times, values = gauges.series(gauge.columns[-1])
+        start = arrival_time(relaxation, gauge.position[0]) if wave is not None else (times[0] if times.size else 0.0)
+        chosen = times >= start
+        entry = {"x_m": gauge.position[0], "analysed_from_s": float(start)}
+        if gauge.kind == OVERTOPPING:
+            entry.update(overtopping_statistics(times[chosen], values[chosen]))
+            report.setdefault("overtopping", {})[gauge.name] = entry
+        else:
+            entry["to_x_m"] = gauge.to_x
+            entry.update(run_up_statistics(times[chosen], values[chosen]))
+            report.setdefault("run_up", {})[gauge.name] = entry
     if wave is not None:
         regular = not hasattr(wave, "significant_height")
         ordered = sorted(surface, key=lambda g: g.position[0])
