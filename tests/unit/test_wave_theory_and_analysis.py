@@ -158,3 +158,32 @@ def test_waves_the_flume_cannot_carry_are_refused_with_the_figure(height, period
     with pytest.raises(CaseFileError, match=message):
         check_flume(wave, cell, [RelaxationZone("generation", 0.0, zones[0]),
                                  RelaxationZone("absorption", 50.0, 50.0 + zones[1])])
+
+
+def test_stream_function_wave_is_linear_when_small_and_stokes_when_moderate():
+    from riprap.waves.stream_function import NO_EULERIAN_CURRENT, StreamFunctionWave
+
+    small = StreamFunctionWave(height=0.001, period=1.2, depth=0.4)
+    linear = LinearWave(height=0.001, period=1.2, depth=0.4)
+    assert small.residual < 1e-12
+    assert abs(small.wave_number / linear.wave_number - 1.0) < 1e-5
+    x = np.linspace(0.0, 2.0, 9)
+    assert np.allclose(small.elevation(x, 0.3), linear.elevation(x, 0.3), atol=2e-3 * 0.001)
+    # within the closed flume's return current (second order: 3e-6 m/s against 2.3e-3)
+    assert np.allclose(small.velocity(x, -0.1, 0.3)[0], linear.velocity(x, -0.1, 0.3)[0], rtol=2e-3,
+                       atol=1e-5)
+    # H/d = 0.3, kH/2 = 0.19: the celerity of Stokes' third order (no Eulerian current, Fenton
+    # 1985 eq. 26 to second order in (ka)^2) within 0.1 %, a crest higher than H/2
+    steep = StreamFunctionWave(height=0.12, period=1.2, depth=0.4, current=NO_EULERIAN_CURRENT)
+    k, t = steep.wave_number, math.tanh(steep.wave_number * 0.4)
+    stokes = math.sqrt(9.81 / k * t) * (1 + (k * 0.06) ** 2 * (9 - 10 * t ** 2 + 9 * t ** 4) / (16 * t ** 4))
+    assert abs(steep.celerity / stokes - 1.0) < 1e-3
+    assert steep.crest_elevation > 0.06 * 1.1
+    assert abs(steep.celerity * 1.2 - steep.wave_length) < 1e-9
+    # the surface series passes through the solved points; continuity holds in the flow
+    e = 1e-6
+    div = ((steep.velocity(0.3 + e, -0.2, 0.1)[0] - steep.velocity(0.3 - e, -0.2, 0.1)[0])
+           + (steep.velocity(0.3, -0.2 + e, 0.1)[1] - steep.velocity(0.3, -0.2 - e, 0.1)[1])) / (2 * e)
+    assert abs(div) < 1e-6
+    with pytest.raises(CaseFileError, match="too close to breaking"):
+        StreamFunctionWave(height=0.4, period=1.2, depth=0.4)

@@ -22,6 +22,11 @@ def wave_of(spec, depth: float, end_time: float, gravity: float):
         return IrregularWave(significant_height=p["significant_height"], peak_period=p["peak_period"],
                              depth=depth, duration=p["duration"] or end_time,
                              peak_enhancement=p["peak_enhancement"], seed=p["seed"], gravity=gravity)
+    if spec.type == "stream_function":
+        from riprap.waves.stream_function import StreamFunctionWave
+
+        return StreamFunctionWave(height=p["height"], period=p["period"], depth=depth,
+                                  phase=p["phase"], gravity=gravity)
     kind = StokesSecondOrderWave if spec.type == "stokes2" else LinearWave
     return kind(height=p["height"], period=p["period"], depth=depth, phase=p["phase"],
                 gravity=gravity)

@@ -575,8 +575,10 @@ KEYS: tuple[Key, ...] = (
         greater_than="lower"),
     # [waves]
     Key("waves", "type", "string", "-",
-        "Wave theory: linear (Airy), stokes2 (Stokes second order), irregular (JONSWAP sea of "
-        "linear components, random phases).", choices=("linear", "stokes2", "irregular")),
+        "Wave theory: linear (Airy), stokes2 (Stokes second order), stream_function (fully "
+        "nonlinear, Fenton 1988: steep waves, any depth), irregular (JONSWAP sea of linear "
+        "components, random phases).",
+        choices=("linear", "stokes2", "stream_function", "irregular")),
     Key("waves", "still_water_level", "number", "m",
         "z of the still water surface; the water depth is measured from the box's bottom."),
     Key("waves", "generation_zone", "number", "m",
@@ -600,6 +602,12 @@ KEYS: tuple[Key, ...] = (
         valid_range=_POSITIVE),
     Key("waves", "phase", "number", "rad", "Phase at the generation zone's inner edge at t = 0.",
         default=0.0, variant="stokes2"),
+    Key("waves", "height", "number", "m", "Wave height H, crest to trough.",
+        variant="stream_function", valid_range=_POSITIVE),
+    Key("waves", "period", "number", "s", "Wave period T.", variant="stream_function",
+        valid_range=_POSITIVE),
+    Key("waves", "phase", "number", "rad", "Phase at the generation zone's inner edge at t = 0.",
+        default=0.0, variant="stream_function"),
     Key("waves", "significant_height", "number", "m", "Spectral significant wave height Hm0.",
         variant="irregular", valid_range=_POSITIVE),
     Key("waves", "peak_period", "number", "s", "Peak period Tp.", variant="irregular",

@@ -5,7 +5,8 @@ height, ``MINIMUM_CELLS_PER_LENGTH`` over the wave length: below these the measu
 the flume is no longer within 5 %, docs/waves.md); the zones must be long enough to make and to
 absorb it; the wave must not break where it is made (Miche's limit H/L = 0.142 tanh(kd), and the
 depth limit H/d = 0.78); and the theory must hold in that depth (Ursell number H L^2/d^3 below 26
-for the Stokes theories, no secondary crest in a Stokes second-order trough).
+for linear and Stokes theory (the stream-function wave has no such limit), no secondary crest in a
+Stokes second-order trough).
 """
 from __future__ import annotations
 
@@ -52,13 +53,13 @@ def check_flume(wave, cell_size: float, zones, *, where: str = "waves") -> None:
             f"{where}: {name} = {height:g} m breaks where it is made: the limit in d = {depth:g} m at "
             f"L = {length:.3g} m is {min(miche, 0.78 * depth):.3g} m (Miche 0.142 L tanh(kd) = "
             f"{miche:.3g} m, depth limit 0.78 d = {0.78 * depth:.3g} m)")
-    if name == "H":
+    if name == "H" and not hasattr(wave, "celerity"):      # the stream function holds at any Ursell
         ursell = height * length ** 2 / depth ** 3
         if ursell > URSELL_LIMIT:
             raise CaseFileError(
                 f"{where}: Ursell number H L^2/d^3 = {ursell:.3g} > {URSELL_LIMIT:g}: in d = {depth:g} "
                 f"m this wave is a cnoidal (shallow-water) wave, outside linear and Stokes theory; "
-                f"make it in deeper water or lower H")
+                f"use type = \"stream_function\", deeper water or a lower H")
         ratio = getattr(wave, "second_harmonic_ratio", None)
         if ratio is not None and ratio() > 0.25:
             raise CaseFileError(
