@@ -53,15 +53,17 @@ def build_waves(case, solver) -> None:
             raise CaseFileError(f"{where}: {error}") from None
         wave_length = wave.wave_length
         generation = spec.generation_zone or wave_length
-        absorption = spec.absorption_zone or DEFAULT_ABSORPTION_WAVE_LENGTHS * wave_length
+        absorption = ((spec.absorption_zone or DEFAULT_ABSORPTION_WAVE_LENGTHS * wave_length)
+                      if spec.absorbing_end else 0.0)
         x_low, x_high = grid.lower[0], grid.upper[0]
         if generation + absorption >= x_high - x_low:
             raise CaseFileError(
                 f"{where}: the zones ({generation:.3g} m to make the waves + {absorption:.3g} m to "
                 f"absorb them; L = {wave_length:.3g} m) fill the whole flume of {x_high - x_low:.3g} "
                 f"m; lengthen [fluid] along x or shorten the zones")
-        zones = [RelaxationZone(GENERATION, x_low, x_low + generation),
-                 RelaxationZone(ABSORPTION, x_high - absorption, x_high)]
+        zones = [RelaxationZone(GENERATION, x_low, x_low + generation)]
+        if spec.absorbing_end:
+            zones.append(RelaxationZone(ABSORPTION, x_high - absorption, x_high))
         check_flume(wave, solver.h, zones, where=where)
         solver.relaxation = WaveRelaxation(wave, level, zones,
                                            ramp_time=spec.ramp_periods * wave.period)

@@ -255,6 +255,7 @@ class WavesSpec:
     still_water_level: float
     generation_zone: float = _default("waves", "generation_zone")
     absorption_zone: float = _default("waves", "absorption_zone")
+    absorbing_end: bool = _default("waves", "absorbing_end")
     ramp_periods: float = _default("waves", "ramp_periods")
     parameters: dict
 

@@ -587,6 +587,9 @@ KEYS: tuple[Key, ...] = (
     Key("waves", "absorption_zone", "number", "m",
         "Length of the absorption zone up to x = upper; 0: two wave lengths.", default=0.0,
         valid_range=_NON_NEGATIVE),
+    Key("waves", "absorbing_end", "boolean", "-",
+        "false: no absorption zone (a structure ends the flume; the generation zone still absorbs "
+        "the waves it reflects).", default=True),
     Key("waves", "ramp_periods", "number", "-",
         "Wave periods over which the generated wave grows from still water.", default=2.0,
         valid_range=_NON_NEGATIVE),
