@@ -160,3 +160,22 @@ def test_frame_0_of_a_run_has_not_moved_and_a_pack_has_no_reference(coupled_run,
     assert "no earlier state" in pack.layer["displacement_reference"]
     assert "max_displacement_m" not in pack.layer
     assert not (tmp_path / "pack_analysis" / "layer_displacement_over_dn.png").exists()
+
+
+def test_a_flume_run_gets_its_stability_report(coupled_run, tmp_path):
+    """A run folder with a waves report: ``riprap analyse`` adds the flume test's stability report
+    (the measured waves' stability number beside Hudson's) to the layer summary."""
+    import shutil
+
+    run = tmp_path / "flume_run"
+    shutil.copytree(coupled_run, run)
+    (run / "waves_report.json").write_text(json.dumps(
+        {"water_density_kg_m3": 1000.0, "gauges": {"g1": {"Hm0_m": 0.7, "Tz_s": 3.0, "waves": 20}},
+         "reflection": []}))
+    analysis = analyse(run, out=tmp_path / "analysis", frame=1)
+    flume = analysis.layer["flume_test"]
+    dn = analysis.state.layer.nominal_diameter
+    assert flume["stability_number"] == pytest.approx(0.7 / (1.4 * dn))
+    assert flume["hudson"]["K_D"] == 16.0 and flume["units_displaced"] == 0
+    summary = json.loads((tmp_path / "analysis" / "layer_summary.json").read_text())
+    assert summary["flume_test"]["Hm0_m"] == 0.7

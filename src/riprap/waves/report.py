@@ -64,10 +64,13 @@ def overtopping_statistics(times, volume) -> dict:
             "duration_s": float(times[-1] - times[0])}
 
 
-def flume_report(gauges, relaxation=None) -> dict:
+def flume_report(gauges, relaxation=None, water_density: float | None = None) -> dict:
     """The analysis of ``gauges`` (a GaugeSet) as a dict for JSON; ``relaxation`` (the flume's
-    WaveRelaxation, optional) gives the target and the analysis windows."""
+    WaveRelaxation, optional) gives the target and the analysis windows; ``water_density``
+    (kg/m^3) is recorded for the stability report."""
     report = {"gauges": {}, "reflection": []}
+    if water_density is not None:
+        report["water_density_kg_m3"] = float(water_density)
     wave = relaxation.wave if relaxation is not None and relaxation.wave is not None else None
     if wave is not None:
         target = {"type": type(wave).__name__, "height_m": wave.height, "period_s": wave.period,

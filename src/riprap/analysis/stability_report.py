@@ -1,0 +1,71 @@
+"""A flume test judged as a design is: the damage the waves did beside what the design formulas say
+those waves would do (issue 15's one report).
+
+From the run's ``waves_report.json`` (``riprap.waves.report.flume_report``): the incident Hm0 at the
+toe (the mean of the Goda-Suzuki splits of the gauge pairs, else the first surface gauge's Hm0), the
+mean period Tz and the number of waves there; from the layer analysis: the units displaced and N_od
+(``riprap.analysis.damage``). Then the stability number N_s = Hm0 / (Delta D_n) beside
+
+- Hudson's for the unit (K_D of the trunk, non-breaking waves: ``HUDSON_TRUNK_STABILITY``, from
+  ``shared/validation/armour_design.md`` §5.2: the Deltares coastal-structures-toolbox and the Rock
+  Manual), N_s,Hudson = (K_D cot alpha)^(1/3), meant for no damage (0-5 % of units displaced);
+- for cubes, Van der Meer's (1988) double-layer N_od for the same Hm0, Tz and number of waves.
+"""
+from __future__ import annotations
+
+import math
+
+from riprap.analysis.design_formulas import hudson_stability_number, van_der_meer_cubes_damage
+
+__all__ = ["flume_stability", "HUDSON_TRUNK_STABILITY"]
+
+#: K_D of a trunk under non-breaking waves per unit kind (armour_design.md §5.2); None: no value
+#: retrieved for it (cubes: Van der Meer's formula instead).
+HUDSON_TRUNK_STABILITY = {"core_loc_like": 16.0, "accropode_like": 15.0, "xbloc_like": 16.0,
+                          "tetrapod": 8.0, "cube": None, "antifer_cube": None}
+
+
+def _incident(waves_report: dict):
+    """(incident Hm0, Tz, waves, where it was read) at the toe."""
+    splits = [entry for entry in waves_report.get("reflection", [])
+              if "incident_Hm0_m" in entry or "incident_height_m" in entry]
+    gauges = [g for g in waves_report.get("gauges", {}).values() if "Hm0_m" in g]
+    period = gauges[0].get("Tz_s") if gauges else None
+    waves = gauges[0].get("waves") if gauges else None
+    if splits:
+        heights = [e.get("incident_Hm0_m", e.get("incident_height_m")) for e in splits]
+        return sum(heights) / len(heights), period, waves, "incident (Goda-Suzuki, mean of the gauge pairs)"
+    if gauges:
+        return gauges[0]["Hm0_m"], period, waves, "first surface gauge (incident and reflected)"
+    return None, None, None, "no analysed surface gauge"
+
+
+def flume_stability(waves_report: dict, layer_summary: dict, *, unit_kind: str,
+                    nominal_diameter: float, armour_density: float, water_density: float,
+                    slope_cot: float) -> dict:
+    """The stability part of the flume test's report (a dict for JSON)."""
+    height, period, waves, source = _incident(waves_report)
+    delta = armour_density / water_density - 1.0
+    result = {"unit": unit_kind, "nominal_diameter_m": nominal_diameter, "relative_density": delta,
+              "slope_cot": slope_cot, "wave_height_source": source,
+              "units_displaced": len(layer_summary.get("units_displaced", [])),
+              "damage_number_nod": layer_summary.get("damage_number_nod"),
+              "damage_threshold_over_dn": layer_summary.get("damage_threshold_over_dn")}
+    if height is None:
+        result["note"] = "the waves report has no analysed surface gauge: no stability number"
+        return result
+    stability = height / (delta * nominal_diameter)
+    result.update({"Hm0_m": height, "Tz_s": period, "waves": waves, "stability_number": stability})
+    stability_coefficient = HUDSON_TRUNK_STABILITY.get(unit_kind)
+    if stability_coefficient is not None:
+        allowed = hudson_stability_number(stability_coefficient, slope_cot)
+        result["hudson"] = {"K_D": stability_coefficient, "stability_number": allowed,
+                            "ratio": stability / allowed,
+                            "meaning": "Hudson's no-damage (0-5 % displaced) limit for a trunk "
+                                       "under non-breaking waves; ratio < 1: below it"}
+    if unit_kind in ("cube", "antifer_cube") and period and waves and math.isfinite(period):
+        result["van_der_meer_cubes"] = {
+            "N_od": van_der_meer_cubes_damage(hs=height, tm=period, waves=waves, delta=delta,
+                                              nominal_diameter=nominal_diameter),
+            "meaning": "Van der Meer (1988) double-layer cubes on cot alpha = 1.5 for these waves"}
+    return result
