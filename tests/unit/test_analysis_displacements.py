@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from riprap.analysis import LayerDescription, analyse
 from riprap.analysis.displacements import DISPLACEMENT_COLUMNS, unit_displacements
+from riprap.errors import CaseFileError
 from riprap.geometry.armour_units import armour_unit
 from riprap.io.layer_file import write_contact_table, write_layer_file
 from riprap.io.pack import PackBody, write_pack
@@ -179,3 +180,7 @@ def test_a_flume_run_gets_its_stability_report(coupled_run, tmp_path):
     assert flume["hudson"]["K_D"] == 16.0 and flume["units_displaced"] == 0
     summary = json.loads((tmp_path / "analysis" / "layer_summary.json").read_text())
     assert summary["flume_test"]["Hm0_m"] == 0.7
+    # a damaged waves report is named, not a traceback
+    (run / "waves_report.json").write_text("{not json")
+    with pytest.raises(CaseFileError, match="waves_report.json: cannot read the waves report"):
+        analyse(run, frame=1)

@@ -36,18 +36,16 @@ def analyse(path, *, out=None, frame: int = -1) -> LayerAnalysis:
 def _add_flume_test(path, analysis) -> None:
     """A run of a flume test (``waves_report.json`` beside its frames): the layer summary gets
     ``flume_test``, the damage beside the design formulas for the measured waves."""
-    import json
-
     from riprap.analysis.stability_report import flume_stability
+    from riprap.io.analysis_input import load_waves_report
 
-    report_path = Path(path) / "waves_report.json"
-    if not (Path(path).is_dir() and report_path.is_file()):
+    waves = load_waves_report(path)
+    if waves is None:
         return
     state = analysis.state
     layer = state.layer
     unit = int(layer.unit_bodies[0]) if len(layer.unit_bodies) else 0
     density = state.materials[int(state.material_of_body[unit])].density
-    waves = json.loads(report_path.read_text(encoding="utf-8"))
     analysis.layer["flume_test"] = flume_stability(
         waves, analysis.layer, unit_kind=layer.unit_kind, nominal_diameter=layer.nominal_diameter,
         armour_density=density, water_density=float(waves.get("water_density_kg_m3", 1025.0)),

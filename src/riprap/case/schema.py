@@ -217,6 +217,8 @@ _ZERO = (0.0, 0.0, 0.0)
 _SHAPE_TYPES = ("sphere", "box", "cube", "random_rock", "tetrapod", "l_shape", "armour_unit",
                 "mesh_file")
 _WALL_TYPES = ("plane", "box")
+#: The regular wave theories of [waves]: each takes height, period and phase.
+_REGULAR_WAVES = ("linear", "stokes2", "stream_function")
 #: Armour unit kinds of :mod:`riprap.geometry.armour_units` (a test keeps the two lists equal).
 UNIT_KINDS = ("core_loc_like", "accropode_like", "xbloc_like", "tetrapod", "cube", "antifer_cube")
 _MESH_EXTENSIONS = (".stl", ".obj", ".ply", ".msh", ".vtu")
@@ -593,24 +595,16 @@ KEYS: tuple[Key, ...] = (
     Key("waves", "ramp_periods", "number", "-",
         "Wave periods over which the generated wave grows from still water.", default=2.0,
         valid_range=_NON_NEGATIVE),
-    Key("waves", "height", "number", "m", "Wave height H, crest to trough.", variant="linear",
-        valid_range=_POSITIVE),
-    Key("waves", "period", "number", "s", "Wave period T.", variant="linear",
-        valid_range=_POSITIVE),
-    Key("waves", "phase", "number", "rad", "Phase at the generation zone's inner edge at t = 0.",
-        default=0.0, variant="linear"),
-    Key("waves", "height", "number", "m", "Wave height H, crest to trough.", variant="stokes2",
-        valid_range=_POSITIVE),
-    Key("waves", "period", "number", "s", "Wave period T.", variant="stokes2",
-        valid_range=_POSITIVE),
-    Key("waves", "phase", "number", "rad", "Phase at the generation zone's inner edge at t = 0.",
-        default=0.0, variant="stokes2"),
-    Key("waves", "height", "number", "m", "Wave height H, crest to trough.",
-        variant="stream_function", valid_range=_POSITIVE),
-    Key("waves", "period", "number", "s", "Wave period T.", variant="stream_function",
-        valid_range=_POSITIVE),
-    Key("waves", "phase", "number", "rad", "Phase at the generation zone's inner edge at t = 0.",
-        default=0.0, variant="stream_function"),
+    *(key
+      for variant in _REGULAR_WAVES
+      for key in (
+          Key("waves", "height", "number", "m", "Wave height H, crest to trough.",
+              variant=variant, valid_range=_POSITIVE),
+          Key("waves", "period", "number", "s", "Wave period T.", variant=variant,
+              valid_range=_POSITIVE),
+          Key("waves", "phase", "number", "rad",
+              "Phase at the generation zone's inner edge at t = 0.", default=0.0,
+              variant=variant))),
     Key("waves", "significant_height", "number", "m", "Spectral significant wave height Hm0.",
         variant="irregular", valid_range=_POSITIVE),
     Key("waves", "peak_period", "number", "s", "Peak period Tp.", variant="irregular",

@@ -35,7 +35,8 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 
-__all__ = ["PorousZone", "PorousMedium", "DEFAULT_LINEAR", "DEFAULT_QUADRATIC", "DEFAULT_ADDED_MASS"]
+__all__ = ["PorousZone", "PorousMedium", "face_means", "DEFAULT_LINEAR", "DEFAULT_QUADRATIC",
+           "DEFAULT_ADDED_MASS"]
 
 DEFAULT_LINEAR = 50.0
 DEFAULT_QUADRATIC = 2.0
@@ -134,12 +135,12 @@ class PorousMedium:
         self.face_porosity, self.scale, self.linear_coefficient = [], [], []
         self.quadratic_coefficient, self.faces = [], []
         for axis in range(3):
-            n_face = _face_mean(porosity, axis, 1.0)
-            c_face = _face_mean(added, axis, 0.0)
+            n_face = face_means(porosity, axis)
+            c_face = face_means(added, axis)
             self.face_porosity.append(n_face)
             self.scale.append(n_face / (1.0 + c_face))
-            self.linear_coefficient.append(_face_mean(linear, axis, 0.0))
-            self.quadratic_coefficient.append(_face_mean(quadratic, axis, 0.0))
+            self.linear_coefficient.append(face_means(linear, axis))
+            self.quadratic_coefficient.append(face_means(quadratic, axis))
             # interior faces only: walls carry no flow, and the open top's face keeps its own
             # coefficient (1/rho of the top cell)
             porous_face = (n_face < 1.0) | (c_face > 0.0)
@@ -153,19 +154,12 @@ class PorousMedium:
         return float(np.sum(self.porosity * fraction)) * cell_volume
 
 
-def _face_mean(cells, axis, outside):
-    """Face values (one more along ``axis``): the mean of the two cells; a boundary face takes
-    its one cell's value (``outside`` only fills the array first)."""
-    shape = list(cells.shape)
-    shape[axis] += 1
-    faces = np.full(shape, outside, dtype=float)
+def face_means(cells, axis) -> np.ndarray:
+    """Cell values at the faces along ``axis`` (one more entry along it): the mean of the two
+    cells; a boundary face takes its one cell's value."""
+    padded = np.concatenate([cells.take([0], axis=axis), cells, cells.take([-1], axis=axis)],
+                            axis=axis)
     low = [slice(None)] * 3
     high = [slice(None)] * 3
-    mid = [slice(None)] * 3
-    low[axis], high[axis], mid[axis] = slice(0, -1), slice(1, None), slice(1, -1)
-    faces[tuple(mid)] = 0.5 * (cells[tuple(low)] + cells[tuple(high)])
-    first, last = [slice(None)] * 3, [slice(None)] * 3
-    first[axis], last[axis] = 0, -1
-    faces[tuple(first)] = cells[tuple(first)]
-    faces[tuple(last)] = cells[tuple(last)]
-    return faces
+    low[axis], high[axis] = slice(0, -1), slice(1, None)
+    return 0.5 * (padded[tuple(low)] + padded[tuple(high)])

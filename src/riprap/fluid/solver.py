@@ -56,16 +56,6 @@ class StepReport:
     water_volume_error: float     # (V - V0) / V0
 
 
-def _face_values(cells, axis) -> np.ndarray:
-    """Cell values at the faces along ``axis``: the mean of the two cells (a boundary face its
-    one cell)."""
-    padded = np.concatenate([cells.take([0], axis=axis), cells, cells.take([-1], axis=axis)], axis=axis)
-    low = [slice(None)] * 3
-    high = [slice(None)] * 3
-    low[axis], high[axis] = slice(0, -1), slice(1, None)
-    return 0.5 * (padded[tuple(low)] + padded[tuple(high)])
-
-
 def _box_overlap_fractions(grid: FluidGrid, lower, upper) -> np.ndarray:
     """Fraction of each cell inside the axis-aligned box lower..upper (exact)."""
     fractions = []
@@ -370,6 +360,8 @@ class FluidSolver:
         """On porous faces: the predictor's increment scaled by s = n/(1 + c), the friction taken
         implicitly; the factors s / (1 + dt K) wait for the pressure's face coefficients
         (``riprap/fluid/porous.py``)."""
+        from riprap.fluid.porous import face_means
+
         porous = self.porous
         speed = np.linalg.norm(self.cell_velocity(), axis=-1)
         factors = []
@@ -378,8 +370,8 @@ class FluidSolver:
             if faces.size == 0 or (axis == 1 and self.grid.two_dimensional):
                 factors.append(np.ones(faces.size))
                 continue
-            face_speed = _face_values(speed, axis).reshape(-1)[faces]
-            face_viscosity = _face_values(viscosity, axis).reshape(-1)[faces]
+            face_speed = face_means(speed, axis).reshape(-1)[faces]
+            face_viscosity = face_means(viscosity, axis).reshape(-1)[faces]
             density = densities[axis].reshape(-1)[faces]
             scale = porous.scale[axis].reshape(-1)[faces]
             friction = scale * (porous.linear_coefficient[axis].reshape(-1)[faces] * face_viscosity
