@@ -2,8 +2,9 @@
 
 Method (``docs/coupling.md``): the rigidity-constraint projection of Sharma & Patankar (2005) on
 riprap's staggered grid, with exact solid fractions. The whole box is one fluid whose density on a
-face is the mixture of the fluid's and the bodies' (by the exact solid fraction of the face's
-control volume); the pressure projection moves body and fluid inertia together, so no added-mass
+face holds the fluid's share and the bodies' (by the exact solid fraction of the face's control
+volume), each moved by the pressure at its own density; the projection moves body and fluid
+inertia together, so no added-mass
 instability appears at any density ratio; after it, each body's region is made rigid with the
 motion that conserves the momentum and angular momentum of body and fluid together. The force of
 the fluid on a body is the momentum this gives it, so the two sides' forces are equal and opposite
@@ -15,7 +16,7 @@ One step of :meth:`CoupledSolver.step`:
 1. the solid volume of every body in every cell, at the present poses;
 2. the fluid predictor (water, momentum, viscosity, gravity, surface tension);
 3. each body's faces take the motion the body would have after falling freely for the step
-   (blend by solid fraction); the mixture density goes into the pressure projection;
+   (blend by solid fraction); the shares' summed inverse densities go into the projection;
 4. each free body's rigid motion from its 6 x 6 momentum system; the fluid's load on every body
    (its own momentum change, or what holding a fixed body still takes); the final blend;
 5. the bodies move over the step in contact sub-steps with gravity, contacts and that load held:
@@ -532,9 +533,6 @@ class CoupledSolver:
         faces.gather((u, v, w), fluid_part)
         faces.gather(fluid_densities, rho_fluid)
         densities = np.where(free, self._densities, rigid_coupling.FOLLOWS_FLUID)
-        solid_density = faces.zeros()
-        rigid_coupling.accumulate_density(*faces.entries, densities, faces.phi, rho_fluid,
-                                          solid_density)
         centres = solids.positions
         # What the predictor's fluxes (advection, viscous stress, surface tension) moved across
         # each body's surface is the body's: its faces' momentum change there, less gravity.
@@ -554,12 +552,26 @@ class CoupledSolver:
                                         fluid.h, centres, predicted, faces.phi, blended_rigid)
         fluid_share = 1.0 - faces.capped
         blended = fluid_share * fluid_part + blended_rigid
-        mixture = fluid_share * rho_fluid + solid_density
+        # The projection moves each share of a face by the pressure at its own density, so the
+        # face's volume flux changes by -dt grad p (1 - phi) / rho_fluid + sum phi_b / rho_b: its
+        # coefficient is the shares' inverse densities summed, not one over the mixture's
+        # density. With the mixture's, air beside a heavy resting body (a sliver of it on a face
+        # makes the face three times as dense) is held up by a third of what holds it up and
+        # falls, driving spurious currents (docs/coupling.md).
+        inverse_solid = faces.zeros()
+        # The fluid's share sees the pressure at the density the fluid solver gives it there
+        # (FluidSolver.pressure_densities: water and air by where the interface lies).
+        rho_pressure = faces.empty()
+        faces.gather(fluid.pressure_densities, rho_pressure)
+        inverse_fluid = 1.0 / rho_pressure
+        rigid_coupling.accumulate_density(*faces.entries, self._inverse_densities(densities),
+                                          faces.phi, inverse_fluid, inverse_solid)
+        inverse_mixture = fluid_share * inverse_fluid + inverse_solid
         faces.scatter(blended, (u, v, w))
-        # The predictor's face densities are not needed again: they become the mixture's.
-        faces.scatter(mixture, fluid_densities)
+        pressure_densities = [a.copy() for a in fluid.pressure_densities]
+        faces.scatter(1.0 / inverse_mixture, pressure_densities)
         exchange_seconds += time.perf_counter() - started
-        betas = fluid._face_coefficients(fluid_densities)
+        betas = fluid._face_coefficients(pressure_densities)
         # The free bodies' cells get extra smoothing in the pressure solve: a heavy body in air
         # is an island of its own pressure modes that the coarse grids miss.
         pressure, report = fluid.project(u, v, w, betas, dt,
@@ -578,9 +590,10 @@ class CoupledSolver:
         pressure_rhs = pressure_rhs[:, 0]
         # Each part of a face's momentum after the projection goes to whom it belongs: a body's
         # share moves with its own blended motion plus the pressure's change of the face velocity.
-        pressure_change = projected - blended
-        fluid_term = fluid_share * rho_fluid * (fluid_part + pressure_change - fluid_share * projected)
-        rhs = self._own_momentum(faces, centres, predicted, densities, rho_fluid, pressure_change,
+        # The pressure's impulse per unit volume on each face, which each share takes in full.
+        pressure_impulse = (projected - blended) / inverse_mixture
+        fluid_term = fluid_share * (rho_fluid * (fluid_part - fluid_share * projected) + pressure_impulse)
+        rhs = self._own_momentum(faces, centres, predicted, densities, rho_fluid, pressure_impulse,
                                  fluid_term, free)
         final = np.zeros((solids.n_bodies, 6))
         entry_start = faces.entries[0]
@@ -602,7 +615,7 @@ class CoupledSolver:
         self._carried = (faces.axis.copy(), faces.index.copy(), projected.copy())
         if self.check_momentum:
             self.last_exchange_balance = self._exchange_balance(
-                faces, fluid_share * rho_fluid, fluid_part, after, mixture, blended, projected,
+                faces, fluid_share * rho_fluid, fluid_part, after, pressure_impulse,
                 body_matrices, predicted, final, free)
         exchange_seconds += time.perf_counter() - started
         fluid_report = fluid.finish_step(u, v, w, pressure, report, dt, courant)
@@ -612,7 +625,7 @@ class CoupledSolver:
         self.fluid_loads = np.where(free[:, None], loads, 0.0)
         self._free_pressure_loads = np.where(free[:, None], pressure_rhs, 0.0)
         self._pending_fixed_loads = (faces, centres.copy(), densities, rho_fluid, predicted,
-                                     pressure_change, fluid_term, pressure_unaccounted,
+                                     pressure_impulse, fluid_term, pressure_unaccounted,
                                      body_matrices, predicted_dry, dt, pressure)
         self.last_exchange_seconds = exchange_seconds
         started = time.perf_counter()
@@ -639,13 +652,18 @@ class CoupledSolver:
                                         chosen, matrices, body, rhs)
         return matrices, body, rhs
 
-    def _own_momentum(self, faces, centres, motions, densities, rho_fluid, pressure_change,
+    @staticmethod
+    def _inverse_densities(densities) -> np.ndarray:
+        """1 / rho_b per body; ``FOLLOWS_FLUID`` stays (the kernels then take the fluid's)."""
+        return np.where(densities < 0.0, densities, 1.0 / np.where(densities < 0.0, 1.0, densities))
+
+    def _own_momentum(self, faces, centres, motions, densities, rho_fluid, pressure_impulse,
                       fluid_term, bodies):
         """``rigid_coupling.own_momentum_rhs`` (bodies, 6) for the chosen bodies (bool each)."""
         rhs = np.zeros((self.solids.n_bodies, 6))
         rigid_coupling.own_momentum_rhs(*faces.entries, faces.axis, faces.index, self._lower,
                                         self.fluid.h, centres, motions, densities, faces.phi,
-                                        rho_fluid, pressure_change, fluid_term,
+                                        rho_fluid, pressure_impulse, fluid_term,
                                         np.asarray(bodies, dtype=np.bool_), rhs)
         return rhs
 
@@ -672,13 +690,13 @@ class CoupledSolver:
 
     def _output_loads(self):
         if self._pending_fixed_loads is not None:
-            (faces, centres, densities, rho_fluid, predicted, pressure_change, fluid_term,
+            (faces, centres, densities, rho_fluid, predicted, pressure_impulse, fluid_term,
              pressure_unaccounted, body_matrices, predicted_dry, dt,
              pressure) = self._pending_fixed_loads
             self._pending_fixed_loads = None
             fixed = self.solids.fixed
             rhs = self._own_momentum(faces, centres, predicted, densities, rho_fluid,
-                                     pressure_change, fluid_term, fixed)
+                                     pressure_impulse, fluid_term, fixed)
             _, _, pressure_rhs = self._momentum_systems(
                 faces, centres, densities, rho_fluid, [faces.zeros()], [pressure_unaccounted],
                 bodies=fixed)
@@ -695,8 +713,8 @@ class CoupledSolver:
                                                self._free_pressure_loads))
         return self._loads_for_output
 
-    def _exchange_balance(self, faces, fluid_share, before, after, mixture, blended,
-                          projected, body_matrices, predicted, final, free) -> np.ndarray:
+    def _exchange_balance(self, faces, fluid_share, before, after, pressure_impulse,
+                          body_matrices, predicted, final, free) -> np.ndarray:
         """Momentum of fluid and free bodies after the exchange, less before, less the pressure's
         impulse (which only the walls do not return): zero to round-off (N s, per axis). Faces the
         bodies do not touch add nothing (there the fluid's share is the whole face, and the blend
@@ -706,7 +724,7 @@ class CoupledSolver:
         for a in range(3):
             on = faces.interior & (faces.axis == a)
             balance[a] = volume * (np.sum((fluid_share * (after - before))[on])
-                                   - np.sum((mixture * (projected - blended))[on]))
+                                   - np.sum(pressure_impulse[on]))
         bodies = np.einsum("bij,bj->bi", body_matrices[free], final[free] - predicted[free])
         return balance + bodies[:, :3].sum(axis=0)
 

@@ -10,13 +10,16 @@ One step of length dt (all explicit but the pressure):
 3. surface tension (``surface_tension`` > 0): u* += dt sigma kappa grad f / rho on the faces, kappa
    from height functions (``riprap/fluid/kernels/surface_tension.py``), grad f discretised as the
    pressure gradient so that the pressure jump balances it exactly (balanced force);
-4. pressure: div((1/rho) grad p) = div(u*) / dt on the cells, 1/rho on the faces from the
-   densities of step 2, walls closed, the open top at p = 0 (``riprap/fluid/pressure.py``,
-   multigrid-preconditioned conjugate gradients);
+4. pressure: div((1/rho) grad p) = div(u*) / dt on the cells, walls closed, the open top at p = 0
+   (``riprap/fluid/pressure.py``, multigrid-preconditioned conjugate gradients). 1/rho on a face:
+   without surface tension, water or air by where the interface cuts the line between the two
+   cell centres (``riprap/fluid/kernels/sharp_density.py``); with it, the densities of step 2,
+   which the smeared surface force must share to stay balanced;
 5. correction: u = u* - dt (1/rho) grad p on every face, so that div u = 0 to the solver tolerance.
 
 Gravity enters the momentum of the faces (step 2) and is balanced by the pressure gradient of step
-4: water at rest under a flat surface stays at rest to the solver tolerance.
+4: water at rest stays at rest to the solver tolerance, and without surface tension its cell
+pressures are exactly hydrostatic wherever the interface lies in its cells.
 
 Time step: the largest that keeps the Courant number max|u| dt / h below ``courant_number``
 (Weymouth & Yue need <= 0.5 for boundedness), explicit viscous diffusion stable (dt <= h^2 /
@@ -293,8 +296,8 @@ class FluidSolver:
     def step(self, dt: float | None = None) -> StepReport:
         """Advance by ``dt`` (default: the stable step)."""
         dt, courant = self.begin_step(dt)
-        u, v, w, densities = self.predict(dt)
-        betas = self._face_coefficients(densities)
+        u, v, w, _ = self.predict(dt)
+        betas = self._face_coefficients(self.pressure_densities)
         pressure, report = self.project(u, v, w, betas, dt)
         return self.finish_step(u, v, w, pressure, report, dt, courant)
 
@@ -351,10 +354,29 @@ class FluidSolver:
         if self.grid.open_top:
             # Zero gradient across the open top; the pressure correction then fixes its flux.
             w[:, :, -1] = w[:, :, -2]
+        #: The faces' densities for the pressure. Without surface tension: water and air by
+        #: where the interface cuts the line between the two cell centres (``kernels.sharp_density``,
+        #: at the new fraction), which keeps the air above waves still. With it: the control
+        #: volumes' mixed densities, which the continuum surface force, spread over the cut cells,
+        #: must share with the pressure to balance it (docs/fluid.md, Pressure densities).
         if self.surface_tension > 0:
+            self.pressure_densities = densities
             self._add_surface_tension(u, v, w, densities, dt)
+        else:
+            self.pressure_densities = self._sharp_face_densities()
         self._zero_solid_faces(u, v, w)
         return u, v, w, densities
+
+    def _sharp_face_densities(self) -> list:
+        from riprap.fluid.kernels.sharp_density import face_densities
+
+        out = []
+        for axis, shape in enumerate((self.u.shape, self.v.shape, self.w.shape)):
+            density = np.ones(shape)
+            if not (axis == 1 and self.grid.two_dimensional):
+                face_densities(self.fraction, axis, self.water.density, self.air.density, density)
+            out.append(density)
+        return out
 
     def _porous_friction(self, new_velocities, densities, viscosity, dt) -> None:
         """On porous faces: the predictor's increment scaled by s = n/(1 + c), the friction taken

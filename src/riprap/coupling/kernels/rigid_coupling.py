@@ -249,7 +249,7 @@ def accumulate_rigid(entry_start, entry_face, entry_half, face_axis, face_index,
 
 @parallel_kernel
 def own_momentum_rhs(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
-                     motions, densities, phi, fluid_density, pressure_change, fluid_term, chosen,
+                     motions, densities, phi, fluid_density, pressure_impulse, fluid_term, chosen,
                      rhs):
     """Per body the right-hand side r of its 6 x 6 system after the projection, each part of a
     face's momentum given to whom it belongs: the body's own share at its own blended motion plus
@@ -278,7 +278,7 @@ def own_momentum_rhs(entry_start, entry_face, entry_half, face_axis, face_index,
             rigid = 0.0
             for m in range(6):
                 rigid += jac[m] * motions[b, m]
-            source = (share * own * (rigid + pressure_change[f])
+            source = (share * (own * rigid + pressure_impulse[f])
                       + share / capped * fluid_term[f]) * volume
             for m in range(6):
                 if jac[m] != 0.0:

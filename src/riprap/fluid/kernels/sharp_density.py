@@ -1,0 +1,84 @@
+"""The density the pressure sees on each face: water and air by where the interface cuts the line
+between the two cell centres, not by the mixture in the face's control volume.
+
+Why: a face's pressure gradient is the difference of two cell-centre pressures over h, and
+hydrostatic balance holds on it only if the face density is the density of the fluid actually
+lying between those two centres. The control volume's mixed density (the half cells beside the
+face) counts the water of a mixed cell that lies below its centre as lying above it: the pressure at
+the centre of a mostly-air cell then carries water's weight, neighbouring columns whose interface
+sits at different heights in their cells differ by a fraction of rho_water g h in the interface
+row, and that difference, divided by the low density of the air faces there, accelerates the air
+just above every wave without bound (0.2 m/s in 0.2 s above a 5 mm/s slosh on 5 cm cells). With
+the segment density, a plane interface gives exactly hydrostatic cell pressures in both fluids
+(the ghost-fluid idea, e.g. Kang, Fedkiw & Liu 2000, J. Sci. Comput. 15: 323, and for free-surface
+flows Vukcevic, Jasak & Gatin 2017, Comput. Fluids 153: 1; here without a jump condition, the
+density itself made sharp).
+
+Each half of the segment lies in one cell: ``theta`` is the fraction of it below that cell's
+PLIC plane (``plic.interface_normal`` and ``plic.plane_constant``, the same reconstruction the
+advection uses); full and empty cells give 1 and 0 without one. The face density is
+``theta rho_water + (1 - theta) rho_air`` with ``theta`` the mean of the two halves.
+"""
+import numpy as np
+
+from riprap._jit import kernel, parallel_kernel, prange
+from riprap.fluid.kernels.plic import interface_normal, plane_constant
+
+
+@kernel
+def _half_segment_water(f, i, j, k, axis, toward_high):
+    """Fraction of the segment from the centre of cell (i, j, k) to its face along ``axis`` (the
+    high face if ``toward_high``) lying in water."""
+    fraction = f[i, j, k]
+    if fraction <= 0.0:
+        return 0.0
+    if fraction >= 1.0:
+        return 1.0
+    n1, n2, n3 = interface_normal(f, i, j, k)
+    if n1 == 0.0 and n2 == 0.0 and n3 == 0.0:
+        return fraction
+    alpha = plane_constant(n1, n2, n3, fraction)
+    # water where n . x <= alpha; along the half segment n . x is linear, from the centre on
+    start = 0.5 * (n1 + n2 + n3) - alpha
+    along = n1 if axis == 0 else (n2 if axis == 1 else n3)
+    end = start + (0.5 * along if toward_high else -0.5 * along)
+    if start <= 0.0 and end <= 0.0:
+        return 1.0
+    if start > 0.0 and end > 0.0:
+        return 0.0
+    crossing = start / (start - end)
+    return crossing if start <= 0.0 else 1.0 - crossing
+
+
+@parallel_kernel
+def face_densities(f, axis, water_density, air_density, out):
+    """``out`` (the face array of ``axis``): the segment density of every interior face; the
+    boundary faces along ``axis`` get the density of their one cell's half segment."""
+    n_along = f.shape[axis]
+    face_nx, face_ny, face_nz = out.shape
+    for outer in prange(face_nx):
+        i = np.int64(outer)
+        for j in range(face_ny):
+            for k in range(face_nz):
+                s = i if axis == 0 else (j if axis == 1 else k)
+                low = s - 1 if s > 0 else 0
+                high = s if s < n_along else n_along - 1
+                il, jl, kl = i, j, k
+                ih, jh, kh = i, j, k
+                if axis == 0:
+                    il, ih = low, high
+                elif axis == 1:
+                    jl, jh = low, high
+                else:
+                    kl, kh = low, high
+                if s == 0:
+                    theta = _half_segment_water(f, ih, jh, kh, axis, False)
+                elif s == n_along:
+                    theta = _half_segment_water(f, il, jl, kl, axis, True)
+                else:
+                    theta = 0.5 * (_half_segment_water(f, il, jl, kl, axis, True)
+                                   + _half_segment_water(f, ih, jh, kh, axis, False))
+                out[i, j, k] = theta * water_density + (1.0 - theta) * air_density
+
+
+__all__ = ["face_densities"]
