@@ -1,7 +1,7 @@
 """The flume test's stability report (``riprap.analysis.stability_report``): the stability number of
 the measured incident waves beside Hudson's (K_D from shared/validation/armour_design.md §5.2) and,
-for cubes, Van der Meer's N_od; the incident height taken from the Goda-Suzuki splits when there
-are any. Constructed reports with known answers (exact arithmetic)."""
+for cubes, Van der Meer's N_od; the incident height taken from the three-gauge splits when there
+are any, else from the Goda-Suzuki pairs. Constructed reports with known answers (exact arithmetic)."""
 import pytest
 
 from riprap.analysis.design_formulas import van_der_meer_cubes_damage
@@ -21,6 +21,10 @@ def test_core_loc_layer_against_hudson_with_the_incident_height():
     assert report["hudson"]["ratio"] == pytest.approx(report["stability_number"] / (16 * 1.33) ** (1 / 3))
     assert report["units_displaced"] == 2 and report["damage_number_nod"] == 0.25
     assert "Goda-Suzuki" in report["wave_height_source"]
+    waves["reflection_three_gauge"] = [{"incident_Hm0_m": 1.0}, {"incident_Hm0_m": 1.1}]
+    report = flume_stability(waves, LAYER, unit_kind="core_loc_like", nominal_diameter=0.5,
+                             armour_density=2400.0, water_density=1000.0, slope_cot=1.33)
+    assert report["Hm0_m"] == pytest.approx(1.05) and "Mansard-Funke" in report["wave_height_source"]
 
 
 def test_cubes_get_van_der_meer_and_no_gauge_gives_a_note():

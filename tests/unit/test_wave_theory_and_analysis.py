@@ -15,7 +15,7 @@ from riprap.errors import CaseFileError
 from riprap.fluid.grid import FluidGrid
 from riprap.fluid.solver import FluidSolver
 from riprap.waves.analysis import (harmonic_amplitude, separate_incident_reflected,
-                                   separate_regular_wave, wave_statistics)
+                                   separate_regular_wave, separate_three_gauges, wave_statistics)
 from riprap.waves.checks import check_flume
 from riprap.waves.gauges import Gauge, GaugeSet
 from riprap.waves.relaxation import RelaxationZone, WaveRelaxation, relaxation_weight
@@ -83,6 +83,47 @@ def test_goda_suzuki_split_recovers_a_known_reflection():
     with pytest.raises(CaseFileError, match="0.05..0.45"):
         separate_regular_wave(t, eta(0.0), eta(1.0), 1.0, depth, period)
     assert abs(abs(harmonic_amplitude(t, eta(0.0), period)) - abs(0.02 + 0.005 * np.exp(-0.7j))) < 1e-8
+
+
+def test_three_gauge_split_recovers_a_known_reflection_where_one_pair_cannot():
+    """Mansard & Funke (1980): a JONSWAP sea (Hm0 0.1 m, Tp 2 s, 1 m deep) reflected with K_r =
+    0.35 and a phase lag, read at x = 0, 0.35 m and L/2 = 2.79 m (the first and third gauges half
+    a peak wave length apart: the two-gauge split of that pair is singular at the peak). The
+    incident Hm0 and K_r come back within 1 %; a regular wave to round-off."""
+    depth, tp, kr = 1.0, 2.0, 0.35
+    sea = IrregularWave(significant_height=0.1, peak_period=tp, depth=depth, duration=400.0, seed=5)
+    t = np.arange(0.0, 400.0, 0.05)
+    frequencies = np.fft.rfftfreq(t.size, 0.05)
+    incident_at_0 = np.array([sea.elevation(0.0, s) for s in t])
+    spectrum = np.fft.rfft(incident_at_0)
+    wave_numbers = np.array([wave_number(1.0 / f, depth) if f > 0 else 0.0 for f in frequencies])
+    def eta(x):     # incident + reflected, each frequency moved by its own wave number
+        incident = np.fft.irfft(spectrum * np.exp(-1j * wave_numbers * x), t.size)
+        reflected = np.fft.irfft(kr * spectrum * np.exp(1j * (wave_numbers * x + 0.9)), t.size)
+        return incident + reflected
+    half_wave_length = math.pi / wave_number(tp, depth)
+    positions = [0.0, 0.35, half_wave_length]
+    split = separate_three_gauges(t, [eta(x) for x in positions], positions, depth, tp)
+    assert abs(split.reflection_coefficient / kr - 1.0) < 0.01
+    incident_hm0 = wave_statistics(t, incident_at_0).hm0
+    band = (frequencies >= 0.5 / tp) & (frequencies <= 2.0 / tp)
+    in_band = 4.0 * math.sqrt(np.sum(0.5 * np.abs(2.0 * spectrum[band] / t.size) ** 2))
+    assert abs(split.incident_hm0 / in_band - 1.0) < 0.01
+    assert in_band / incident_hm0 > 0.95      # the band holds the sea
+    with pytest.raises(CaseFileError, match="0.05..0.45"):
+        separate_incident_reflected(t, eta(0.0), eta(half_wave_length), half_wave_length, depth, tp)
+    period = 1.2
+    k, omega = wave_number(period, depth), 2 * math.pi / period
+    def regular(x):
+        return 0.02 * np.cos(k * x - omega * t) + 0.006 * np.cos(-k * x - omega * t + 0.4)
+    positions = [0.0, 0.3, math.pi / k]
+    split = separate_three_gauges(t, [regular(x) for x in positions], positions, depth, period,
+                                  regular=True)
+    assert abs(split.reflection_coefficient - 0.3) < 1e-9 and abs(split.incident_hm0 - 0.04) < 1e-10
+    with pytest.raises(CaseFileError, match="half wave lengths"):
+        positions = [0.0, math.pi / k, 2 * math.pi / k]
+        separate_three_gauges(t, [regular(x) for x in positions], positions, depth, period,
+                              regular=True)
 
 
 def test_statistics_of_a_sine():

@@ -11,7 +11,8 @@ Sources and tolerances (issue 15's acceptance figures):
   ``LENGTH_TOLERANCE`` = 1 % of the dispersion relation omega^2 = g k tanh(k d) (Dean &
   Dalrymple 1991, eq. 3.34).
 - Reflection from the absorbing end: the two-gauge split of Goda & Suzuki (1976) on neighbouring
-  gauges, every pair below ``REFLECTION_LIMIT`` = 5 %.
+  gauges, every pair below ``REFLECTION_LIMIT`` = 5 %; the same for the three-gauge split of
+  Mansard & Funke (1980) of every neighbouring triple in the flume's own report.
 - Water volume over 20 periods: its mean over the last period differs from the still flume's by
   less than ``VOLUME_DRIFT_LIMIT`` = 0.1 %.
 """
@@ -25,7 +26,7 @@ from riprap.case.build_fluid import build_fluid_solver
 from riprap.case.load import load_case
 from riprap.waves.analysis import harmonic_amplitude, separate_regular_wave, zero_down_crossing_heights
 from riprap.waves.gauges import Gauge, GaugeSet
-from riprap.waves.report import arrival_time
+from riprap.waves.report import arrival_time, flume_report
 
 CASE = Path(__file__).resolve().parents[2] / "examples" / "09_regular_waves" / "case.toml"
 HEIGHT_TOLERANCE = 0.05
@@ -94,6 +95,13 @@ def test_the_absorbing_end_reflects_less_than_five_percent(flume):
         coefficients.append(split.reflection_coefficient)
         assert abs(split.incident_hm0 / wave.height - 1.0) < HEIGHT_TOLERANCE
     assert max(coefficients) < REFLECTION_LIMIT, coefficients
+    # the flume's own report: Mansard & Funke's three-gauge split of every neighbouring triple
+    report = flume_report(gauges, fluid.relaxation)
+    triples = report["reflection_three_gauge"]
+    assert len(triples) == len(positions) - 2
+    for entry in triples:
+        assert entry["reflection_coefficient"] < REFLECTION_LIMIT, entry
+        assert abs(entry["incident_height_m"] / wave.height - 1.0) < HEIGHT_TOLERANCE, entry
 
 
 def test_water_volume_does_not_drift(flume):

@@ -27,14 +27,17 @@ HUDSON_TRUNK_STABILITY = {"core_loc_like": 16.0, "accropode_like": 15.0, "xbloc_
 
 def _incident(waves_report: dict):
     """(incident Hm0, Tz, waves, where it was read) at the toe."""
-    splits = [entry for entry in waves_report.get("reflection", [])
-              if "incident_Hm0_m" in entry or "incident_height_m" in entry]
     gauges = [g for g in waves_report.get("gauges", {}).values() if "Hm0_m" in g]
     period = gauges[0].get("Tz_s") if gauges else None
     waves = gauges[0].get("waves") if gauges else None
-    if splits:
-        heights = [e.get("incident_Hm0_m", e.get("incident_height_m")) for e in splits]
-        return sum(heights) / len(heights), period, waves, "incident (Goda-Suzuki, mean of the gauge pairs)"
+    # three gauges first (Mansard & Funke: no singular spacings, less noise), then pairs
+    for key, method in (("reflection_three_gauge", "Mansard-Funke, mean of the gauge triples"),
+                        ("reflection", "Goda-Suzuki, mean of the gauge pairs")):
+        heights = [e.get("incident_Hm0_m", e.get("incident_height_m"))
+                   for e in waves_report.get(key, [])
+                   if "incident_Hm0_m" in e or "incident_height_m" in e]
+        if heights:
+            return sum(heights) / len(heights), period, waves, f"incident ({method})"
     if gauges:
         return gauges[0]["Hm0_m"], period, waves, "first surface gauge (incident and reflected)"
     return None, None, None, "no analysed surface gauge"

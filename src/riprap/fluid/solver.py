@@ -382,18 +382,18 @@ class FluidSolver:
         """On porous faces: the predictor's increment scaled by s = n/(1 + c), the friction taken
         implicitly; the factors s / (1 + dt K) wait for the pressure's face coefficients
         (``riprap/fluid/porous.py``)."""
-        from riprap.fluid.porous import face_means
+        from riprap.fluid.kernels.porous_faces import face_speeds_and_viscosities
 
         porous = self.porous
-        speed = np.linalg.norm(self.cell_velocity(), axis=-1)
         factors = []
         for axis, (out, old) in enumerate(zip(new_velocities, (self.u, self.v, self.w))):
             faces = porous.faces[axis]
             if faces.size == 0 or (axis == 1 and self.grid.two_dimensional):
                 factors.append(np.ones(faces.size))
                 continue
-            face_speed = face_means(speed, axis).reshape(-1)[faces]
-            face_viscosity = face_means(viscosity, axis).reshape(-1)[faces]
+            face_speed, face_viscosity = np.empty(faces.size), np.empty(faces.size)
+            face_speeds_and_viscosities(self.u, self.v, self.w, viscosity, axis, faces, face_speed,
+                                        face_viscosity)
             density = densities[axis].reshape(-1)[faces]
             scale = porous.scale[axis].reshape(-1)[faces]
             friction = scale * (porous.linear_coefficient[axis].reshape(-1)[faces] * face_viscosity

@@ -13,7 +13,12 @@ Structures*, 3rd ed., ch. 2 and 4; EurOtop 2018 for the spectral period):
   Suzuki 1976, Port Harbour Res. Inst. Tech. Note 248): per frequency the complex amplitudes at
   the gauges are ``Z1 = a_I + a_R``, ``Z2 = a_I e^{ik dx} + a_R e^{-ik dx}``, solved for a_I, a_R
   where 0.05 <= dx / L <= 0.45 (outside it sin(k dx) is too small); the reflection coefficient
-  is ``K_r = sqrt(E_R / E_I)`` over the frequencies that carry the wave's energy.
+  is ``K_r = sqrt(E_R / E_I)`` over the frequencies that carry the wave's energy;
+- the same from three gauges (Mansard & Funke 1980, Proc. 17th ICCE, 154-172): per frequency the
+  least-squares a_I, a_R of ``Z_p = a_I e^{ik x_p} + a_R e^{-ik x_p}`` at the three gauges, which
+  stays defined where one pair's spacing is a whole number of half wave lengths and averages the
+  noise of three records; a frequency is used where the least-squares system is as well posed as
+  the two-gauge one at its band's edge.
 
 Records may be sampled at uneven times (fluid steps); they are put on an even grid first.
 """
@@ -28,7 +33,7 @@ from riprap.errors import CaseFileError
 from riprap.waves.theory import GRAVITY, wave_number
 
 __all__ = ["WaveStatistics", "wave_statistics", "ReflectionAnalysis", "separate_incident_reflected",
-           "separate_regular_wave", "harmonic_amplitude",
+           "separate_regular_wave", "separate_three_gauges", "harmonic_amplitude",
            "even_record", "zero_down_crossing_heights"]
 
 # The band of the Goda-Suzuki split: where the gauge spacing is within this fraction of a wave length.
@@ -193,6 +198,87 @@ def separate_incident_reflected(times, eta_1, eta_2, spacing: float, depth: floa
                               reflection_coefficient=math.sqrt(energy_reflected / energy_incident)
                               if energy_incident > 0 else float("nan"),
                               band=band)
+
+
+# Smallest eigenvalue, per gauge, of the three-gauge least-squares system that is used: the
+# two-gauge system's at a spacing of 0.05 wave lengths (the Goda-Suzuki band's edge).
+_THREE_GAUGE_CONDITION = (2.0 - 2.0 * math.cos(2.0 * math.pi * _GODA_SUZUKI_BAND[0])) / 2.0
+
+
+def _three_gauge_split(amplitudes, k, offsets):
+    """(a_I, a_R) by least squares from the complex amplitudes at the gauges, or None where the
+    system is ill posed (all spacings near whole numbers of half wave lengths)."""
+    phases = np.exp(1j * k * offsets)
+    # normal matrix [[n, S], [conj(S), n]] with S = sum e^{-2ikx}: eigenvalues n -+ |S|
+    n = offsets.size
+    if (n - abs(np.sum(phases ** -2))) / n < _THREE_GAUGE_CONDITION:
+        return None
+    matrix = np.column_stack([phases, 1.0 / phases])
+    (incident, reflected), *_ = np.linalg.lstsq(matrix, amplitudes, rcond=None)
+    return incident, reflected
+
+
+def separate_three_gauges(times, records, positions, depth: float,
+                          peak_period: float | None = None, gravity: float = GRAVITY,
+                          band=(0.5, 2.0), regular: bool = False) -> ReflectionAnalysis:
+    """Mansard & Funke's three-gauge split of ``records`` (three elevation series on ``times``) at
+    ``positions`` (m along the flume), in water of ``depth`` m. Irregular waves: the energy summed
+    over the frequencies from ``band`` times the peak's (``peak_period``, default the spectral peak
+    of the first gauge) where the system is well posed. ``regular``: at the one frequency
+    1/``peak_period`` (``harmonic_amplitude`` at each gauge); the heights are then regular-wave
+    heights (H = 2 a), in the fields named Hm0."""
+    positions = np.asarray(positions, dtype=float)
+    if positions.size != 3 or len(records) != 3:
+        raise CaseFileError(f"wave analysis: the three-gauge split needs three gauges, got "
+                            f"{positions.size}")
+    offsets = positions - positions[0]
+    if np.unique(np.round(offsets, 9)).size != 3:
+        raise CaseFileError(f"wave analysis: the three gauges must stand apart along the flume, "
+                            f"got x = {positions.tolist()} m")
+    if regular:
+        if peak_period is None:
+            raise CaseFileError("wave analysis: the three-gauge split of a regular wave needs its period")
+        k = wave_number(peak_period, depth, gravity)
+        amplitudes = np.array([harmonic_amplitude(times, r, peak_period) for r in records])
+        split = _three_gauge_split(amplitudes, k, offsets)
+        if split is None:
+            raise CaseFileError(f"wave analysis: gauges at x = {positions.tolist()} m are all whole "
+                                f"numbers of half wave lengths apart (L = {2 * math.pi / k:.3g} m): "
+                                "move one by about a tenth of a wave length")
+        incident, reflected = split
+        return ReflectionAnalysis(incident_hm0=2.0 * abs(incident), reflected_hm0=2.0 * abs(reflected),
+                                  reflection_coefficient=abs(reflected) / abs(incident),
+                                  band=(1.0 / peak_period, 1.0 / peak_period))
+    t, first = even_record(times, records[0])
+    evens = [first] + [np.interp(t, np.asarray(times, dtype=float), np.asarray(r, dtype=float))
+                       for r in records[1:]]
+    n = first.size
+    frequencies = np.fft.rfftfreq(n, t[1] - t[0])
+    # complex amplitudes of exp(-i omega t) at each gauge (numpy's rfft is of exp(+i omega t))
+    spectra = np.array([np.conj(np.fft.rfft(e - e.mean())) * 2.0 / n for e in evens])
+    if peak_period is None:
+        peak_period = 1.0 / frequencies[1 + int(np.argmax(np.abs(spectra[0, 1:])))]
+    fp = 1.0 / peak_period
+    energy_incident = energy_reflected = 0.0
+    used = []
+    for m, f in enumerate(frequencies):
+        if m == 0 or not band[0] * fp <= f <= band[1] * fp:
+            continue
+        split = _three_gauge_split(spectra[:, m], wave_number(1.0 / f, depth, gravity), offsets)
+        if split is None:
+            continue
+        energy_incident += 0.5 * abs(split[0]) ** 2
+        energy_reflected += 0.5 * abs(split[1]) ** 2
+        used.append(f)
+    if not used:
+        raise CaseFileError(f"wave analysis: no frequency near the peak ({fp:.3g} Hz) can be split "
+                            f"with gauges at x = {positions.tolist()} m over a record of "
+                            f"{t[-1] - t[0]:.3g} s")
+    return ReflectionAnalysis(incident_hm0=4.0 * math.sqrt(energy_incident),
+                              reflected_hm0=4.0 * math.sqrt(energy_reflected),
+                              reflection_coefficient=math.sqrt(energy_reflected / energy_incident)
+                              if energy_incident > 0 else float("nan"),
+                              band=(used[0], used[-1]))
 
 
 def harmonic_amplitude(times, eta, period: float) -> complex:

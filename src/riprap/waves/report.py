@@ -1,5 +1,5 @@
-"""The flume's wave analysis: per surface gauge its heights and periods, per pair of neighbouring
-surface gauges the incident and reflected waves, per overtopping gauge the overtopped volume and
+"""The flume's wave analysis: per surface gauge its heights and periods, per pair and per triple of
+neighbouring surface gauges the incident and reflected waves (Goda-Suzuki, Mansard-Funke), per overtopping gauge the overtopped volume and
 mean discharge, per run-up gauge R_max and R2%, beside the target wave (``waves_report.json``).
 
 Each record is analysed from the time the wave train has arrived: the ramp, plus the travel from
@@ -13,7 +13,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 from riprap.waves.analysis import (separate_incident_reflected, separate_regular_wave,
-                                   wave_statistics)
+                                   separate_three_gauges, wave_statistics)
 from riprap.waves.gauges import OVERTOPPING, RUN_UP, SURFACE
 
 __all__ = ["flume_report", "group_velocity", "arrival_time", "run_up_statistics",
@@ -129,4 +129,30 @@ def flume_report(gauges, relaxation=None, water_density: float | None = None) ->
                 entry["incident_height_m"] = entry.pop("incident_Hm0_m")
                 entry["reflected_height_m"] = entry.pop("reflected_Hm0_m")
             report["reflection"].append(entry)
+        for triple in zip(ordered[:-2], ordered[1:-1], ordered[2:]):
+            entry = _three_gauge_entry(gauges, windows, triple, wave, regular)
+            if entry is not None:
+                report.setdefault("reflection_three_gauge", []).append(entry)
     return report
+
+
+def _three_gauge_entry(gauges, windows, triple, wave, regular):
+    """Mansard & Funke's split of three neighbouring surface gauges over the last one's window
+    (the train has reached all three), or None where it is too short or cannot be split."""
+    t_last, _ = windows[triple[-1].name]
+    if t_last.size < 8 or t_last[-1] - t_last[0] < 4.0 * wave.period:
+        return None
+    times = gauges.times
+    chosen = times >= t_last[0]
+    records = [gauges.series(g.columns[0])[1][chosen] for g in triple]
+    positions = [g.position[0] for g in triple]
+    try:
+        split = separate_three_gauges(times[chosen], records, positions, wave.depth, wave.period,
+                                      regular=regular)
+    except CaseFileError:
+        return None
+    entry = {"gauges": [g.name for g in triple], "x_m": positions, **split.as_dict()}
+    if regular:
+        entry["incident_height_m"] = entry.pop("incident_Hm0_m")
+        entry["reflected_height_m"] = entry.pop("reflected_Hm0_m")
+    return entry

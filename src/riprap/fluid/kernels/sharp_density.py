@@ -22,6 +22,7 @@ advection uses); full and empty cells give 1 and 0 without one. The face density
 import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
+from riprap.fluid.kernels.faces import cells_beside_face
 from riprap.fluid.kernels.plic import interface_normal, plane_constant
 
 
@@ -61,16 +62,7 @@ def face_densities(f, axis, water_density, air_density, out):
         for j in range(face_ny):
             for k in range(face_nz):
                 s = i if axis == 0 else (j if axis == 1 else k)
-                low = s - 1 if s > 0 else 0
-                high = s if s < n_along else n_along - 1
-                il, jl, kl = i, j, k
-                ih, jh, kh = i, j, k
-                if axis == 0:
-                    il, ih = low, high
-                elif axis == 1:
-                    jl, jh = low, high
-                else:
-                    kl, kh = low, high
+                il, jl, kl, ih, jh, kh = cells_beside_face(axis, i, j, k, n_along)
                 if s == 0:
                     theta = _half_segment_water(f, ih, jh, kh, axis, False)
                 elif s == n_along:
