@@ -136,6 +136,9 @@ def test_a_coupled_run_gives_each_units_displacement_and_rotation_since_frame_0(
     # damage: moved less than one D_n, so nothing displaced (N_od 0); turned once, never back
     assert layer["units_displaced"] == [] and layer["damage_number_nod"] == 0.0
     assert list(units["rocking_events"]) == [0, 0] and layer["rocking_events"] == 0
+    # the moved unit uncovers part of its old place: the cross-section's surface went down there
+    assert layer["eroded_area_m2"] > 0.0
+    assert layer["damage_level_s"] == pytest.approx(layer["eroded_area_m2"] / dn ** 2)
     # The same numbers in units.csv; the contact columns are empty, not zero.
     lines = (out / "units.csv").read_text().splitlines()
     rows = [dict(zip(lines[0].split(","), line.split(","))) for line in lines[1:]]
@@ -156,6 +159,7 @@ def test_frame_0_of_a_run_has_not_moved_and_a_pack_has_no_reference(coupled_run,
     at_start = analyse(coupled_run, frame=0)
     assert at_start.units["displacement_m"] == pytest.approx([0.0, 0.0], abs=1e-9)
     assert at_start.units["rotation_deg"] == pytest.approx([0.0, 0.0], abs=1e-6)
+    assert at_start.layer["eroded_area_m2"] == 0.0 and at_start.layer["damage_level_s"] == 0.0
     pack = analyse(coupled_run.parent / "pack", out=tmp_path / "pack_analysis")
     assert np.isnan(pack.units["displacement_m"]).all()
     assert "no earlier state" in pack.layer["displacement_reference"]

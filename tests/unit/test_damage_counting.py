@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from riprap.analysis.damage import (damage_level_s, damage_number_nod, displaced_units,
-                                    eroded_area, rocking_events, surface_profile)
+                                    eroded_area, profile_from_surfaces, rocking_events,
+                                    surface_profile)
 from riprap.analysis.displacements import unit_displacements
 from riprap.errors import CaseFileError
 
@@ -58,3 +59,31 @@ def test_profile_is_the_upper_envelope_averaged_over_strips():
     assert np.isnan(profile[2])
     with pytest.raises(CaseFileError, match="threshold must be > 0"):
         displaced_units([1.0], 0.0)
+
+
+def _cube_triangles(lower, size=1.0):
+    from riprap.geometry import shapes
+
+    mesh = shapes.box(lengths=(size, size, size))
+    nodes = mesh.nodes - mesh.nodes.min(axis=0) + np.asarray(lower, dtype=float)
+    return nodes[mesh.boundary_faces()]
+
+
+def test_a_unit_taken_out_of_a_two_layer_stack_erodes_its_cross_section():
+    """Two layers of four unit cubes along x (1 m wide flume); taking the top cube over
+    x = 1..2 away lowers the surface there from 2 m to 1 m: A_e = 1 m^2 exactly, S = 1 / D_n^2.
+    The profile is read from the cubes' surface triangles; the mesh nodes' highest points per
+    bin would still see the neighbours' corners at x = 1 and 2."""
+    spacing = 0.25
+    xs = np.arange(0.5 * spacing, 4.0, spacing)
+    ys = np.arange(0.5 * spacing, 1.0, spacing)
+    cubes = [_cube_triangles((i, 0.0, layer)) for layer in (0.0, 1.0) for i in range(4)]
+    before = profile_from_surfaces(np.concatenate(cubes), xs, ys)
+    assert np.allclose(before, 2.0)
+    after = profile_from_surfaces(np.concatenate(cubes[:5] + cubes[6:]), xs, ys)
+    assert np.allclose(after, np.where((xs > 1.0) & (xs < 2.0), 1.0, 2.0))
+    area = eroded_area(before, after, spacing)
+    assert area == pytest.approx(1.0, abs=1e-12)
+    assert damage_level_s(area, 0.8) == pytest.approx(1.0 / 0.64)
+    outside = profile_from_surfaces(np.concatenate(cubes), np.array([5.0, 6.0]), ys)
+    assert np.all(np.isnan(outside))

@@ -10,7 +10,9 @@
   eroded area of the cross-section, from profiles of the armour's surface before and after: the
   area between them where the surface went down. A profile is the upper envelope of the armour's
   surface points in bins along the section, averaged over strips across the flume (as a profiler
-  on a carriage measures lines across the width and averages them).
+  on a carriage measures lines across the width and averages them). From a run's bodies
+  (``profile_from_surfaces``): the highest surface triangle above each point of an even plan grid
+  (``riprap.analysis.surface_heights``), averaged across the width.
 """
 from __future__ import annotations
 
@@ -21,7 +23,7 @@ import numpy as np
 from riprap.errors import CaseFileError
 
 __all__ = ["displaced_units", "damage_number_nod", "rocking_events", "surface_profile",
-           "eroded_area", "damage_level_s"]
+           "profile_from_surfaces", "eroded_area", "damage_level_s"]
 
 
 def displaced_units(displacement_over_dn, threshold: float = 1.0) -> np.ndarray:
@@ -76,6 +78,29 @@ def surface_profile(points, x_edges, y_edges) -> np.ndarray:
     profile = np.full(nx, np.nan)
     has = counted > 0
     profile[has] = np.nansum(top[has], axis=1) / counted[has]
+    return profile
+
+
+def profile_from_surfaces(triangles, xs, ys, floor=None) -> np.ndarray:
+    """The armour surface's height at each x of ``xs`` (m along the section, evenly spaced): the
+    highest of the ``triangles`` ((T, 3, 3) corners in the world, m) above each point of the plan
+    grid ``xs`` x ``ys`` (``ys`` evenly spaced across the flume), averaged across. ``floor`` (one
+    height per x, optional): what a point no triangle covers reads (the slope's face under the
+    layer); without it such points are left out of the mean, and an x no triangle covers is NaN."""
+    from riprap.analysis.surface_heights import highest_surface
+
+    xs, ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
+    if xs.size < 2 or ys.size < 1:
+        raise CaseFileError("damage: a profile needs at least two x and one y")
+    heights = np.full((xs.size, ys.size), -np.inf)
+    if floor is not None:
+        heights[:] = np.asarray(floor, dtype=float).reshape(-1, 1)
+    highest_surface(np.ascontiguousarray(triangles, dtype=float).reshape(-1, 3, 3), xs, ys, heights)
+    heights[np.isinf(heights)] = np.nan
+    covered = np.isfinite(heights).sum(axis=1)
+    profile = np.full(xs.size, np.nan)
+    has = covered > 0
+    profile[has] = np.nansum(heights[has], axis=1) / covered[has]
     return profile
 
 

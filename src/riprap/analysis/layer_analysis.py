@@ -25,7 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from riprap.analysis.damage import damage_number_nod, displaced_units, rocking_events
+from riprap.analysis.damage import (damage_level_s, damage_number_nod, displaced_units, eroded_area,
+                                   profile_from_surfaces, rocking_events)
 from riprap.analysis.displacements import DISPLACEMENT_COLUMNS, unit_displacements
 from riprap.analysis.orientations import equal_area_points, lower_hemisphere, trend_plunge
 from riprap.analysis.rocking import rocking_factor_of_safety
@@ -49,6 +50,8 @@ DISPLACED_THRESHOLD_DN = 1.0
 #: A rocking event: the unit's rotation from its reference pose rises above this (degrees) and
 #: falls back below half of it (``riprap.analysis.damage.rocking_events``).
 ROCKING_ANGLE_DEG = 2.0
+#: Profile points per nominal diameter along and across the section (for the eroded area).
+PROFILE_SAMPLES_PER_DN = 4
 
 
 @dataclass(frozen=True, eq=False)
@@ -266,4 +269,34 @@ def _displacement_summary(state, columns) -> dict:
             "mean_displacement_m": float(distance.mean()) if len(distance) else 0.0,
             "max_rotation_deg": float(turned.max(initial=0.0)),
             "moved_threshold_over_dn": MOVED_THRESHOLD_DN,
-            "units_moved": [int(k) for k in moved]}
+            "units_moved": [int(k) for k in moved],
+            **_profile_damage(state)}
+
+
+def _profile_damage(state) -> dict:
+    """Eroded area A_e and damage level S = A_e / D_n^2 of the cross-section between the reference
+    and this state: profiles of the bodies' upper surface, lowered onto every body's surface
+    triangles at each pose on a plan grid of D_n / 4 over the slope (a D_n beyond its toe and top)
+    and averaged across the width, the slope's face read where no body covers a point
+    (``riprap.analysis.damage.profile_from_surfaces``)."""
+    layer = state.layer
+    slope, dn = layer.slope, layer.nominal_diameter
+    spacing = dn / PROFILE_SAMPLES_PER_DN
+    x_toe = float(slope.to_world(0.0, 0.0, 0.0)[0])
+    x_top = float(slope.to_world(slope.length, 0.0, 0.0)[0])
+    xs = np.arange(min(x_toe, x_top) - dn, max(x_toe, x_top) + dn + 0.5 * spacing, spacing)
+    ys = np.arange(0.5 * spacing, slope.width, spacing)
+    now, before = [], []
+    for body in range(state.n_bodies):
+        faces = state.boundary_faces(body)
+        shape = int(state.shape_of_body[body])
+        local = state.meshes[shape].nodes - state.mesh_centroids[shape]
+        now.append((local @ state.rotations[body].T + state.positions[body])[faces])
+        before.append((local @ np.asarray(state.reference_rotations)[body].T
+                       + np.asarray(state.reference_positions)[body])[faces])
+    along = np.clip((xs - slope.toe[0]) / slope.tangent[0], 0.0, slope.length)
+    face = slope.toe[2] + along * slope.tangent[2]
+    eroded = eroded_area(profile_from_surfaces(np.concatenate(before), xs, ys, face),
+                         profile_from_surfaces(np.concatenate(now), xs, ys, face), spacing)
+    return {"eroded_area_m2": eroded, "damage_level_s": damage_level_s(eroded, dn),
+            "profile_spacing_m": spacing}
