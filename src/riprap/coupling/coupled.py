@@ -536,7 +536,10 @@ class CoupledSolver:
         centres = solids.positions
         # What the predictor's fluxes (advection, viscous stress, surface tension) moved across
         # each body's surface is the body's: its faces' momentum change there, less gravity.
-        impulses = (rho_fluid * (fluid_part - fluid.gravity[faces.axis] * dt)
+        # In a porous zone the predictor gave the pore water the zone's factor of gravity (only the
+        # fluid's share moves through the pores; the bodies' shares move as themselves).
+        porous = self._porous_factors(faces)
+        impulses = (rho_fluid * (fluid_part - porous * fluid.gravity[faces.axis] * dt)
                     - start_density * start_velocity)
         zero = faces.zeros()
         matrices, body_matrices, transferred = self._momentum_systems(
@@ -566,10 +569,13 @@ class CoupledSolver:
         inverse_fluid = 1.0 / rho_pressure
         rigid_coupling.accumulate_density(*faces.entries, self._inverse_densities(densities),
                                           faces.phi, inverse_fluid, inverse_solid)
-        inverse_mixture = fluid_share * inverse_fluid + inverse_solid
+        # In a porous zone the fluid's share's coefficient is scaled by the zone's factor
+        # n / (1 + c) / (1 + dt K); a body's share is not.
+        inverse_mixture = fluid_share * inverse_fluid * porous + inverse_solid
         faces.scatter(blended, (u, v, w))
         pressure_densities = [a.copy() for a in fluid.pressure_densities]
-        faces.scatter(1.0 / inverse_mixture, pressure_densities)
+        # (the fluid's face coefficients scale porous faces by the zone's factor once more)
+        faces.scatter(porous / inverse_mixture, pressure_densities)
         exchange_seconds += time.perf_counter() - started
         betas = fluid._face_coefficients(pressure_densities)
         # The free bodies' cells get extra smoothing in the pressure solve: a heavy body in air
@@ -591,8 +597,11 @@ class CoupledSolver:
         # Each part of a face's momentum after the projection goes to whom it belongs: a body's
         # share moves with its own blended motion plus the pressure's change of the face velocity.
         # The pressure's impulse per unit volume on each face, which each share takes in full.
+        # -dt grad p per unit volume on each face: each body's share takes it in full, the
+        # fluid's share in a porous zone the zone's factor of it
         pressure_impulse = (projected - blended) / inverse_mixture
-        fluid_term = fluid_share * (rho_fluid * (fluid_part - fluid_share * projected) + pressure_impulse)
+        fluid_term = fluid_share * (rho_fluid * (fluid_part - fluid_share * projected)
+                                    + porous * pressure_impulse)
         rhs = self._own_momentum(faces, centres, predicted, densities, rho_fluid, pressure_impulse,
                                  fluid_term, free)
         final = np.zeros((solids.n_bodies, 6))
@@ -615,7 +624,8 @@ class CoupledSolver:
         self._carried = (faces.axis.copy(), faces.index.copy(), projected.copy())
         if self.check_momentum:
             self.last_exchange_balance = self._exchange_balance(
-                faces, fluid_share * rho_fluid, fluid_part, after, pressure_impulse,
+                faces, fluid_share * rho_fluid, fluid_part, after,
+                (fluid_share * porous + faces.capped) * pressure_impulse,
                 body_matrices, predicted, final, free)
         exchange_seconds += time.perf_counter() - started
         fluid_report = fluid.finish_step(u, v, w, pressure, report, dt, courant)
@@ -651,6 +661,26 @@ class CoupledSolver:
                                         np.array(velocities), np.array(unaccounted), with_matrices,
                                         chosen, matrices, body, rhs)
         return matrices, body, rhs
+
+    def _porous_factors(self, faces) -> np.ndarray:
+        """The fluid's porous factor (``FluidSolver._porous_factors``) on each face of the set;
+        1 outside porous zones."""
+        fluid = self.fluid
+        factors = np.ones(len(faces.axis))
+        if fluid._porous_factors is None:
+            return factors
+        for axis in range(3):
+            listed = fluid.porous.faces[axis]
+            if listed.size == 0:
+                continue
+            on_axis = np.flatnonzero(faces.axis == axis)
+            shape = (fluid.u, fluid.v, fluid.w)[axis].shape
+            flat = np.ravel_multi_index(tuple(faces.index[on_axis].T), shape)
+            where = np.searchsorted(listed, flat)
+            inside = where < listed.size
+            inside[inside] = listed[where[inside]] == flat[inside]
+            factors[on_axis[inside]] = fluid._porous_factors[axis][where[inside]]
+        return factors
 
     @staticmethod
     def _inverse_densities(densities) -> np.ndarray:
@@ -713,7 +743,7 @@ class CoupledSolver:
                                                self._free_pressure_loads))
         return self._loads_for_output
 
-    def _exchange_balance(self, faces, fluid_share, before, after, pressure_impulse,
+    def _exchange_balance(self, faces, fluid_share, before, after, face_impulse,
                           body_matrices, predicted, final, free) -> np.ndarray:
         """Momentum of fluid and free bodies after the exchange, less before, less the pressure's
         impulse (which only the walls do not return): zero to round-off (N s, per axis). Faces the
@@ -724,7 +754,7 @@ class CoupledSolver:
         for a in range(3):
             on = faces.interior & (faces.axis == a)
             balance[a] = volume * (np.sum((fluid_share * (after - before))[on])
-                                   - np.sum(pressure_impulse[on]))
+                                   - np.sum(face_impulse[on]))
         bodies = np.einsum("bij,bj->bi", body_matrices[free], final[free] - predicted[free])
         return balance + bodies[:, :3].sum(axis=0)
 
