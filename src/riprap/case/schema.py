@@ -627,8 +627,10 @@ KEYS: tuple[Key, ...] = (
     Key("gauges", "position", "vector", "m", "Where the gauge is (a surface gauge uses x and y).",
         variant="surface"),
     Key("gauges", "position", "vector", "m", "The point read.", variant="velocity"),
-    Key("gauges", "position", "vector", "m", "A point of the plane x = const (y, z unused).",
-        variant="overtopping"),
+    Key("gauges", "position", "vector", "m",
+        "A point of the plane x = const at the crest level z: only the water crossing above it "
+        "(from the cell row holding it up) counts, not the flow through a core under the crest "
+        "(y unused).", variant="overtopping"),
     Key("gauges", "position", "vector", "m",
         "Where the run-up is looked for from (x; y picks the cell row; z unused).",
         variant="run_up"),

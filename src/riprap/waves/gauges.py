@@ -6,10 +6,12 @@ elevation eta (m) above the still water level, exact for a single-valued surface
 holds a plunging jet's air pocket counts only its water). A velocity gauge reads (u, v, w) at its
 point, each component interpolated linearly between the faces that carry it.
 
-An overtopping gauge stands on a plane x = const (the crest's landward edge): it reads the water
-volume that crossed the plane in each step per metre of flume width (the volume-of-fluid step's
-own face fluxes, so exactly the water that went over), summed into the overtopped volume per
-metre V (m^3/m), and that step's mean discharge q (m^3/s per m). A
+An overtopping gauge stands on a plane x = const (the crest's landward edge) at the crest level z
+of its ``position``: it reads the water volume that crossed the plane above that level in each
+step per metre of flume width (the volume-of-fluid step's own face fluxes, so exactly the water
+that went over; from the cell row that holds the crest level up, so that the flow through a
+porous core under the crest is not counted), summed into the overtopped volume per metre V
+(m^3/m), and that step's mean discharge q (m^3/s per m). A
 run-up gauge reads, between x = ``position`` x and ``to_x``, the highest level the water reaches
 on the slope: in each cell column the top of the water resting on the column's bed (its obstacle
 cells, or the box's bottom; cells more than half water counted up from there, plus the part of
@@ -119,8 +121,8 @@ class GaugeSet:
                 where.append(column[:2])
                 continue
             if gauge.kind == OVERTOPPING:
-                # the x face nearest the plane
-                where.append(int(min(max(round((p[0] - lower[0]) / h), 0), cells[0])))
+                # the x face nearest the plane, from the cell row holding the crest level up
+                where.append((int(min(max(round((p[0] - lower[0]) / h), 0), cells[0])), column[2]))
                 continue
             if gauge.kind == RUN_UP:
                 last = int(min(max((gauge.to_x - lower[0]) // h, 0), cells[0] - 1))
@@ -224,15 +226,17 @@ class GaugeSet:
         return self.times.copy(), self.values[:, self.columns.index(column)].copy()
 
 
-def _water_crossed_per_width(fluid, face: int) -> float:
-    """Water volume per metre of width (m^3/m) that crossed the x faces of index ``face`` in the
-    fluid's last step: the volume-of-fluid step's own fluxes, so that it is exactly the water that
-    left one side and reached the other. 0 before the first step."""
+def _water_crossed_per_width(fluid, place) -> float:
+    """Water volume per metre of width (m^3/m) that crossed the x faces of index ``place[0]``
+    from cell row ``place[1]`` up in the fluid's last step: the volume-of-fluid step's own fluxes,
+    so that it is exactly the water that left one side and reached the other. 0 before the first
+    step."""
     fluxes = getattr(fluid, "last_water_fluxes", None)
     if fluxes is None or fluid.step_count == 0:
         return 0.0
+    face, row = place
     width = fluid.h * fluid.fraction.shape[1]
-    return float(np.sum(fluxes[0][face])) / width
+    return float(np.sum(fluxes[0][face][:, row:])) / width
 
 
 def _highest_contiguous_water(fluid, first: int, last: int, j: int, h: float, bottom: float) -> float:
