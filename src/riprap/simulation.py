@@ -742,17 +742,28 @@ def _require(ok: bool, key: str, value, expected: str) -> None:
         raise CaseFileError(f"simulation.{key} = {value!r}: expected {expected}")
 
 
+#: Wall seconds between the plain progress lines written where stderr is not a terminal (a run
+#: sent to a log file or a batch queue), where a live bar shows nothing.
+PLAIN_PROGRESS_PERIOD = 60.0
+
+
 class _Progress:
-    """A rich progress bar: simulated time, steps/s and the model's own figures."""
+    """A rich progress bar on a terminal: simulated time, steps/s and the model's own figures; a
+    plain line every ``PLAIN_PROGRESS_PERIOD`` wall seconds to stderr elsewhere."""
 
     def __init__(self, enabled: bool, end_time: float, name: str):
+        import sys
+
         self.enabled = enabled
         self.end_time = end_time
         self.name = name
         self._progress = None
+        self._plain = enabled and not sys.stderr.isatty()
+        self._last_line = wallclock.perf_counter()
+        self._start_time = None
 
     def __enter__(self):
-        if self.enabled:
+        if self.enabled and not self._plain:
             from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
             self._progress = Progress(
@@ -765,12 +776,33 @@ class _Progress:
         return self
 
     def update(self, model, start_wall, start_steps):
+        if self._plain:
+            self._plain_line(model, start_wall)
         if self._progress is None:
             return
         rate = (model.step_count - start_steps) / max(wallclock.perf_counter() - start_wall, 1e-9)
         self._progress.update(self._task, completed=min(model.time, self.end_time),
                               rate=f"{rate:,.1f}" if rate < 100 else f"{rate:,.0f}",
                               figures=model.progress_text())
+
+    def _plain_line(self, model, start_wall) -> None:
+        import sys
+
+        now = wallclock.perf_counter()
+        if self._start_time is None:          # the rate counts from the first chunk's end
+            self._start_time, self._start_wall = model.time, now
+            return
+        if now - self._last_line < PLAIN_PROGRESS_PERIOD or model.time <= self._start_time:
+            return
+        self._last_line = now
+        wall = now - start_wall
+        done = min(model.time, self.end_time)
+        # wall seconds per simulated second so far
+        rate = (now - self._start_wall) / (model.time - self._start_time)
+        remaining = max(self.end_time - done, 0.0) * rate
+        print(f"riprap: {self.name}: t = {done:.4g} / {self.end_time:.4g} s, {wall:.0f} s wall "
+              f"({rate:.3g} s per simulated s, about {remaining / 60:.0f} min to go)  "
+              f"{model.progress_text()}", file=sys.stderr, flush=True)
 
     def __exit__(self, *exc):
         if self._progress is not None:

@@ -105,3 +105,18 @@ def test_a_body_that_blows_up_in_the_flow_is_named_with_its_cell_and_time(tmp_pa
     assert metadata["kind"] == "riprap coupled run"
     assert {"fraction", "u", "bodies_positions", "bodies_velocities"} <= set(arrays)
     assert np.array_equal(arrays["bodies_positions"][0], [0.1, 0.1, 0.1]), "the last good state"
+
+
+def test_a_run_whose_stderr_is_not_a_terminal_writes_plain_progress_lines(tmp_path, monkeypatch,
+                                                                         capsys):
+    """A run sent to a log file (nohup, a batch queue) shows no live bar: it says where it is in
+    plain lines instead (every PLAIN_PROGRESS_PERIOD wall seconds; here every chunk)."""
+    import riprap.simulation as simulation
+
+    monkeypatch.setattr(simulation, "PLAIN_PROGRESS_PERIOD", 0.0)
+    sim = rr.Simulation(end_time=0.02, output_interval=0.01, fluid=_tank(8),
+                        output_directory=tmp_path / "logged", progress=True, picture=False)
+    sim.run()
+    lines = [line for line in capsys.readouterr().err.splitlines() if " / 0.02 s" in line]
+    assert lines and "per simulated s" in lines[-1] and "pressure iterations" in lines[-1]
+    assert lines[-1].startswith("riprap: fluid: t = ")
