@@ -573,11 +573,12 @@ class CoupledSolver:
         # n / (1 + c) / (1 + dt K); a body's share is not.
         inverse_mixture = fluid_share * inverse_fluid * porous + inverse_solid
         faces.scatter(blended, (u, v, w))
-        pressure_densities = [a.copy() for a in fluid.pressure_densities]
-        # (the fluid's face coefficients scale porous faces by the zone's factor once more)
-        faces.scatter(porous / inverse_mixture, pressure_densities)
+        # The fluid's pressure densities of this step are not read again (the fluid's share was
+        # gathered above): the touched faces take the shares' in place. (The fluid's face
+        # coefficients scale porous faces by the zone's factor once more.)
+        faces.scatter(porous / inverse_mixture, fluid.pressure_densities)
         exchange_seconds += time.perf_counter() - started
-        betas = fluid._face_coefficients(pressure_densities)
+        betas = fluid._face_coefficients(fluid.pressure_densities)
         # The free bodies' cells get extra smoothing in the pressure solve: a heavy body in air
         # is an island of its own pressure modes that the coarse grids miss.
         pressure, report = fluid.project(u, v, w, betas, dt,

@@ -125,10 +125,7 @@ def flume_report(gauges, relaxation=None, water_density: float | None = None) ->
             except CaseFileError:
                 continue        # spacing outside 0.05 .. 0.45 wave lengths: no split for this pair
             entry = {"gauges": [first.name, second.name], "spacing_m": spacing, **split.as_dict()}
-            if regular:
-                entry["incident_height_m"] = entry.pop("incident_Hm0_m")
-                entry["reflected_height_m"] = entry.pop("reflected_Hm0_m")
-            report["reflection"].append(entry)
+            report["reflection"].append(_named_for(entry, regular))
         for triple in zip(ordered[:-2], ordered[1:-1], ordered[2:]):
             entry = _three_gauge_entry(gauges, windows, triple, wave, regular)
             if entry is not None:
@@ -151,7 +148,12 @@ def _three_gauge_entry(gauges, windows, triple, wave, regular):
                                       regular=regular)
     except CaseFileError:
         return None
-    entry = {"gauges": [g.name for g in triple], "x_m": positions, **split.as_dict()}
+    return _named_for({"gauges": [g.name for g in triple], "x_m": positions, **split.as_dict()},
+                      regular)
+
+
+def _named_for(entry: dict, regular: bool) -> dict:
+    """A split's entry with a regular wave's heights named as heights (H = 2 a), not Hm0."""
     if regular:
         entry["incident_height_m"] = entry.pop("incident_Hm0_m")
         entry["reflected_height_m"] = entry.pop("reflected_Hm0_m")
