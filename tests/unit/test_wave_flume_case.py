@@ -51,7 +51,7 @@ position = [1.5, 0.01, 0.0]
 [[gauges]]
 type = "overtopping"
 name = "above"
-position = [1.5, 0.01, 0.42]
+position = [1.5, 0.01, {above_z}]
 [[gauges]]
 type = "run_up"
 name = "up"
@@ -60,9 +60,9 @@ to_x = 2.0
 """
 
 
-def _case(end_time=0.4, length=5.6, kind="linear", extra="", gauge_x=1.8):
+def _case(end_time=0.4, length=5.6, kind="linear", extra="", gauge_x=1.8, above_z=0.42):
     text = CASE.format(end_time=end_time, length=length, cells=round(length / 0.02), kind=kind,
-                       extra=extra, gauge_x=gauge_x)
+                       extra=extra, gauge_x=gauge_x, above_z=above_z)
     return parse_case(text, source="flume.toml")
 
 
@@ -102,6 +102,7 @@ def test_flume_writes_gauges_and_report_and_restarts_bit_for_bit(tmp_path):
     (dict(extra="generation_zone = 0.3"), "generation zone is 0.3 m long"),
     (dict(extra="absorption_zone = 0.5"), "needed to absorb"),
     (dict(gauge_x=9.0), "flume.toml \\[\\[gauges\\]\\]: gauge 'a'"),
+    (dict(above_z=4.2), "gauge 'above' at \\[1.5, 0.01, 4.2\\] m is outside the fluid box"),
 ])
 def test_bad_flumes_are_refused_naming_the_file(change, message):
     with pytest.raises(CaseFileError, match=message):
@@ -137,7 +138,7 @@ period = 1.0
 def test_an_irregular_sea_is_built_from_its_spectrum():
     def sea_case(end_time):
         text = CASE.format(end_time=end_time, length=5.6, cells=280, kind="irregular", extra="",
-                           gauge_x=1.8)
+                           gauge_x=1.8, above_z=0.42)
         text = text.replace("height = 0.04\nperiod = 1.0", "significant_height = 0.05\npeak_period = 1.0")
         return parse_case(text, source="sea.toml")
 

@@ -100,7 +100,8 @@ class GaugeSet:
         lower, upper = np.asarray(grid.lower), np.asarray(grid.upper)
         for gauge in self.gauges:
             p = np.asarray(gauge.position, dtype=float)
-            axes = (0, 1, 2) if gauge.kind == VELOCITY else (0, 1)
+            # an overtopping gauge's z is its crest level: inside the box too
+            axes = (0, 1, 2) if gauge.kind in (VELOCITY, OVERTOPPING) else (0, 1)
             outside = [a for a in axes if not lower[a] <= p[a] <= upper[a]]
             if gauge.kind == RUN_UP and not gauge.to_x <= upper[0]:
                 outside.append(0)
