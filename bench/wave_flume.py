@@ -40,7 +40,7 @@ def main():
     simulation.prepare()
     coupled = simulation.model.solver
     fluid, solids = coupled.fluid, coupled.solids
-    period = fluid.relaxation.wave.period
+    period = fluid.wave_source.wave.period
     print(f"examples/10: {fluid.grid.n_cells:,} cells ({' x '.join(map(str, fluid.grid.cells))}, "
           f"{fluid.h:g} m), {int((~solids.fixed).sum())} free units, {int(solids.fixed.sum())} "
           f"fixed bodies, contact sub-step {coupled.solid_time_step:.2e} s, Tp = {period:g} s")

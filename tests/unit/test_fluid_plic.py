@@ -386,7 +386,7 @@ def test_advect_water_fluxes_are_the_volumes_used():
     fractions = before.copy()
     indicator = (fractions > 0.5).astype(float)
     flux = np.zeros_like(w)
-    advect_sweep(fractions, w, indicator, dt, H, 2, flux, np.ones_like(fractions))
+    advect_sweep(fractions, w, indicator, dt, H, 2, flux, np.ones_like(fractions), False)
     expected = (before - np.diff(flux, axis=2) / H ** 3
                 + indicator * dt / H * np.diff(w, axis=2))
     assert np.abs(fractions - np.clip(expected, 0.0, 1.0)).max() < 1e-15

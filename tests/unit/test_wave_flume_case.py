@@ -1,6 +1,7 @@
 """A flume in a case file (``[waves]``, ``[[gauges]]``): it runs, writes its gauges and report,
 restarts with the gauge records continued bit for bit, and bad flume input is refused naming the
 file and the key."""
+import dataclasses
 import json
 
 import numpy as np
@@ -66,8 +67,9 @@ def _case(end_time=0.4, length=5.6, kind="linear", extra="", gauge_x=1.8, above_
     return parse_case(text, source="flume.toml")
 
 
-def _run(tmp_path, name, end_time, restart=None):
-    run = build_fluid_run(_case(end_time), output_directory=tmp_path / name, progress=False)
+def _run(tmp_path, name, end_time, restart=None, extra=""):
+    run = build_fluid_run(_case(end_time, extra=extra), output_directory=tmp_path / name,
+                          progress=False)
     return run, run.run(restart_from=restart)
 
 
@@ -103,6 +105,9 @@ def test_flume_writes_gauges_and_report_and_restarts_bit_for_bit(tmp_path):
     (dict(extra="absorption_zone = 0.5"), "needed to absorb"),
     (dict(gauge_x=9.0), "flume.toml \\[\\[gauges\\]\\]: gauge 'a'"),
     (dict(above_z=4.2), "gauge 'above' at \\[1.5, 0.01, 4.2\\] m is outside the fluid box"),
+    (dict(extra='generation = "boundary"\ngeneration_zone = 1.4'), "which has no zone"),
+    (dict(extra='generation = "boundary"\nabsorption_zone = 0.5'), "needed to absorb"),
+    (dict(extra='generation = "bounday"'), "generation"),
 ])
 def test_bad_flumes_are_refused_naming_the_file(change, message):
     with pytest.raises(CaseFileError, match=message):
@@ -146,3 +151,43 @@ def test_an_irregular_sea_is_built_from_its_spectrum():
     assert sea.duration == 20.0 and sea.frequencies[1] - sea.frequencies[0] == pytest.approx(1 / 20.0)
     with pytest.raises(CaseFileError, match="sea.toml \\[waves\\]: waves: duration 1 s"):
         build_fluid_run(sea_case(1.0), progress=False)
+
+
+def test_a_boundary_wave_maker_restarts_bit_for_bit_and_brings_water_in(tmp_path):
+    """generation = "boundary": the x = lower faces carry the wave's velocity (no zone), the water
+    that enters through them is counted, and a restart continues exactly (the boundary velocity
+    is a function of the time and the water in the first cells, both in the checkpoint)."""
+    extra = 'generation = "boundary"'
+    whole, _ = _run(tmp_path, "whole", 0.8, extra=extra)
+    _run(tmp_path, "first", 0.4, extra=extra)
+    second, _ = _run(tmp_path, "first", 0.8, restart=tmp_path / "first" / "checkpoint.npz",
+                     extra=extra)
+    fluid = whole.fluid
+    assert fluid.relaxation.zones[0].kind == "absorption" and len(fluid.relaxation.zones) == 1
+    assert np.array_equal(second.fluid.fraction, fluid.fraction)
+    assert np.array_equal(second.fluid.u, fluid.u)
+    assert np.array_equal(second.fluid.gauges.values, fluid.gauges.values)
+    # the boundary moves water: its face velocity is the wave's under the surface and zero in air
+    maker = fluid.wave_maker
+    assert np.abs(fluid.u[0]).max() > 1e-3
+    above = fluid.grid.centres(2) > 0.3 + 0.04
+    assert np.all(fluid.u[0][:, above] == 0.0)
+    # ... and the first column's water is what came through it: the fluid's volume changed by the
+    # water the boundary let in, not by air turned into water
+    assert fluid.water_volume() != fluid.initial_water_volume
+    assert abs(fluid.last_report.water_volume_error) < 5e-3
+    assert maker.last_correction is not None and maker.last_correction.shape == (1,)
+
+
+def test_a_boundary_wave_maker_needs_an_open_top_and_open_boundary_cells():
+    from riprap.case.build_fluid import build_fluid_solver
+    from riprap.waves.boundary_generation import BoundaryWaveMaker
+
+    case = _case(extra='generation = "boundary"')
+    closed = dataclasses.replace(case, fluid=dataclasses.replace(case.fluid, z_high="free_slip"))
+    with pytest.raises(CaseFileError, match="needs an open top"):
+        build_fluid_solver(closed)
+    fluid = build_fluid_solver(_case())
+    fluid.add_obstacle_box((0.0, 0.0, 0.0), (0.04, 0.02, 0.1))
+    with pytest.raises(CaseFileError, match="must be open"):
+        BoundaryWaveMaker(fluid.relaxation.wave, 0.3).attach(fluid)

@@ -1,8 +1,9 @@
-"""Build a case's ``[waves]`` and ``[[gauges]]`` onto its fluid: the relaxation zones, the wave
-they make, the gauges; and the checks that the flume can carry those waves (``riprap.waves.checks``)."""
+"""Build a case's ``[waves]`` and ``[[gauges]]`` onto its fluid: the wave maker (a relaxation zone
+or the boundary) and the absorbing zone, the wave they make, the gauges; and the checks that the flume can carry those waves (``riprap.waves.checks``)."""
 from __future__ import annotations
 
 from riprap.errors import CaseFileError
+from riprap.waves.boundary_generation import BoundaryWaveMaker
 from riprap.waves.checks import check_flume
 from riprap.waves.gauges import Gauge, GaugeSet
 from riprap.waves.relaxation import ABSORPTION, GENERATION, RelaxationZone, WaveRelaxation
@@ -33,7 +34,7 @@ def wave_of(spec, depth: float, end_time: float, gravity: float):
 
 
 def build_waves(case, solver) -> None:
-    """Give ``solver`` (a FluidSolver) the case's relaxation zones and gauges, checked."""
+    """Give ``solver`` (a FluidSolver) the case's wave maker, zones and gauges, checked."""
     grid = solver.grid
     where = f"{case.source} [waves]"
     spec = case.waves
@@ -52,7 +53,11 @@ def build_waves(case, solver) -> None:
         except CaseFileError as error:
             raise CaseFileError(f"{where}: {error}") from None
         wave_length = wave.wave_length
-        generation = spec.generation_zone or wave_length
+        boundary = spec.generation == "boundary"
+        if boundary and spec.generation_zone:
+            raise CaseFileError(f"{where}: generation_zone = {spec.generation_zone:g} m is given with "
+                                f"generation = \"boundary\", which has no zone; drop one of them")
+        generation = 0.0 if boundary else (spec.generation_zone or wave_length)
         absorption = ((spec.absorption_zone or DEFAULT_ABSORPTION_WAVE_LENGTHS * wave_length)
                       if spec.absorbing_end else 0.0)
         x_low, x_high = grid.lower[0], grid.upper[0]
@@ -61,12 +66,22 @@ def build_waves(case, solver) -> None:
                 f"{where}: the zones ({generation:.3g} m to make the waves + {absorption:.3g} m to "
                 f"absorb them; L = {wave_length:.3g} m) fill the whole flume of {x_high - x_low:.3g} "
                 f"m; lengthen [fluid] along x or shorten the zones")
-        zones = [RelaxationZone(GENERATION, x_low, x_low + generation)]
+        zones = [] if boundary else [RelaxationZone(GENERATION, x_low, x_low + generation)]
         if spec.absorbing_end:
             zones.append(RelaxationZone(ABSORPTION, x_high - absorption, x_high))
         check_flume(wave, solver.h, zones, where=where)
-        solver.relaxation = WaveRelaxation(wave, level, zones,
-                                           ramp_time=spec.ramp_periods * wave.period)
+        ramp_time = spec.ramp_periods * wave.period
+        if boundary:
+            maker = BoundaryWaveMaker(wave, level, ramp_time=ramp_time,
+                                      active_absorption=spec.active_absorption, gravity=gravity)
+            try:
+                maker.attach(solver)
+            except CaseFileError as error:
+                raise CaseFileError(f"{where}: {error}") from None
+            if zones:
+                solver.relaxation = WaveRelaxation(None, level, zones)
+        else:
+            solver.relaxation = WaveRelaxation(wave, level, zones, ramp_time=ramp_time)
     if case.gauges:
         if level is None:
             levels = [r.parameters["level"] for r in case.water_regions if r.type == "level"]

@@ -253,6 +253,8 @@ class WavesSpec:
 
     type: str
     still_water_level: float
+    generation: str = _default("waves", "generation")
+    active_absorption: bool = _default("waves", "active_absorption")
     generation_zone: float = _default("waves", "generation_zone")
     absorption_zone: float = _default("waves", "absorption_zone")
     absorbing_end: bool = _default("waves", "absorbing_end")

@@ -583,9 +583,16 @@ KEYS: tuple[Key, ...] = (
         choices=("linear", "stokes2", "stream_function", "irregular")),
     Key("waves", "still_water_level", "number", "m",
         "z of the still water surface; the water depth is measured from the box's bottom."),
+    Key("waves", "generation", "string", "-",
+        "Where the waves are made: relaxation (a zone from x = lower, blended towards the wave) "
+        "or boundary (the x = lower boundary imposes the wave's velocity, with active absorption: "
+        "no zone, needs an open top).", default="relaxation", choices=("relaxation", "boundary")),
+    Key("waves", "active_absorption", "boolean", "-",
+        "generation = boundary: the boundary also absorbs the waves that come back to it "
+        "(Schaffer & Klopman 2000).", default=True),
     Key("waves", "generation_zone", "number", "m",
-        "Length of the generation zone from x = lower; 0: one wave length.", default=0.0,
-        valid_range=_NON_NEGATIVE),
+        "Length of the generation zone from x = lower; 0: one wave length (generation = "
+        "relaxation).", default=0.0, valid_range=_NON_NEGATIVE),
     Key("waves", "absorption_zone", "number", "m",
         "Length of the absorption zone up to x = upper; 0: two wave lengths.", default=0.0,
         valid_range=_NON_NEGATIVE),

@@ -136,6 +136,9 @@ class FluidSolver:
         #: Wave-making and absorbing zones (``riprap.waves.relaxation.WaveRelaxation``) blended in
         #: after every step, or None.
         self.relaxation = None
+        #: The wave maker on the x = lower boundary (``riprap.waves.boundary_generation``), whose
+        #: velocity is imposed in every step before the pressure, or None.
+        self.wave_maker = None
         #: Gauges (``riprap.waves.gauges.GaugeSet``) read after every step, or None.
         self.gauges = None
         #: Porous zones (``riprap.fluid.porous.PorousMedium``) or None; ``add_porous_zones``.
@@ -209,6 +212,13 @@ class FluidSolver:
         self.initial_water_volume = None
 
     # ------------------------------------------------------------------ properties
+    @property
+    def wave_source(self):
+        """What makes this flume's waves (its ``wave_maker`` or its ``relaxation``), or None."""
+        if self.wave_maker is not None:
+            return self.wave_maker
+        return self.relaxation
+
     def water_volume(self) -> float:
         """Water in the box (m^3): in porous zones only their pores hold it."""
         if self.porous is not None:
@@ -262,7 +272,7 @@ class FluidSolver:
 
         u, v, w = velocities or (self.u, self.v, self.w)
         return plic.advect(self.fraction, u, v, w, dt, self.h, self.step_count,
-                           porosity=self._open_part)
+                           porosity=self._open_part, water_inflow_x_low=self.wave_maker is not None)
 
     def _face_coefficients(self, densities):
         """1/rho on every face: transported densities inside, walls 0, the open top 1/rho of the
@@ -365,6 +375,10 @@ class FluidSolver:
         else:
             self.pressure_densities = self._sharp_face_densities()
         self._zero_solid_faces(u, v, w)
+        if self.wave_maker is not None:
+            # the boundary's flux at the step's end, so that the projection makes u divergence
+            # free with it and the next step's water is carried by that field
+            self.wave_maker.impose(self, u, self.time + dt)
         return u, v, w, densities
 
     def _sharp_face_densities(self) -> list:

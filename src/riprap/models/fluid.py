@@ -137,7 +137,7 @@ class FluidModel(Model):
 
             self._write_gauges()
             outputs["gauges"] = str(self._directory / "gauges.csv")
-            report = flume_report(gauges, self.fluid.relaxation, self.fluid.water.density)
+            report = flume_report(gauges, self.fluid.wave_source, self.fluid.water.density)
             outputs["waves_report"] = str(write_waves_report(self._directory / "waves_report.json",
                                                              report))
             if self._picture:

@@ -27,11 +27,12 @@ def group_velocity(period: float, depth: float, wave_length: float) -> float:
     return 0.5 * c * (1.0 + 2.0 * k * depth / math.sinh(2.0 * k * depth))
 
 
-def arrival_time(relaxation, x: float) -> float:
-    """When the steady wave train has reached ``x`` (s)."""
-    wave = relaxation.wave
+def arrival_time(wave_source, x: float) -> float:
+    """When the steady wave train made by ``wave_source`` (a WaveRelaxation or a
+    BoundaryWaveMaker) has reached ``x`` (s)."""
+    wave = wave_source.wave
     speed = group_velocity(wave.period, wave.depth, wave.wave_length)
-    return relaxation.ramp_time + max(x - relaxation.origin, 0.0) / speed + 2.0 * wave.period
+    return wave_source.ramp_time + max(x - wave_source.origin, 0.0) / speed + 2.0 * wave.period
 
 
 def run_up_statistics(times, level) -> dict:
@@ -64,14 +65,15 @@ def overtopping_statistics(times, volume) -> dict:
             "duration_s": float(times[-1] - times[0])}
 
 
-def flume_report(gauges, relaxation=None, water_density: float | None = None) -> dict:
-    """The analysis of ``gauges`` (a GaugeSet) as a dict for JSON; ``relaxation`` (the flume's
-    WaveRelaxation, optional) gives the target and the analysis windows; ``water_density``
+def flume_report(gauges, wave_source=None, water_density: float | None = None) -> dict:
+    """The analysis of ``gauges`` (a GaugeSet) as a dict for JSON; ``wave_source`` (what makes the
+    flume's waves: its WaveRelaxation or BoundaryWaveMaker, optional) gives the target and the
+    analysis windows; ``water_density``
     (kg/m^3) is recorded for the stability report."""
     report = {"gauges": {}, "reflection": []}
     if water_density is not None:
         report["water_density_kg_m3"] = float(water_density)
-    wave = relaxation.wave if relaxation is not None and relaxation.wave is not None else None
+    wave = wave_source.wave if wave_source is not None and wave_source.wave is not None else None
     if wave is not None:
         target = {"type": type(wave).__name__, "height_m": wave.height, "period_s": wave.period,
                   "depth_m": wave.depth, "wave_length_m": wave.wave_length}
@@ -80,7 +82,7 @@ def flume_report(gauges, relaxation=None, water_density: float | None = None) ->
     windows = {}
     for gauge in surface:
         times, eta = gauges.series(gauge.columns[0])
-        start = arrival_time(relaxation, gauge.position[0]) if wave is not None else times[0] if times.size else 0.0
+        start = arrival_time(wave_source, gauge.position[0]) if wave is not None else times[0] if times.size else 0.0
         chosen = times >= start
         windows[gauge.name] = (times[chosen], eta[chosen])
         entry = {"x_m": gauge.position[0], "analysed_from_s": float(start),
@@ -94,7 +96,7 @@ def flume_report(gauges, relaxation=None, water_density: float | None = None) ->
         if gauge.kind not in (OVERTOPPING, RUN_UP):
             continue
         times, values = gauges.series(gauge.columns[-1])
-        start = arrival_time(relaxation, gauge.position[0]) if wave is not None else (times[0] if times.size else 0.0)
+        start = arrival_time(wave_source, gauge.position[0]) if wave is not None else (times[0] if times.size else 0.0)
         chosen = times >= start
         entry = {"x_m": gauge.position[0], "analysed_from_s": float(start)}
         if gauge.kind == OVERTOPPING:

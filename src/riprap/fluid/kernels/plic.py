@@ -50,7 +50,9 @@ on the face between cells i-1 and i; water volume fluxes have the shape of the m
 in m^3 per sweep, positive along +axis. ``ny == 1`` is a 2D problem in the x-z plane (no y
 sweep, 3x3 x-z stencils). Cells of side ``h`` (m), time step ``dt`` (s). Cells outside the domain
 take the fraction of the nearest cell for the normal (zero gradient); water entering through a
-boundary face is air (fraction 0 outside), water leaving is cut from the upwind cell as anywhere.
+boundary face is air (fraction 0 outside), except through the x = lower boundary where a wave maker
+imposes the velocity (``water_inflow_x_low``: all that enters there is water,
+``riprap/waves/boundary_generation.py``); water leaving is cut from the upwind cell as anywhere.
 """
 import math
 from typing import NamedTuple
@@ -388,7 +390,8 @@ def _slab_water_fraction(f, i, j, k, direction, courant, velocity_positive):
 
 
 @parallel_kernel
-def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_flux_out, porosity):
+def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_flux_out, porosity,
+                 water_inflow_x_low):
     """One direction-split sweep of Weymouth & Yue (2010) along axis ``direction`` (0 x, 1 y, 2 z).
 
     Arguments: ``f`` (nx, ny, nz) water fractions, updated in place; ``face_velocity`` the normal
@@ -401,6 +404,7 @@ def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_f
     zones); ``f`` is then the water fraction of the pore space, the face velocity the filtration
     (Darcy) velocity, the slab of a mixed upwind cell |u| dt / (n h) thick (the pore velocity's)
     and each update divided by n. Requires |u| dt / (n h) <= 1/2 (checked by ``advect``).
+    ``water_inflow_x_low``: what enters through the x = lower boundary is water (else air).
 
     Returns the largest distance of any updated fraction outside [0, 1] before clipping (0.0 if
     none); values within ``CLIP_TOLERANCE`` of the range are clipped, larger ones are left.
@@ -437,7 +441,10 @@ def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_f
                 # upwind cell: before the face if the flow is positive, after it otherwise
                 upwind = face_index - 1 if positive else face_index
                 if upwind < 0 or upwind >= n_along:
-                    water_flux_out[i, j, k] = 0.0          # inflow through the boundary: air
+                    if water_inflow_x_low and direction == 0 and upwind < 0:
+                        water_flux_out[i, j, k] = velocity * swept_per_velocity
+                    else:
+                        water_flux_out[i, j, k] = 0.0      # inflow through the boundary: air
                     continue
                 ci, cj, ck = i, j, k
                 if direction == 0:
@@ -522,7 +529,7 @@ def sweep_order(step_index: int, two_dimensional: bool) -> tuple:
 
 
 def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
-           water_flux_z=None, porosity=None) -> AdvectionFluxes:
+           water_flux_z=None, porosity=None, water_inflow_x_low=False) -> AdvectionFluxes:
     """Move the water fraction ``f`` (nx, ny, nz, in place) by the face velocities ``u``, ``v``,
     ``w`` (m/s, MAC layout of the module docstring) over ``dt`` (s) on cubic cells of side ``h``
     (m): all sweeps of one step, in the order ``sweep_order(step_index, ny == 1)``.
@@ -534,7 +541,8 @@ def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
     by what crosses open boundaries).
 
     ``porosity`` (nx, ny, nz, optional; default 1): porous zones (``advect_sweep``), where f is
-    the pore space's water fraction.
+    the pore space's water fraction. ``water_inflow_x_low``: what flows in through the x = lower
+    boundary faces is water (a wave maker's boundary); elsewhere inflow through a boundary is air.
 
     Raises ``InstabilityError`` if the Courant number max |u| dt / (n h) exceeds 1/2 (the
     scheme's bound; n the smallest porosity), ``ValueError`` for arrays of the wrong shape or type.
@@ -574,6 +582,6 @@ def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
     largest_overshoot = 0.0
     for axis in sweep_order(step_index, two_dimensional):
         overshoot = advect_sweep(f, velocities["uvw"[axis]], dilation_indicator, float(dt),
-                                 float(h), axis, fluxes[axis], porosity)
+                                 float(h), axis, fluxes[axis], porosity, bool(water_inflow_x_low))
         largest_overshoot = max(largest_overshoot, float(overshoot))
     return AdvectionFluxes(fluxes[0], fluxes[1], fluxes[2], largest_overshoot)
