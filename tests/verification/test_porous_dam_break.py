@@ -12,7 +12,9 @@ Tolerances: the free surface's rms distance from the laboratory's at each of the
 18, 13, 9, 8, 8 mm on 5 mm cells: the first time is the gate's opening, which the lab did not do
 instantly), their mean below ``MEAN_RMS_LIMIT`` = 12 mm (measured 11); the same tank without the
 porous zone misses by more than ``NO_POROUS_FACTOR`` = 4 times as much (measured 60-178 mm); the
-water volume, which only the pores hold inside the block, kept to ``VOLUME_TOLERANCE`` = 1e-9.
+water volume, which only the pores hold inside the block, kept to ``VOLUME_TOLERANCE`` = 1e-9
+once the water that left through the open top is counted (a film of fraction 4e-4 that creeps
+up the wall to the top row after 1.15 s: 7e-7 of the volume, held below ``LEFT_LIMIT`` = 1e-5).
 """
 import csv
 from pathlib import Path
@@ -29,6 +31,7 @@ RMS_LIMIT = 0.020
 MEAN_RMS_LIMIT = 0.012
 NO_POROUS_FACTOR = 4.0
 VOLUME_TOLERANCE = 1e-9
+LEFT_LIMIT = 1e-5
 
 
 def _profiles():
@@ -49,9 +52,11 @@ def _run(porous: bool):
         fluid.add_porous_zones([PorousZone(porosity=0.49, stone_diameter=0.0159,
                                            lower=(0.30, 0.0, 0.0), upper=(0.59, CELL, 0.58))])
     errors = {}
+    fluid.water_out_of_the_top = 0.0
     for time, (x, height) in _profiles().items():
         while fluid.time < time - 1e-9:
             fluid.step(min(fluid.stable_time_step(), time - fluid.time))
+            fluid.water_out_of_the_top += float(fluid.last_water_fluxes[2][:, :, -1].sum())
         column = fluid.fraction[:, 0, :].sum(axis=1) * CELL      # the surface, inside the block too
         simulated = np.interp(x, grid.centres(0), column)
         errors[time] = float(np.sqrt(np.mean((simulated - height) ** 2)))
@@ -78,6 +83,9 @@ def test_the_porous_zone_is_what_makes_it_right(porous_run):
 
 def test_only_the_pores_hold_water_and_none_is_lost(porous_run):
     fluid, _ = porous_run
-    assert abs(fluid.last_report.water_volume_error) < VOLUME_TOLERANCE
+    still = fluid.initial_water_volume
+    left = fluid.water_out_of_the_top / still
+    assert 0.0 <= left < LEFT_LIMIT
+    assert abs(fluid.last_report.water_volume_error + left) < VOLUME_TOLERANCE
     inside = (fluid.grid.centres(0) > 0.31) & (fluid.grid.centres(0) < 0.58)
     assert np.all(fluid.porous.porosity[inside] == pytest.approx(0.49))

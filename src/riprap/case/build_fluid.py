@@ -28,7 +28,8 @@ def build_fluid_solver(case) -> FluidSolver:
                          air=Phase("air", spec.air_density, spec.air_viscosity),
                          gravity=case.simulation.gravity, courant_number=spec.courant_number,
                          pressure_tolerance=spec.pressure_tolerance,
-                         max_time_step=spec.max_time_step, surface_tension=spec.surface_tension)
+                         max_time_step=spec.max_time_step, surface_tension=spec.surface_tension,
+                         limit_air_speed=spec.limit_air_speed)
     for number, region in enumerate(case.water_regions):
         try:
             if region.type == "level":

@@ -218,6 +218,7 @@ class FluidSpec:
     surface_tension: float = _default("fluid", "surface_tension")
     courant_number: float = _default("fluid", "courant_number")
     max_time_step: float = _default("fluid", "max_time_step")
+    limit_air_speed: bool = _default("fluid", "limit_air_speed")
     pressure_tolerance: float = _default("fluid", "pressure_tolerance")
 
 

@@ -558,6 +558,10 @@ KEYS: tuple[Key, ...] = (
         valid_range=Range(minimum=0.0, maximum=0.5, minimum_inclusive=False)),
     Key("fluid", "max_time_step", "number", "s", "Upper bound of the automatic time step.",
         default=0.01, valid_range=_POSITIVE),
+    Key("fluid", "limit_air_speed", "boolean", "-",
+        "The Courant number taken only where water is, the air away from it capped at the speed "
+        "that step carries (breaking waves: the air blown ahead of crests and out of an armour "
+        "layer no longer sets the step).", default=False),
     Key("fluid", "pressure_tolerance", "number", "-",
         "Relative residual at which the pressure solve stops.", default=1.0e-8,
         valid_range=Range(minimum=0.0, maximum=1.0e-2, minimum_inclusive=False)),

@@ -221,7 +221,12 @@ class CoupledSolver:
         water too (``_carriers``)."""
         step = self.fluid.stable_time_step()
         if self._carried is not None:
-            speed = float(np.abs(self._carried[2]).max(initial=0.0))
+            from riprap.fluid.kernels.face_speeds import listed_pore_speed
+
+            fluid = self.fluid
+            axis, index, values = self._carried
+            speed = float(listed_pore_speed(fluid.fraction, axis, index, values, fluid.open_part,
+                                            fluid.limit_air_speed))
             if speed > 0.0:
                 step = min(step, self.fluid.courant_number * self.fluid.h / speed)
         return step
@@ -502,6 +507,13 @@ class CoupledSolver:
     def step(self, dt: float | None = None) -> CoupledStepReport:
         fluid, solids = self.fluid, self.solids
         dt, courant = fluid.begin_step(self.stable_time_step() if dt is None else dt)
+        if fluid.limit_air_speed and self._carried is not None:
+            # the carried air beside the bodies is held to the same cap as the fluid's own faces
+            from riprap.fluid.kernels.face_speeds import limit_listed_faces
+
+            axis, index, values = self._carried
+            limit_listed_faces(fluid.fraction, axis, index, values, fluid.open_part,
+                               fluid.air_speed_limit(dt))
         free = ~solids.fixed
         inertia = self._world_inertia()
         # Every body is blended in with the motion it would have after falling freely for dt

@@ -89,12 +89,15 @@ class FluidSolver:
     surface_tension : float
         Air-water surface tension sigma (N/m; default 0.0728, clean water at 20 degrees C; 0
         leaves it out).
+    limit_air_speed : bool
+        Take the Courant number only on the faces that touch water, and cap the speed of the
+        other faces (air away from the water) at what that step carries (``limit_air``).
     """
 
     def __init__(self, grid: FluidGrid, *, water: Phase = WATER_20C, air: Phase = AIR_20C,
                  gravity=(0.0, 0.0, -9.81), courant_number: float = 0.3,
                  pressure_tolerance: float = 1e-8, max_time_step: float = 0.01,
-                 surface_tension: float = 0.0728):
+                 surface_tension: float = 0.0728, limit_air_speed: bool = False):
         from riprap.fluid.pressure import PressureSolver
 
         if not 0.0 < courant_number <= 0.5:
@@ -112,6 +115,10 @@ class FluidSolver:
         self.courant_number = float(courant_number)
         self.max_time_step = float(max_time_step)
         self.surface_tension = float(surface_tension)
+        self.limit_air_speed = bool(limit_air_speed)
+        #: (faces clipped, their largest speed before the clip in m/s) of the last step's
+        #: ``limit_air``; (0, 0.0) without the limit.
+        self.last_air_limit = (0, 0.0)
         check_fluid_grid(grid.cells)
         nx, ny, nz = grid.cells
         self.h = grid.cell_size
@@ -213,6 +220,12 @@ class FluidSolver:
 
     # ------------------------------------------------------------------ properties
     @property
+    def open_part(self) -> np.ndarray:
+        """The part of each cell open to the fluid (nx, ny, nz): the porosity in porous zones, 1
+        elsewhere."""
+        return self._open_part
+
+    @property
     def wave_source(self):
         """What makes this flume's waves (its ``wave_maker`` or its ``relaxation``), or None."""
         if self.wave_maker is not None:
@@ -226,9 +239,37 @@ class FluidSolver:
         return float(self.fraction.sum()) * self.h ** 3
 
     def _pore_speed(self) -> float:
-        """Largest speed the water moves at: in a porous zone the filtration velocity over n."""
-        speed = self.max_speed()
-        return speed / self.porous.minimum_porosity if self.porous is not None else speed
+        """Largest speed the water moves at: on each face |u| / n of the cells beside it (the
+        pore velocity in a porous zone); with ``limit_air_speed`` only on faces that touch water
+        (``kernels/face_speeds.py``)."""
+        from riprap.fluid.kernels.face_speeds import largest_pore_speed
+
+        return max(largest_pore_speed(self.fraction, q, axis, self._open_part, self.limit_air_speed)
+                   for axis, q in enumerate((self.u, self.v, self.w)))
+
+    def air_speed_limit(self, dt: float) -> float:
+        """The pore speed (m/s) a step of ``dt`` carries at the Courant number."""
+        return self.courant_number * self.h / dt
+
+    def limit_air(self, dt: float) -> None:
+        """Cap the pore speed at ``air_speed_limit(dt)`` on the faces that touch no water.
+
+        Why: under breaking waves the air pushed out ahead of a plunging crest or out of a
+        breakwater's voids reaches several times the water's speed, and a step held to the
+        Courant number of that air is several times shorter than the water needs. No water
+        crosses those faces, so the volume-of-fluid step does not feel them; their momentum is
+        the air's (1/830 of the water's density), and the next pressure solve gives the air the
+        flow that continuity asks for again. The cap keeps the explicit momentum transport of
+        the air within its Courant limit. Recorded in ``last_air_limit``."""
+        from riprap.fluid.kernels.face_speeds import limit_air_faces
+
+        limit = self.air_speed_limit(dt)
+        clipped, largest = 0, 0.0
+        for axis, q in enumerate((self.u, self.v, self.w)):
+            count, fastest = limit_air_faces(self.fraction, q, axis, self._open_part, limit)
+            clipped += int(count)
+            largest = max(largest, float(fastest))
+        self.last_air_limit = (clipped, largest)
 
     def cell_density(self, fraction=None) -> np.ndarray:
         f = self.fraction if fraction is None else fraction
@@ -316,6 +357,8 @@ class FluidSolver:
         if self.initial_water_volume is None:
             self.initial_water_volume = self.water_volume()
         dt = self.stable_time_step() if dt is None else float(dt)
+        if self.limit_air_speed:
+            self.limit_air(dt)
         courant = self._pore_speed() * dt / self.h
         if courant > 0.5 + 1e-12:
             raise InstabilityError(f"fluid: Courant number {courant:.3f} > 0.5 at t = {self.time:.6g} s "

@@ -153,8 +153,12 @@ class FluidModel(Model):
         r = self._report
         if r is None:
             return ""
-        return (f"dt {r.time_step:.2e}  CFL {r.courant_number:.2f}  water volume error "
+        text = (f"dt {r.time_step:.2e}  CFL {r.courant_number:.2f}  water volume error "
                 f"{r.water_volume_error:.1e}  pressure iterations {r.pressure_iterations}")
+        clipped, fastest = self.fluid.last_air_limit
+        if clipped:
+            text += f"  air capped on {clipped} faces (fastest {fastest:.3g} m/s)"
+        return text
 
     def summary_fields(self, wall_time: float, steps: int) -> dict:
         cells = self.fluid.grid.n_cells

@@ -61,6 +61,7 @@ import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
 from riprap.errors import InstabilityError
+from riprap.fluid.kernels.face_speeds import largest_pore_speed
 
 #: Largest Courant number |u| dt / h of the split scheme: Weymouth & Yue (2010) show the
 #: sweeps stay bounded up to 1/2 with the frozen dilation indicator.
@@ -545,7 +546,8 @@ def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
     boundary faces is water (a wave maker's boundary); elsewhere inflow through a boundary is air.
 
     Raises ``InstabilityError`` if the Courant number max |u| dt / (n h) exceeds 1/2 (the
-    scheme's bound; n the smallest porosity), ``ValueError`` for arrays of the wrong shape or type.
+    scheme's bound; n the smaller porosity of the cells beside each face), ``ValueError`` for
+    arrays of the wrong shape or type.
     """
     if f.ndim != 3 or f.dtype != np.float64 or not f.flags.c_contiguous:
         raise ValueError("advect: f must be a C-ordered float64 array (nx, ny, nz); "
@@ -570,8 +572,10 @@ def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
         porosity = np.ones(f.shape)
     elif porosity.shape != f.shape or porosity.dtype != np.float64:
         raise ValueError(f"advect: porosity must be float64 with shape {f.shape}")
-    courant = max(float(np.abs(u).max()), float(np.abs(w).max()),
-                  0.0 if two_dimensional else float(np.abs(v).max())) * dt / (h * float(porosity.min()))
+    # the pore speed face by face: |u| / n of the cells beside each face
+    courant = max(largest_pore_speed(f, q, axis, porosity, False)
+                  for axis, q in enumerate((u, v, w))
+                  if not (two_dimensional and axis == 1)) * dt / h
     if not math.isfinite(courant) or courant > MAXIMUM_COURANT_NUMBER + _COURANT_ROUND_OFF:
         raise InstabilityError(
             f"volume-of-fluid advection: Courant number max|u| dt / h = {courant:.4g} exceeds "
