@@ -1,0 +1,217 @@
+"""Fracture of deformable bodies: joint (cohesive) elements between the tets of an exploded mesh.
+
+The mesh is exploded (every tet gets its own copy of its four nodes) and a joint holds each pair of
+faces that were shared (``explode_mesh``); the joints' law is Munjiza's combined single and smeared
+crack model (``riprap/deformable/kernels/joints.py``). A :class:`FracturingBody` is a
+:class:`DeformableBody` on the exploded mesh whose steps add the joints' forces.
+
+Why the softening length is G / (f * 0.3863) and not Y3D's 3 G / f: the area under Hordijk's curve
+z(D) over D in [0, 1] is 0.3863 (``SOFTENING_AREA``), so a crack that opens from the strength to
+z = 0 over a length o_t dissipates f_t o_t 0.3863 per unit area; Y3D's o_t = 3 G_f / f_t gives
+1.16 G_f. With o_t = G_f / (0.3863 f_t) it is G_f exactly (checked in
+``tests/verification/test_fracture_mode_one.py``).
+
+Limits of this first part (issue 16): joints everywhere in a body (not yet in chosen regions);
+4-node tets only; a broken joint keeps its faces from passing through each other by the
+compressive penalty only (no friction, and faces that separate and meet elsewhere do not see each
+other: the body's self-contact is the next part); fragments are not yet separate bodies.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from riprap.deformable.body import TIME_STEP_SAFETY, DeformableBody, stable_step_for
+from riprap.deformable.kernels import joints as joint_kernels
+from riprap.errors import CaseFileError
+
+__all__ = ["JointMaterial", "explode_mesh", "FracturingBody", "SOFTENING_AREA"]
+
+
+def _softening_area(samples: int = 200_001) -> float:
+    damage = np.linspace(0.0, 1.0, samples)
+    a, b, c = joint_kernels.SOFTENING_A, joint_kernels.SOFTENING_B, joint_kernels.SOFTENING_C
+    z = ((1.0 - (a + b - 1.0) / (a + b) * np.exp(damage * (a + c * b) / ((a + b) * (1.0 - a - b))))
+         * (a * (1.0 - damage) + b * (1.0 - damage) ** c))
+    return float(np.sum(0.5 * (z[1:] + z[:-1]) * np.diff(damage)))
+
+
+#: The area under the softening curve z(D), D in [0, 1] (0.3863).
+SOFTENING_AREA = _softening_area()
+
+
+@dataclass(frozen=True)
+class JointMaterial:
+    """Strength and toughness of the joints between a body's tets (SI units).
+
+    tensile_strength : float
+        f_t (Pa): the normal stress at which a joint starts to crack (concrete: 2-5 MPa).
+    cohesion : float
+        c (Pa): the shear strength without normal stress (concrete: about 2 f_t).
+    friction_angle : float
+        phi (degrees): the shear strength grows by tan(phi) times the compressive normal stress.
+    fracture_energy_mode_i, fracture_energy_mode_ii : float
+        G_I, G_II (J/m^2): energy a crack dissipates per unit area in opening and in sliding
+        (concrete: about 100 and 1000 J/m^2).
+    joint_penalty : float
+        p (Pa): a joint's stiffness per unit area is p / h (h its size), so p = 10 E makes it a
+        tenth as compliant as the elements beside it; stiffer joints shorten the time step.
+    """
+
+    tensile_strength: float
+    cohesion: float
+    friction_angle: float
+    fracture_energy_mode_i: float
+    fracture_energy_mode_ii: float
+    joint_penalty: float
+
+    def __post_init__(self):
+        for name in ("tensile_strength", "cohesion", "fracture_energy_mode_i",
+                     "fracture_energy_mode_ii", "joint_penalty"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise CaseFileError(f"joints: {name} = {value!r} must be > 0")
+        if not (math.isfinite(self.friction_angle) and 0.0 <= self.friction_angle < 90.0):
+            raise CaseFileError(f"joints: friction_angle = {self.friction_angle!r} must be in "
+                                "[0, 90) degrees")
+
+    def kernel_row(self) -> np.ndarray:
+        """(f_t, c, tan phi, p, G_I / area, G_II / area) as the kernel reads them."""
+        return np.array([self.tensile_strength, self.cohesion,
+                         math.tan(math.radians(self.friction_angle)), self.joint_penalty,
+                         self.fracture_energy_mode_i / SOFTENING_AREA,
+                         self.fracture_energy_mode_ii / SOFTENING_AREA])
+
+
+_TET_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])   # outward, opposite corner k
+
+
+def explode_mesh(nodes, tets):
+    """Give every tet its own nodes and list the joints between formerly shared faces.
+
+    Returns (nodes (4 m, 3), tets (m, 4), joints (n, 6), joint_tets (n, 2), original_node (4 m,)):
+    tet t's corners are nodes 4t..4t+3; joint j holds tet ``joint_tets[j, 0]``'s face (nodes
+    ``joints[j, :3]``) to tet ``joint_tets[j, 1]``'s (``joints[j, 3:]``, paired in order), with
+    the face's normal (x1 - x0) x (x2 - x0) pointing out of the first tet.
+    """
+    nodes = np.asarray(nodes, dtype=np.float64)
+    tets = np.asarray(tets, dtype=np.int64)
+    m = len(tets)
+    new_nodes = nodes[tets.reshape(-1)]
+    new_tets = np.arange(4 * m, dtype=np.int64).reshape(m, 4)
+    local_faces = tets[:, _TET_FACES]                                   # (m, 4, 3) global ids
+    keys = np.sort(local_faces.reshape(-1, 3), axis=1)
+    order = np.lexsort(keys.T[::-1])
+    sorted_keys = keys[order]
+    same = np.all(sorted_keys[1:] == sorted_keys[:-1], axis=1)
+    first = order[:-1][same]
+    second = order[1:][same]
+    tet_a, face_a = first // 4, first % 4
+    tet_b = second // 4
+    corners_a = _TET_FACES[face_a]                                      # local corners in A, (n, 3)
+    global_ids = tets[tet_a[:, None], corners_a]                        # outward from A
+    # B's local corner holding each of those global nodes
+    match = tets[tet_b][:, None, :] == global_ids[:, :, None]           # (n, 3, 4)
+    corners_b = np.argmax(match, axis=2)
+    joints = np.concatenate([4 * tet_a[:, None] + corners_a, 4 * tet_b[:, None] + corners_b], axis=1)
+    return (new_nodes, new_tets, joints.astype(np.int64), np.stack([tet_a, tet_b], axis=1),
+            tets.reshape(-1).copy())
+
+
+class FracturingBody(DeformableBody):
+    """A deformable body that cracks: the exploded mesh of ``nodes``, ``tets`` with a joint
+    between every two tets that shared a face (``explode_mesh``), of ``joint_material``.
+
+    Other parameters as :class:`DeformableBody` (4-node tets only).
+    """
+
+    def __init__(self, nodes, tets, material, joint_material: JointMaterial, *,
+                 name: str = "body", gravity=(0.0, 0.0, 0.0), mass_damping: float = 0.0):
+        if not isinstance(joint_material, JointMaterial):
+            raise CaseFileError(f"deformable body '{name}': joint_material must be a JointMaterial")
+        exploded, new_tets, joints, joint_tets, original = explode_mesh(nodes, tets)
+        super().__init__(exploded, new_tets, material, element_type="tet4", name=name,
+                         gravity=gravity, mass_damping=mass_damping)
+        self.joint_material = joint_material
+        self.joints = joints
+        self.joint_tets = joint_tets
+        self.original_node = original
+        corners = exploded[joints[:, :3]]
+        edges = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2)
+        #: h of each joint (m): the mean edge of its face.
+        self.joint_sizes = edges.mean(axis=1)
+        #: Reference area of each joint's face (m^2).
+        self.joint_areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
+                                                         corners[:, 2] - corners[:, 0]), axis=1)
+        self.joint_damage = np.zeros((len(joints), 3))
+        self.joint_broken = np.zeros(len(joints), dtype=np.bool_)
+        self._joint_row = joint_material.kernel_row()
+        self._joint_buffer = np.zeros((len(joints), 6, 3))
+        order = np.argsort(joints.reshape(-1), kind="stable")
+        counts = np.bincount(joints.reshape(-1), minlength=len(exploded))
+        self._joint_offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        self._joint_slots = order.astype(np.int64)
+
+    # ------------------------------------------------------------------ steps
+    def stable_time_step(self) -> float:
+        """The elements' stable step with the joints' stiffness added: the largest frequency
+        bounded by sqrt(omega_element^2 + omega_joint^2), omega_joint^2 the largest over the
+        nodes of the joints' Gershgorin row sum at the node over its mass: (p / h) (2 A / 3) per
+        joint (a node's two points, each a third of the area, each shared by its two vertices
+        and read from both faces)."""
+        if self._stable_time_step is None:
+            omega_elements = float(self.elements.largest_element_frequencies(self.material).max())
+            stiffness = np.zeros(len(self.masses))
+            per_joint = (self.joint_material.joint_penalty / self.joint_sizes
+                         * self.joint_areas * (2.0 / 3.0))
+            np.add.at(stiffness, self.joints.reshape(-1), np.repeat(per_joint, 6))
+            omega_joints = float(np.sqrt((stiffness / self.masses).max())) if len(per_joint) else 0.0
+            omega = math.hypot(omega_elements, omega_joints)
+            self._stable_time_step = stable_step_for(omega, self.material.viscous_time_constant,
+                                                     self.mass_damping)
+            self._stiffest_frequency = omega
+        return self._stable_time_step
+
+    def joint_forces(self) -> np.ndarray:
+        """The joints' forces on the nodes (n, 3) at the present positions (updates damage)."""
+        forces = np.zeros_like(self.positions)
+        self._add_joint_forces(forces)
+        return forces
+
+    def _add_joint_forces(self, out) -> int:
+        broken_now = joint_kernels.joint_forces(self.positions, self.joints, self.joint_sizes,
+                                                self._joint_row, self.joint_damage,
+                                                self.joint_broken, self._joint_buffer)
+        joint_kernels.gather_joint_forces(self._joint_buffer, self._joint_offsets,
+                                          self._joint_slots, out)
+        return int(broken_now)
+
+    def step(self, n_steps: int = 1) -> None:
+        """Advance ``n_steps`` steps; the joints' forces at the start of each step enter it as
+        the nodes' contact forces (a single body has no other contact)."""
+        if self._time_step is None:
+            self._time_step = TIME_STEP_SAFETY * self.stable_time_step()
+        for _ in range(int(n_steps)):
+            self.contact_forces[:] = 0.0
+            self._add_joint_forces(self.contact_forces)
+            super().step(1)
+
+    # ------------------------------------------------------------------ results
+    @property
+    def broken_area(self) -> float:
+        """Reference area (m^2) of the broken joints: the crack surface (one side)."""
+        return float(self.joint_areas[self.joint_broken].sum())
+
+    def fragments(self) -> np.ndarray:
+        """Fragment number of every tet: tets joined by unbroken joints share one."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        intact = ~self.joint_broken
+        a, b = self.joint_tets[intact, 0], self.joint_tets[intact, 1]
+        n = self.n_elements
+        graph = coo_matrix((np.ones(a.size), (a, b)), shape=(n, n))
+        _, labels = connected_components(graph, directed=False)
+        return labels
