@@ -86,17 +86,17 @@ class BoundaryWaveMaker:
         """Check that ``fluid`` can carry a boundary wave maker and make it ``fluid.wave_maker``."""
         grid = fluid.grid
         if not grid.open_top:
-            raise CaseFileError("waves: generation = \"boundary\" needs an open top to the fluid box "
+            raise CaseFileError("generation = \"boundary\" needs an open top to the fluid box "
                                 "(the waves bring water in and out through the x = lower boundary)")
         if fluid.solid[0].any():
-            raise CaseFileError(f"waves: generation = \"boundary\": the fluid cells at the x = "
+            raise CaseFileError(f"generation = \"boundary\": the fluid cells at the x = "
                                 f"{grid.lower[0]:g} m boundary must be open (an obstacle fills some)")
         if fluid.porous is not None and (fluid.porous.porosity[0] < 1.0).any():
-            raise CaseFileError(f"waves: generation = \"boundary\": the fluid cells at the x = "
+            raise CaseFileError(f"generation = \"boundary\": the fluid cells at the x = "
                                 f"{grid.lower[0]:g} m boundary must lie outside porous zones")
         depth = self.still_water_level - grid.lower[2]
         if not depth > 0:
-            raise CaseFileError(f"waves: still_water_level {self.still_water_level:g} m lies at or "
+            raise CaseFileError(f"still_water_level {self.still_water_level:g} m lies at or "
                                 f"below the fluid box's floor {grid.lower[2]:g} m")
         self.depth = depth
         #: c (m/s) of the correction U_c = -(c / d)(eta_measured - eta_target): the linear
@@ -110,13 +110,17 @@ class BoundaryWaveMaker:
         self.mean_flux = self._mean_theory_flux(fluid.h)
         fluid.wave_maker = self
 
-    def _theory_flux(self, t: float, h: float) -> float:
-        """The full (unramped) wave's volume flux (m^2/s) through the boundary's faces at t."""
+    def _theory_profile(self, t: float, h: float, eta: float) -> np.ndarray:
+        """The unramped wave's x velocity on the boundary faces (nz,) under the surface eta."""
         level = self.still_water_level
-        eta = float(self.wave.elevation(np.array([0.0]), t)[0])
         below = np.clip((level + eta - self._face_bottoms) / h, 0.0, 1.0)
         u_theory, _ = self.wave.velocity_grid(np.array([0.0]), self._face_centres - level, t)
-        return float(np.sum(u_theory[0] * below) * h)
+        return u_theory[0] * below
+
+    def _theory_flux(self, t: float, h: float) -> float:
+        """The full (unramped) wave's volume flux (m^2/s) through the boundary's faces at t."""
+        eta = float(self.wave.elevation(np.array([0.0]), t)[0])
+        return float(np.sum(self._theory_profile(t, h, eta)) * h)
 
     def _mean_theory_flux(self, h: float) -> float:
         """Mean of ``_theory_flux`` over the wave's period, or an irregular sea's duration (40
@@ -140,11 +144,9 @@ class BoundaryWaveMaker:
         h = fluid.h
         level = self.still_water_level
         factor = float(ramp(t, self.ramp_time))
-        eta_target = float(self.target_elevation(0.0 + self.origin, t))
-        below_target = np.clip((level + eta_target - self._face_bottoms) / h, 0.0, 1.0)
-        u_theory, _ = self.wave.velocity_grid(np.array([0.0]), self._face_centres - level, t)
-        velocity = np.broadcast_to(factor * u_theory[0] * below_target,
-                                   (fluid.fraction.shape[1], below_target.size)).copy()
+        eta_target = float(self.target_elevation(self.origin, t))
+        profile = factor * self._theory_profile(t, h, eta_target)
+        velocity = np.broadcast_to(profile, (fluid.fraction.shape[1], profile.size)).copy()
         eta_measured = self.measured_elevation(fluid)
         below_measured = np.clip((level + eta_measured[:, None] - self._face_bottoms[None, :]) / h,
                                  0.0, 1.0)
