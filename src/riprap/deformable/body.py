@@ -29,6 +29,11 @@ NO_CONTACT = (np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int64)
               np.zeros(1), np.zeros(0), np.zeros(0), 0.0, np.zeros(0), np.zeros((0, 3)),
               np.zeros((0, 0, 3)), np.zeros((0, 0, 3)), np.zeros(0), np.zeros(0))
 NO_TET4_GRADIENTS = np.zeros((0, 4, 3))
+# The joint arguments of a run without joints (see finite_strain.advance_steps).
+NO_JOINTS = (np.zeros((0, 6), dtype=np.int64), np.zeros(0), np.zeros((1, 6)),
+             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0, dtype=np.bool_),
+             np.zeros(0, dtype=np.bool_), np.zeros((0, 6, 3)), np.zeros(1, dtype=np.int64),
+             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(1), False)
 
 # Bodies with fewer integration points than this step on one thread: starting the threads of a
 # parallel loop (twice a step) cost more than the work for the 480-tet cantilever of the tests
@@ -194,11 +199,15 @@ class DeformableBody:
             self.element_material, self._element_forces, self.jacobians, self._offsets,
             self._slots, self.masses, self.external_forces, self.contact_forces, self.gravity,
             self.mass_damping, self.constrained, self.prescribed_velocities, dt, self.nodal_forces,
-            NO_CONTACT)
+            NO_CONTACT, self._joint_arguments())
         self.step_count += int(done)
         self.time += int(done) * dt
         if status == finite_strain.INVERTED:
             self._raise_inverted(int(worst), float(value))
+
+    def _joint_arguments(self):
+        """The joint arguments of ``finite_strain.advance_steps`` (none: a body without joints)."""
+        return NO_JOINTS
 
     def _raise_inverted(self, worst: int, value: float) -> None:
         centre = self.positions[self.elements.corner_tets[worst]].mean(axis=0)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from riprap.deformable.body import TIME_STEP_SAFETY, DeformableBody, stable_step_for
+from riprap.deformable.body import DeformableBody, stable_step_for
 from riprap.deformable.kernels import joints as joint_kernels
 from riprap.errors import CaseFileError
 
@@ -120,6 +120,22 @@ def explode_mesh(nodes, tets):
             tets.reshape(-1).copy())
 
 
+def _missing_corner(face_nodes):
+    """The local corner (0..3) of each exploded tet that a face (three of its nodes) leaves out:
+    the face is that tet's face k (``_TET_FACES[k]``)."""
+    local = face_nodes % 4
+    return 6 - local.sum(axis=1)
+
+
+def node_slots(joints, n_nodes):
+    """(offsets, slots): ``slots[offsets[i]:offsets[i + 1]]`` are the flat (joint * 6 + corner)
+    entries of a joint force buffer that act on node i."""
+    flat = np.asarray(joints, dtype=np.int64).reshape(-1)
+    order = np.argsort(flat, kind="stable")
+    counts = np.bincount(flat, minlength=n_nodes)
+    return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), order.astype(np.int64)
+
+
 class FracturingBody(DeformableBody):
     """A deformable body that cracks: the exploded mesh of ``nodes``, ``tets`` with a joint
     between every two tets that shared a face (``explode_mesh``), of ``joint_material``.
@@ -135,6 +151,9 @@ class FracturingBody(DeformableBody):
         super().__init__(exploded, new_tets, material, element_type="tet4", name=name,
                          gravity=gravity, mass_damping=mass_damping)
         self.joint_material = joint_material
+        #: The mesh before it was exploded (reference nodes and tets).
+        self.original_nodes = np.asarray(nodes, dtype=np.float64).copy()
+        self.original_tets = np.asarray(tets, dtype=np.int64).copy()
         self.joints = joints
         self.joint_tets = joint_tets
         self.original_node = original
@@ -145,14 +164,25 @@ class FracturingBody(DeformableBody):
         #: Reference area of each joint's face (m^2).
         self.joint_areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
                                                          corners[:, 2] - corners[:, 0]), axis=1)
+        #: Damage D of each joint's three points (0 intact .. 1 no strength left).
         self.joint_damage = np.zeros((len(joints), 3))
+        #: Joints with two points at D = 1: they only keep their faces from passing through.
         self.joint_broken = np.zeros(len(joints), dtype=np.bool_)
-        self._joint_row = joint_material.kernel_row()
+        #: Broken joints between two fragments: no force at all (in a DeformableSystem, contact
+        #: takes over their faces).
+        self.joint_detached = np.zeros(len(joints), dtype=np.bool_)
+        #: Work done by the joints on the nodes so far (J): minus the energy they stored and
+        #: dissipated.
+        self.joint_work = np.zeros(1)
+        self._joint_properties = joint_material.kernel_row()[None, :]
+        self._joint_material_index = np.zeros(len(joints), dtype=np.int64)
         self._joint_buffer = np.zeros((len(joints), 6, 3))
-        order = np.argsort(joints.reshape(-1), kind="stable")
-        counts = np.bincount(joints.reshape(-1), minlength=len(exploded))
-        self._joint_offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-        self._joint_slots = order.astype(np.int64)
+        self._joint_node_offsets, self._joint_node_slots = node_slots(joints, len(exploded))
+        self._joint_node_forces = np.zeros((len(exploded), 3))
+        # tet t's face k (opposite corner k): the joint on it, or -1 on the body's surface
+        self.face_joint = np.full((len(new_tets), 4), -1, dtype=np.int64)
+        self.face_joint[joint_tets[:, 0], _missing_corner(joints[:, :3])] = np.arange(len(joints))
+        self.face_joint[joint_tets[:, 1], _missing_corner(joints[:, 3:])] = np.arange(len(joints))
 
     # ------------------------------------------------------------------ steps
     def stable_time_step(self) -> float:
@@ -163,40 +193,38 @@ class FracturingBody(DeformableBody):
         and read from both faces)."""
         if self._stable_time_step is None:
             omega_elements = float(self.elements.largest_element_frequencies(self.material).max())
-            stiffness = np.zeros(len(self.masses))
-            per_joint = (self.joint_material.joint_penalty / self.joint_sizes
-                         * self.joint_areas * (2.0 / 3.0))
-            np.add.at(stiffness, self.joints.reshape(-1), np.repeat(per_joint, 6))
-            omega_joints = float(np.sqrt((stiffness / self.masses).max())) if len(per_joint) else 0.0
-            omega = math.hypot(omega_elements, omega_joints)
+            omega = math.hypot(omega_elements, self.joint_frequency())
             self._stable_time_step = stable_step_for(omega, self.material.viscous_time_constant,
                                                      self.mass_damping)
             self._stiffest_frequency = omega
         return self._stable_time_step
 
+    def joint_frequency(self) -> float:
+        """Bound on the largest angular frequency (rad/s) of a node held by its joints alone."""
+        if not len(self.joints):
+            return 0.0
+        stiffness = np.zeros(len(self.masses))
+        per_joint = (self.joint_material.joint_penalty / self.joint_sizes
+                     * self.joint_areas * (2.0 / 3.0))
+        np.add.at(stiffness, self.joints.reshape(-1), np.repeat(per_joint, 6))
+        return float(np.sqrt((stiffness / self.masses).max()))
+
     def joint_forces(self) -> np.ndarray:
         """The joints' forces on the nodes (n, 3) at the present positions (updates damage)."""
         forces = np.zeros_like(self.positions)
-        self._add_joint_forces(forces)
+        joint_kernels.joint_forces_serial(self.positions, self.joints, self.joint_sizes,
+                                          self._joint_properties, self._joint_material_index,
+                                          self.joint_damage, self.joint_broken,
+                                          self.joint_detached, self._joint_buffer)
+        joint_kernels.gather_joint_forces_serial(self._joint_buffer, self._joint_node_offsets,
+                                                 self._joint_node_slots, forces)
         return forces
 
-    def _add_joint_forces(self, out) -> int:
-        broken_now = joint_kernels.joint_forces(self.positions, self.joints, self.joint_sizes,
-                                                self._joint_row, self.joint_damage,
-                                                self.joint_broken, self._joint_buffer)
-        joint_kernels.gather_joint_forces(self._joint_buffer, self._joint_offsets,
-                                          self._joint_slots, out)
-        return int(broken_now)
-
-    def step(self, n_steps: int = 1) -> None:
-        """Advance ``n_steps`` steps; the joints' forces at the start of each step enter it as
-        the nodes' contact forces (a single body has no other contact)."""
-        if self._time_step is None:
-            self._time_step = TIME_STEP_SAFETY * self.stable_time_step()
-        for _ in range(int(n_steps)):
-            self.contact_forces[:] = 0.0
-            self._add_joint_forces(self.contact_forces)
-            super().step(1)
+    def _joint_arguments(self):
+        return (self.joints, self.joint_sizes, self._joint_properties, self._joint_material_index,
+                self.joint_damage, self.joint_broken, self.joint_detached, self._joint_buffer,
+                self._joint_node_offsets, self._joint_node_slots, self._joint_node_forces,
+                self.joint_work, False)
 
     # ------------------------------------------------------------------ results
     @property
@@ -215,3 +243,33 @@ class FracturingBody(DeformableBody):
         graph = coo_matrix((np.ones(a.size), (a, b)), shape=(n, n))
         _, labels = connected_components(graph, directed=False)
         return labels
+
+    def fragment_table(self) -> dict:
+        """The pieces the body has broken into, each a body of its own, largest first: per
+        fragment its tets' count, volume (m^3, reference), mass (kg), mass fraction of the unit,
+        centre of mass (m) and velocity (m/s, its momentum over its mass), and ``element_fragment``
+        (the fragment of every tet in this numbering). Mass is the tets' own, so the fragments'
+        masses add up to the body's exactly."""
+        labels = self.fragments()
+        n = int(labels.max()) + 1 if len(labels) else 0
+        volumes = np.bincount(labels, weights=self.elements.volumes, minlength=n)
+        # every tet owns its four nodes: a node's mass and momentum belong to its tet's fragment
+        node_fragment = np.repeat(labels, 4)
+        masses = np.bincount(node_fragment, weights=self.masses, minlength=n)
+        centres = np.stack([np.bincount(node_fragment, weights=self.masses * self.positions[:, d],
+                                        minlength=n) for d in range(3)], axis=1) / masses[:, None]
+        velocities = np.stack([np.bincount(node_fragment, weights=self.masses * self.velocities[:, d],
+                                           minlength=n) for d in range(3)], axis=1) / masses[:, None]
+        order = np.argsort(-masses, kind="stable")
+        renumber = np.empty(n, dtype=np.int64)
+        renumber[order] = np.arange(n)
+        return {"elements": np.bincount(labels, minlength=n)[order], "volume": volumes[order],
+                "mass": masses[order], "mass_fraction": masses[order] / self.mass,
+                "centre": centres[order], "velocity": velocities[order],
+                "element_fragment": renumber[labels]}
+
+    def breakage_summary(self) -> dict:
+        """Broken area (m^2), number of fragments and the largest fragment's mass fraction."""
+        table = self.fragment_table()
+        return {"broken_area_m2": self.broken_area, "fragments": int(len(table["mass"])),
+                "largest_fragment_mass_fraction": float(table["mass_fraction"][0])}

@@ -16,8 +16,11 @@ import math
 
 import numpy as np
 
-from riprap.deformable.body import (NO_TET4_GRADIENTS, PARALLEL_POINTS, TIME_STEP_SAFETY,
-                                    DeformableBody, material_table, stable_step_for)
+from riprap.deformable.body import (NO_JOINTS, NO_TET4_GRADIENTS, PARALLEL_POINTS,
+                                    TIME_STEP_SAFETY, DeformableBody, material_table,
+                                    stable_step_for)
+from riprap.deformable.elements import _OUTWARD_FACES
+from riprap.deformable.joints import FracturingBody, node_slots
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import finite_strain
 from riprap.errors import CaseFileError
@@ -99,6 +102,7 @@ class DeformableSystem:
         self._pairs = np.zeros((0, 2), dtype=np.int64)
         self._listed_positions = np.full_like(self.positions, np.inf)
         self.pair_listings = 0
+        self.surface_rebuilds = 0
 
     # ------------------------------------------------------------------ assembly
     def _join(self, rigid_surfaces) -> None:
@@ -144,43 +148,41 @@ class DeformableSystem:
         counts = np.bincount(flat, minlength=len(self.positions))
         self._offsets = np.r_[0, np.cumsum(counts)].astype(np.int64)
         self._slots = order.astype(np.int64)
-        # contact surfaces: boundary triangles and the tets that touch the boundary
-        triangles, tets, triangle_body, tet_body, depths = [], [], [], [], []
-        # per body (deformable, then rigid): the median boundary sub-tet height, over which a
-        # tet's potential rises by one
-        potential_heights = []
+        # contact surfaces: boundary triangles and the tets that touch the boundary; a fracturing
+        # body's also the faces of its detached joints (rebuilt when they change)
+        self._surface_pieces = []            # per body (deformable, then rigid), or None
+        self.potential_heights = []
+        skin_heights = []
+        self._wall_depth_of_body = []
         for k, body in enumerate(bodies):
-            mesh = TetMesh(body.elements.reference_nodes, body.elements.contact_tets(), name=body.name)
-            faces = mesh.boundary_faces()
-            boundary_nodes = np.zeros(len(mesh.nodes), dtype=bool)
-            boundary_nodes[faces.ravel()] = True
-            layer = np.flatnonzero(boundary_nodes[mesh.tets].any(axis=1))
-            offset = self.node_offsets[k]
-            triangles.append(faces + offset)
-            tets.append(mesh.tets[layer] + offset)
-            triangle_body.append(np.full(len(faces), k, dtype=np.int64))
-            tet_body.append(np.full(len(layer), k, dtype=np.int64))
+            if isinstance(body, FracturingBody):
+                mesh = TetMesh(body.original_nodes, body.original_tets, name=body.name)
+                self._surface_pieces.append(None)
+            else:
+                mesh = TetMesh(body.elements.reference_nodes, body.elements.contact_tets(),
+                               name=body.name)
+                faces = mesh.boundary_faces()
+                boundary_nodes = np.zeros(len(mesh.nodes), dtype=bool)
+                boundary_nodes[faces.ravel()] = True
+                layer = np.flatnonzero(boundary_nodes[mesh.tets].any(axis=1))
+                self._surface_pieces.append((faces, mesh.tets[layer], np.arange(len(faces)),
+                                             layer, None, None))
             heights = boundary_tet_heights(mesh)
-            depths.append(np.full(len(faces), float(np.median(heights))))
+            # the median boundary sub-tet height, over which a tet's potential rises by one
+            self._wall_depth_of_body.append(float(np.median(heights)))
             body._contact_height = float(np.percentile(heights, 10))
-            potential_heights.append(float(np.median(heights)))
-        # the walls act on the deformable bodies' triangles and tets only, which come first
-        self.n_wall_triangles = sum(len(t) for t in triangles)
-        self.n_wall_tets = sum(len(t) for t in tets)
-        skin_heights = [b._contact_height for b in bodies]
+            skin_heights.append(body._contact_height)
+            self.potential_heights.append(float(np.median(heights)))
         self.proxy_local_nodes = []
         self.proxy_node_offsets = [self.n_deformable_nodes]
         for r, (local_nodes, faces, layer_tets, height) in enumerate(proxies):
-            offset = self.proxy_node_offsets[-1]
-            triangles.append(faces + offset)
-            tets.append(layer_tets + offset)
-            triangle_body.append(np.full(len(faces), len(bodies) + r, dtype=np.int64))
-            tet_body.append(np.full(len(layer_tets), len(bodies) + r, dtype=np.int64))
-            depths.append(np.full(len(faces), height))
+            self._surface_pieces.append((faces, layer_tets, np.arange(len(faces)),
+                                         np.arange(len(layer_tets)), None, None))
+            self._wall_depth_of_body.append(height)
             self.proxy_local_nodes.append(local_nodes)
-            self.proxy_node_offsets.append(offset + len(local_nodes))
+            self.proxy_node_offsets.append(self.proxy_node_offsets[-1] + len(local_nodes))
             skin_heights.append(height)
-            potential_heights.append(height)
+            self.potential_heights.append(height)
         self.proxy_node_offsets = np.asarray(self.proxy_node_offsets, dtype=np.int64)
         self._proxy_body = np.repeat(np.arange(len(proxies), dtype=np.int64),
                                      [len(p[0]) for p in proxies])
@@ -189,22 +191,151 @@ class DeformableSystem:
         self.first_rigid_body = len(bodies)
         self._moving_key = None
         self._moving_nodes = np.zeros(0, dtype=np.int64)
+        self._body_friction = np.array([b.material.friction_coefficient for b in bodies]
+                                       + rigid_friction)
+        self._body_damping = np.array([b.material.contact_damping_ratio for b in bodies]
+                                      + rigid_damping)
+        self._reference = np.concatenate([b.elements.reference_nodes for b in bodies]
+                                         + [p[0] for p in proxies])
+        self.skin = 0.5 * min(skin_heights)
+        self.potential_heights = np.asarray(self.potential_heights)
+        self._join_joints()
+        self._build_contact_surfaces()
+
+    def _join_joints(self) -> None:
+        """The joints of the fracturing bodies in one set of arrays (the bodies' damage, broken
+        and detached flags become views into them)."""
+        fracturing = [k for k, b in enumerate(self.bodies) if isinstance(b, FracturingBody)]
+        self.fracturing_bodies = fracturing
+        counts = [len(self.bodies[k].joints) for k in fracturing]
+        self.joint_offsets = np.r_[0, np.cumsum(counts)].astype(np.int64)
+        n_nodes = len(self.positions)
+        if not fracturing:
+            self.joints = np.zeros((0, 6), dtype=np.int64)
+            self.joint_data = NO_JOINTS
+            self.joint_work = np.zeros(1)
+            return
+        self.joints = np.concatenate([self.bodies[k].joints + self.node_offsets[k]
+                                      for k in fracturing])
+        sizes = np.concatenate([self.bodies[k].joint_sizes for k in fracturing])
+        properties = np.concatenate([self.bodies[k]._joint_properties for k in fracturing])
+        material = np.repeat(np.arange(len(fracturing), dtype=np.int64), counts)
+        for name in ("joint_damage", "joint_broken", "joint_detached"):
+            joined = np.concatenate([getattr(self.bodies[k], name) for k in fracturing])
+            setattr(self, name, joined)
+            for i, k in enumerate(fracturing):
+                setattr(self.bodies[k], name, joined[self.joint_offsets[i]:self.joint_offsets[i + 1]])
+        offsets, slots = node_slots(self.joints, n_nodes)
+        self.joint_work = np.zeros(1)
+        self.joint_node_forces = np.zeros((n_nodes, 3))
+        self.joint_data = (self.joints, sizes, properties, material, self.joint_damage,
+                           self.joint_broken, self.joint_detached, np.zeros((len(self.joints), 6, 3)),
+                           offsets, slots, self.joint_node_forces, self.joint_work, True)
+
+    def _fracturing_surface(self, body) -> tuple:
+        """A fracturing body's contact surface now: its outer faces and the faces of its detached
+        joints (outward from their own tets), the tets touching them (by the mesh before it was
+        exploded, so that a tet meeting the surface at a corner counts), keys of both that stay
+        the same as the surface grows, and the fragment of each."""
+        open_face = body.face_joint < 0
+        open_face |= body.joint_detached[np.maximum(body.face_joint, 0)] & (body.face_joint >= 0)
+        tet_index, face_index = np.nonzero(open_face)
+        faces = 4 * tet_index[:, None] + _OUTWARD_FACES[face_index]
+        on_surface = np.zeros(len(body.original_nodes), dtype=bool)
+        on_surface[body.original_node[faces.ravel()]] = True
+        layer = np.flatnonzero(on_surface[body.original_tets].any(axis=1))
+        fragments = body.fragments()
+        return (faces, body.elements.elements[layer], 4 * tet_index + face_index, layer,
+                fragments[tet_index], fragments[layer])
+
+    def _build_contact_surfaces(self) -> None:
+        """The contact arrays from every body's surface, in the order the walls need (deformable
+        bodies' triangles and tets first); each triangle and tet keeps a key (body, local key) by
+        which friction springs are carried over when a fracturing body's surface grows."""
+        triangles, tets, triangle_body, tet_body, triangle_keys, tet_keys = [], [], [], [], [], []
+        triangle_group, tet_group, depths = [], [], []
+        offsets = np.r_[self.node_offsets[:-1], self.proxy_node_offsets[:-1]]
+        group = 0
+        for k, piece in enumerate(self._surface_pieces):
+            if piece is None:
+                piece = self._fracturing_surface(self.bodies[k])
+            faces, layer_tets, face_keys, layer_keys, face_groups, layer_groups = piece
+            triangles.append(faces + offsets[k])
+            tets.append(layer_tets + offsets[k])
+            triangle_body.append(np.full(len(faces), k, dtype=np.int64))
+            tet_body.append(np.full(len(layer_tets), k, dtype=np.int64))
+            triangle_keys.append(k * _KEY_STRIDE + face_keys)
+            tet_keys.append(k * _KEY_STRIDE + layer_keys)
+            if face_groups is None:
+                triangle_group.append(np.full(len(faces), group, dtype=np.int64))
+                tet_group.append(np.full(len(layer_tets), group, dtype=np.int64))
+                group += 1
+            else:
+                triangle_group.append(group + face_groups)
+                tet_group.append(group + layer_groups)
+                group += int(max(face_groups.max(initial=-1), layer_groups.max(initial=-1))) + 1
+            if k == len(self.bodies) - 1:
+                # groups of deformable bodies first: candidate_pairs skips rigid-rigid pairs
+                self.first_rigid_group = group
+            depths.append(np.full(len(faces), self._wall_depth_of_body[k]))
+        n_bodies = len(self.bodies)
+        self.n_wall_triangles = sum(len(t) for t in triangles[:n_bodies])
+        self.n_wall_tets = sum(len(t) for t in tets[:n_bodies])
         self.triangles = np.concatenate(triangles)
         self.contact_tets = np.concatenate(tets)
         self.triangle_body = np.concatenate(triangle_body)
         self.tet_body = np.concatenate(tet_body)
+        self.triangle_keys = np.concatenate(triangle_keys)
+        self.tet_keys = np.concatenate(tet_keys)
+        self.triangle_group = np.concatenate(triangle_group)
+        self.tet_group = np.concatenate(tet_group)
         self.wall_depths = np.concatenate(depths)
-        friction = np.array([b.material.friction_coefficient for b in bodies] + rigid_friction)
-        self.triangle_friction = friction[self.triangle_body]
-        self.tet_friction = friction[self.tet_body]
-        damping = np.array([b.material.contact_damping_ratio for b in bodies] + rigid_damping)
-        self.triangle_damping = damping[self.triangle_body]
-        self.tet_damping = damping[self.tet_body]
-        reference = np.concatenate([b.elements.reference_nodes for b in bodies]
-                                   + [p[0] for p in proxies])
-        self.tet_heights = _subtet_heights(reference, self.contact_tets)
-        self.skin = 0.5 * min(skin_heights)
-        self.potential_heights = np.asarray(potential_heights)
+        self.triangle_friction = self._body_friction[self.triangle_body]
+        self.tet_friction = self._body_friction[self.tet_body]
+        self.triangle_damping = self._body_damping[self.triangle_body]
+        self.tet_damping = self._body_damping[self.tet_body]
+        self.tet_heights = _subtet_heights(self._reference, self.contact_tets)
+
+    def update_fragments(self) -> None:
+        """After joints broke: detach the broken joints that now part two fragments, and if any
+        did, rebuild the contact surfaces, carrying every friction spring over by its keys."""
+        grew = False
+        for k in self.fracturing_bodies:
+            body = self.bodies[k]
+            if not body.joint_broken.any():
+                continue
+            fragments = body.fragments()
+            parted = body.joint_broken & (fragments[body.joint_tets[:, 0]]
+                                          != fragments[body.joint_tets[:, 1]])
+            if (parted & ~body.joint_detached).any():
+                body.joint_detached |= parted
+                grew = True
+        if not grew:
+            return
+        old_triangle_keys, old_tet_keys = self.triangle_keys, self.tet_keys
+        old_wall_triangles, old_wall_tets = self.n_wall_triangles, self.n_wall_tets
+        self._build_contact_surfaces()
+        self.tet_stiffness = (self.tangential_stiffness_ratio * self.contact_penalty
+                              / self.tet_heights)
+        triangle_from = _find_keys(old_triangle_keys, self.triangle_keys)
+        tet_from = _find_keys(old_tet_keys, self.tet_keys)
+        self.wall_triangle_springs = _carried(self.wall_triangle_springs,
+                                              triangle_from[:self.n_wall_triangles], old_wall_triangles)
+        self.wall_tet_springs = _carried(self.wall_tet_springs, tet_from[:self.n_wall_tets],
+                                         old_wall_tets)
+        # the listed pairs in the new numbering (pairs whose triangle or tet left the surface go)
+        triangle_to = np.full(len(old_triangle_keys), -1, dtype=np.int64)
+        found = triangle_from >= 0
+        triangle_to[triangle_from[found]] = np.flatnonzero(found)
+        tet_to = np.full(len(old_tet_keys), -1, dtype=np.int64)
+        found = tet_from >= 0
+        tet_to[tet_from[found]] = np.flatnonzero(found)
+        pairs = np.stack([triangle_to[self._pairs[:, 0]], tet_to[self._pairs[:, 1]]], axis=1)
+        kept = (pairs >= 0).all(axis=1)
+        self._pairs = pairs[kept]
+        self.pair_springs = self.pair_springs[kept]
+        self._list_pairs()
+        self.surface_rebuilds += 1
 
     # ------------------------------------------------------------------ rigid bodies
     @property
@@ -244,9 +375,9 @@ class DeformableSystem:
 
     # ------------------------------------------------------------------ time step
     def stable_time_step(self) -> float:
-        """2 / sqrt(omega_elements^2 + omega_contact^2): the stiffest element and the stiffest
-        contact on one node (penalty times the node's share of surface over the potentials' depth).
-        Computed once: it depends on the reference geometry only."""
+        """2 / sqrt(omega_elements^2 + omega_contact^2): the stiffest element (with its joints) and
+        the stiffest contact on one node (penalty times the node's share of surface over the
+        potentials' depth; on a fracturing body, of every face of its tets). Computed once: it depends on the reference geometry only."""
         if self._stable_time_step is not None:
             return self._stable_time_step
         omega_elements = 0.0
@@ -256,12 +387,18 @@ class DeformableSystem:
         # from the reference geometry, so that a run and its restart take the same step
         reference = np.concatenate([b.elements.reference_nodes for b in self.bodies]
                                    + self.proxy_local_nodes)
-        corners = reference[self.triangles]
+        # a fracturing body's every face may come into contact once its joint has parted
+        fracturing = np.isin(self.triangle_body, self.fracturing_bodies)
+        own = (self.triangle_body < self.first_rigid_body) & ~fracturing
+        surfaces = [self.triangles[own]] + [
+            (self.bodies[k].elements.elements[:, _OUTWARD_FACES] + self.node_offsets[k]).reshape(-1, 3)
+            for k in self.fracturing_bodies]
+        triangles = np.concatenate(surfaces)
+        corners = reference[triangles]
         areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
                                               corners[:, 2] - corners[:, 0]), axis=1)
         node_area = np.zeros(len(reference))
-        own = self.triangle_body < self.first_rigid_body
-        np.add.at(node_area, self.triangles[own].ravel(), np.repeat(areas[own] / 3.0, 3))
+        np.add.at(node_area, triangles.ravel(), np.repeat(areas / 3.0, 3))
         heights = np.array([b._contact_height for b in self.bodies])
         node_body = np.repeat(np.arange(len(self.bodies)), np.diff(self.node_offsets))
         node_area = node_area[:self.n_deformable_nodes]
@@ -290,8 +427,8 @@ class DeformableSystem:
     # ------------------------------------------------------------------ stepping
     def _list_pairs(self) -> None:
         pairs = contact_kernels.candidate_pairs(self.positions, self.triangles,
-                                                self.triangle_body, self.contact_tets,
-                                                self.tet_body, self.skin, self.first_rigid_body)
+                                                self.triangle_group, self.contact_tets,
+                                                self.tet_group, self.skin, self.first_rigid_group)
         self.pair_springs = contact_kernels.carry_springs(self._pairs, self.pair_springs, pairs,
                                                           len(self.contact_tets))
         self._pairs = pairs
@@ -317,7 +454,7 @@ class DeformableSystem:
                 self.element_material, self._element_forces, self.jacobians, self._offsets,
                 self._slots, self.masses, self.external_forces, self.contact_forces, self.gravity,
                 self.mass_damping, self.constrained, self.prescribed_velocities, dt,
-                self.nodal_forces, contact)
+                self.nodal_forces, contact, self.joint_data)
             self.step_count += int(done)
             self.time += int(done) * dt
             for body in self.bodies:
@@ -326,6 +463,8 @@ class DeformableSystem:
             remaining -= int(done)
             if status == finite_strain.REBUILD_CONTACTS:
                 self._list_pairs()
+            elif status == finite_strain.JOINTS_BROKE:
+                self.update_fragments()
             elif status == finite_strain.INVERTED:
                 k = int(np.searchsorted(self.element_offsets, worst, side="right") - 1)
                 body = self.bodies[k]
@@ -342,6 +481,30 @@ class DeformableSystem:
         """Of the deformable bodies (J)."""
         n = self.n_deformable_nodes
         return 0.5 * float(np.sum(self.masses[:n, None] * self.velocities[:n] ** 2))
+
+
+# Keys of contact triangles and tets: body * _KEY_STRIDE + a key within the body.
+_KEY_STRIDE = 1 << 40
+
+
+def _find_keys(old_keys, new_keys):
+    """For each new key, the index of the same key among the old ones (-1 if new)."""
+    source = np.full(len(new_keys), -1, dtype=np.int64)
+    if len(old_keys) == 0:
+        return source
+    order = np.argsort(old_keys, kind="stable")
+    at = np.minimum(np.searchsorted(old_keys[order], new_keys), len(old_keys) - 1)
+    found = old_keys[order][at] == new_keys
+    source[found] = order[at[found]]
+    return source
+
+
+def _carried(springs, source, old_count):
+    """Wall springs (n_walls, n, 3) of the new numbering from the old ones by ``source``."""
+    carried = np.zeros((springs.shape[0], len(source), 3))
+    found = (source >= 0) & (source < old_count)
+    carried[:, found] = springs[:, source[found]]
+    return carried
 
 
 def _subtet_heights(nodes: np.ndarray, tets: np.ndarray) -> np.ndarray:

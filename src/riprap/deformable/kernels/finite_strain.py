@@ -20,6 +20,7 @@ import numpy as np
 
 from riprap._jit import inline_kernel, kernel, parallel_kernel, prange
 from riprap.deformable.kernels import contact as contact_kernels
+from riprap.deformable.kernels import joints as joint_kernels
 
 
 @inline_kernel
@@ -371,10 +372,21 @@ def smallest_jacobian(jacobians):
     return worst, value
 
 
+@kernel
+def _power(forces, velocities):
+    """sum of forces . velocities over the nodes (W)."""
+    power = 0.0
+    for n in range(forces.shape[0]):
+        power += (forces[n, 0] * velocities[n, 0] + forces[n, 1] * velocities[n, 1]
+                  + forces[n, 2] * velocities[n, 2])
+    return power
+
+
 #: Status codes of :func:`advance_steps`.
 DONE = 0
 INVERTED = 1
 REBUILD_CONTACTS = 2
+JOINTS_BROKE = 3
 #: Contact pairs are evaluated in parallel from this many on (below, threads cost more than
 #: they give: a pair takes about 0.2 microseconds).
 PARALLEL_PAIRS = 2000
@@ -384,7 +396,7 @@ PARALLEL_PAIRS = 2000
 def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradients, gradients,
                   weights, materials, element_material, element_forces, jacobians, node_offsets,
                   node_slots, masses, external_forces, contact_forces, gravity, mass_damping,
-                  constrained, prescribed_velocities, time_step, nodal_forces, contact):
+                  constrained, prescribed_velocities, time_step, nodal_forces, contact, joint_data):
     """Up to ``n_steps`` central-difference steps without returning to Python.
 
     ``contact`` = (the triangles and tets walls act on, all contact triangles and tets, wall depth
@@ -394,13 +406,23 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     triangle and per tet, tangential over normal contact stiffness, tangential stiffness per tet
     and m^2 of contact, the tangential springs of the pairs, of the wall triangles and of the
     wall tets, the normal damping ratio per triangle and per tet).
+    ``joint_data`` = the joints between tets of fracturing bodies (``riprap/deformable/kernels/joints.py``):
+    (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
+    detached, a (n, 6, 3) buffer, the node-to-slot lists of the buffer, the joints' force on every
+    node, their work done on the nodes so far (1,, trapezoidal), whether to stop after a step that broke one).
+    Their forces join the contact forces.
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
     which ``element`` has J <= 0 (or a non-finite J); REBUILD_CONTACTS before a step once a node has
-    moved half the skin since the pairs were listed."""
+    moved half the skin since the pairs were listed; JOINTS_BROKE after a step in which a joint
+    broke, if asked."""
     (wall_triangles, wall_tets, triangles, contact_tets, wall_depths, pairs, penalty, walls,
      listed_positions, skin, totals, triangle_friction, tet_friction, tangential_ratio,
      tet_stiffness, pair_springs, wall_triangle_springs, wall_tet_springs, triangle_damping,
      tet_damping) = contact
+    (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
+     joint_detached, joint_buffer, joint_node_offsets, joint_node_slots, joint_node_forces,
+     joint_work, stop_on_break) = joint_data
+    has_joints = joint_nodes.shape[0] > 0
     tet4 = elements.shape[1] == 4
     has_contact = triangles.shape[0] > 0
     half_skin_squared = 0.25 * skin * skin
@@ -436,6 +458,28 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
                                                        wall_triangle_springs[w],
                                                        wall_tet_springs[w])
                 totals[w] = force
+        newly_broken = 0
+        if has_joints:
+            if parallel:
+                newly_broken = joint_kernels.joint_forces(
+                    positions, joint_nodes, joint_sizes, joint_properties, joint_material,
+                    joint_damage, joint_broken, joint_detached, joint_buffer)
+                joint_kernels.gather_joint_forces(joint_buffer, joint_node_offsets,
+                                                  joint_node_slots, joint_node_forces)
+            else:
+                newly_broken = joint_kernels.joint_forces_serial(
+                    positions, joint_nodes, joint_sizes, joint_properties, joint_material,
+                    joint_damage, joint_broken, joint_detached, joint_buffer)
+                joint_kernels.gather_joint_forces_serial(joint_buffer, joint_node_offsets,
+                                                         joint_node_slots, joint_node_forces)
+            if has_contact:
+                contact_forces += joint_node_forces
+            else:
+                contact_forces[:] = joint_node_forces
+            # the joints' work by the trapezoidal rule, exact for a linear spring (the rectangle
+            # rule gains k dx^2 / 2 a step: a steady drift while the joints vibrate): this force
+            # closes the last interval, with the velocity over it
+            joint_work[0] += 0.5 * time_step * _power(joint_node_forces, velocities)
         if not parallel:
             element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
                                   weights, materials, element_material, element_forces, jacobians)
@@ -458,4 +502,9 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
                                              node_slots, masses, external_forces, contact_forces,
                                              gravity, mass_damping, constrained,
                                              prescribed_velocities, time_step, nodal_forces)
+        if has_joints:
+            # ... and opens this one
+            joint_work[0] += 0.5 * time_step * _power(joint_node_forces, velocities)
+            if stop_on_break and newly_broken > 0:
+                return step + 1, JOINTS_BROKE, -1, 1.0
     return n_steps, DONE, -1, 1.0

@@ -26,8 +26,6 @@ other) and no tension or shear.
 """
 import math
 
-import numpy as np
-
 from riprap._jit import inline_kernel, kernel, parallel_kernel, prange
 
 SOFTENING_A = 0.63
@@ -54,110 +52,196 @@ def _rising(ratio):
     return (2.0 - ratio) * ratio
 
 
-@kernel
-def _joint(j, positions, joints, sizes, properties, damage, broken, forces_a, forces_b):
-    """Forces on the six nodes of joint ``j`` into forces_a/forces_b (3, 3); updates its damage.
+@inline_kernel
+def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penalty, softening_i,
+                    softening_ii, damage_before, broken):
+    """Traction (pulling face A towards B) at one point of a joint whose faces are apart by
+    (sx, sy, sz), mid-surface normal n; and the point's damage after it."""
+    opening = sx * nx + sy * ny + sz * nz
+    tx = sx - opening * nx
+    ty = sy - opening * ny
+    tz = sz - opening * nz
+    slip = math.sqrt(tx * tx + ty * ty + tz * tz)
+    opening_peak = 2.0 * h * tensile / penalty
+    # the faces may not pass through each other (sigma = p o / h)
+    compression = 2.0 * opening / opening_peak * tensile if opening < 0.0 else 0.0
+    if broken:
+        sigma = compression
+        tau = 0.0
+        current = damage_before
+    else:
+        shear_strength = cohesion - tan_phi * compression
+        slip_peak = 2.0 * h * shear_strength / penalty
+        excess_o = max(opening - opening_peak, 0.0) * tensile / softening_i
+        excess_s = max(slip - slip_peak, 0.0) * shear_strength / softening_ii
+        now = math.sqrt(excess_o * excess_o + excess_s * excess_s)
+        current = max(damage_before, min(now, 1.0))
+        z = softening(current)
+        if opening < 0.0:
+            sigma = compression
+        elif opening < opening_peak:
+            sigma = _rising(opening / opening_peak) * z * tensile
+        else:
+            sigma = z * tensile
+        if slip < slip_peak:
+            tau = _rising(slip / slip_peak) * z * shear_strength
+        else:
+            tau = z * shear_strength
+    fx = sigma * nx
+    fy = sigma * ny
+    fz = sigma * nz
+    if slip > 0.0 and tau != 0.0:
+        scale = tau / slip
+        fx += scale * tx
+        fy += scale * ty
+        fz += scale * tz
+    return fx, fy, fz, current
+
+
+@inline_kernel
+def _put_vertex(buffer, j, k, fx, fy, fz):
+    """Force on face A's vertex k, and its opposite on B's vertex k."""
+    buffer[j, k, 0] = fx
+    buffer[j, k, 1] = fy
+    buffer[j, k, 2] = fz
+    buffer[j, 3 + k, 0] = -fx
+    buffer[j, 3 + k, 1] = -fy
+    buffer[j, 3 + k, 2] = -fz
+
+
+@inline_kernel
+def _joint(j, positions, joints, sizes, properties, joint_material, damage, broken, detached,
+           buffer):
+    """Forces of joint ``j`` on its six nodes into ``buffer[j]`` (6, 3); updates its damage.
     Returns the number of its points at D >= 1."""
-    tensile, cohesion, tan_phi, penalty, softening_i, softening_ii = (
-        properties[0], properties[1], properties[2], properties[3], properties[4], properties[5])
+    for k in range(6):
+        for d in range(3):
+            buffer[j, k, d] = 0.0
+    if detached[j]:
+        return 0
+    row = joint_material[j]
+    tensile = properties[row, 0]
+    cohesion = properties[row, 1]
+    tan_phi = properties[row, 2]
+    penalty = properties[row, 3]
+    softening_i = properties[row, 4]
+    softening_ii = properties[row, 5]
     h = sizes[j]
-    delta = np.empty((3, 3))
-    middle = np.empty((3, 3))
-    for k in range(3):
-        for d in range(3):
-            xa = positions[joints[j, k], d]
-            xb = positions[joints[j, 3 + k], d]
-            delta[k, d] = xb - xa
-            middle[k, d] = 0.5 * (xa + xb)
-    e1 = middle[1] - middle[0]
-    e2 = middle[2] - middle[0]
-    normal = np.array([e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                       e1[0] * e2[1] - e1[1] * e2[0]])
-    twice_area = math.sqrt(normal[0] ** 2 + normal[1] ** 2 + normal[2] ** 2)
-    for k in range(3):
-        for d in range(3):
-            forces_a[k, d] = 0.0
-            forces_b[k, d] = 0.0
+    a0, a1, a2 = joints[j, 0], joints[j, 1], joints[j, 2]
+    b0, b1, b2 = joints[j, 3], joints[j, 4], joints[j, 5]
+    # separations at the vertices and the mid-surface's corners
+    d0x = positions[b0, 0] - positions[a0, 0]
+    d0y = positions[b0, 1] - positions[a0, 1]
+    d0z = positions[b0, 2] - positions[a0, 2]
+    d1x = positions[b1, 0] - positions[a1, 0]
+    d1y = positions[b1, 1] - positions[a1, 1]
+    d1z = positions[b1, 2] - positions[a1, 2]
+    d2x = positions[b2, 0] - positions[a2, 0]
+    d2y = positions[b2, 1] - positions[a2, 1]
+    d2z = positions[b2, 2] - positions[a2, 2]
+    m0x = positions[a0, 0] + 0.5 * d0x
+    m0y = positions[a0, 1] + 0.5 * d0y
+    m0z = positions[a0, 2] + 0.5 * d0z
+    e1x = positions[a1, 0] + 0.5 * d1x - m0x
+    e1y = positions[a1, 1] + 0.5 * d1y - m0y
+    e1z = positions[a1, 2] + 0.5 * d1z - m0z
+    e2x = positions[a2, 0] + 0.5 * d2x - m0x
+    e2y = positions[a2, 1] + 0.5 * d2y - m0y
+    e2z = positions[a2, 2] + 0.5 * d2z - m0z
+    nx = e1y * e2z - e1z * e2y
+    ny = e1z * e2x - e1x * e2z
+    nz = e1x * e2y - e1y * e2x
+    twice_area = math.sqrt(nx * nx + ny * ny + nz * nz)
     if twice_area <= 0.0:
         return 0
-    normal /= twice_area
-    weight = twice_area / 6.0                          # a third of the area per point
-    opening_peak = 2.0 * h * tensile / penalty
+    nx /= twice_area
+    ny /= twice_area
+    nz /= twice_area
+    # a third of the area per point, half of that to each of the point's two vertices
+    share = twice_area / 12.0
+    is_broken = broken[j]
     failed = 0
+    # point q sits midway between vertices q and q + 1
+    t0x, t0y, t0z, damage[j, 0] = _point_traction(
+        0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, h, tensile, cohesion,
+        tan_phi, penalty, softening_i, softening_ii, damage[j, 0], is_broken)
+    t1x, t1y, t1z, damage[j, 1] = _point_traction(
+        0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, h, tensile, cohesion,
+        tan_phi, penalty, softening_i, softening_ii, damage[j, 1], is_broken)
+    t2x, t2y, t2z, damage[j, 2] = _point_traction(
+        0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, h, tensile, cohesion,
+        tan_phi, penalty, softening_i, softening_ii, damage[j, 2], is_broken)
     for q in range(3):
-        k0 = q
-        k1 = (q + 1) % 3
-        d_vec = 0.5 * (delta[k0] + delta[k1])
-        opening = d_vec[0] * normal[0] + d_vec[1] * normal[1] + d_vec[2] * normal[2]
-        slip_vec = d_vec - opening * normal
-        slip = math.sqrt(slip_vec[0] ** 2 + slip_vec[1] ** 2 + slip_vec[2] ** 2)
-        if broken[j]:
-            sigma = 2.0 * opening / opening_peak * tensile if opening < 0.0 else 0.0
-            tau = 0.0
-        else:
-            # strengths and softening lengths of this point
-            sigma_trial = 2.0 * opening / opening_peak * tensile if opening < 0.0 else 0.0
-            shear_strength = cohesion - tan_phi * sigma_trial
-            slip_peak = 2.0 * h * shear_strength / penalty
-            opening_soft = softening_i / tensile
-            slip_soft = softening_ii / shear_strength
-            excess_o = max(opening - opening_peak, 0.0) / opening_soft
-            excess_s = max(slip - slip_peak, 0.0) / slip_soft
-            now = math.sqrt(excess_o * excess_o + excess_s * excess_s)
-            current = max(damage[j, q], min(now, 1.0))
-            damage[j, q] = current
-            z = softening(current)
-            if opening < 0.0:
-                sigma = sigma_trial
-            elif opening < opening_peak:
-                sigma = _rising(opening / opening_peak) * z * tensile
-            else:
-                sigma = z * tensile
-            if slip < slip_peak:
-                tau = _rising(slip / slip_peak) * z * shear_strength
-            else:
-                tau = z * shear_strength
-            if current >= 1.0:
-                failed += 1
-        traction = sigma * normal
-        if slip > 0.0 and tau != 0.0:
-            traction = traction + (tau / slip) * slip_vec
-        for d in range(3):
-            share = 0.5 * weight * traction[d]
-            forces_a[k0, d] += share
-            forces_a[k1, d] += share
-            forces_b[k0, d] -= share
-            forces_b[k1, d] -= share
+        if damage[j, q] >= 1.0:
+            failed += 1
+    # vertex k takes the points on its two edges: q = k and q = k - 1
+    _put_vertex(buffer, j, 0, share * (t0x + t2x), share * (t0y + t2y), share * (t0z + t2z))
+    _put_vertex(buffer, j, 1, share * (t0x + t1x), share * (t0y + t1y), share * (t0z + t1z))
+    _put_vertex(buffer, j, 2, share * (t1x + t2x), share * (t1y + t2y), share * (t1z + t2z))
     return failed
 
 
+@inline_kernel
+def _joint_step(j, positions, joints, sizes, properties, joint_material, damage, broken, detached,
+                buffer):
+    """``_joint``, then mark the joint broken once two of its points are at D >= 1; returns 1 if
+    it broke now."""
+    failed = _joint(j, positions, joints, sizes, properties, joint_material, damage, broken,
+                    detached, buffer)
+    if failed >= 2 and not broken[j]:
+        broken[j] = True
+        return 1
+    return 0
+
+
 @parallel_kernel
-def joint_forces(positions, joints, sizes, properties, damage, broken, joint_force_buffer):
-    """Forces of every joint (``_joint``) into ``joint_force_buffer`` (n_joints, 6, 3); a joint
-    with two or more points at D >= 1 is marked ``broken``. Returns the number broken now."""
-    n = joints.shape[0]
-    newly = np.zeros(n, dtype=np.int64)
-    for j in prange(n):
-        forces_a = np.empty((3, 3))
-        forces_b = np.empty((3, 3))
-        failed = _joint(j, positions, joints, sizes, properties, damage, broken, forces_a, forces_b)
-        for k in range(3):
-            for d in range(3):
-                joint_force_buffer[j, k, d] = forces_a[k, d]
-                joint_force_buffer[j, 3 + k, d] = forces_b[k, d]
-        if not broken[j] and failed >= 2:
-            broken[j] = True
-            newly[j] = 1
-    return newly.sum()
+def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, detached,
+                 buffer):
+    """Forces of every joint (``_joint``) into ``buffer`` (n_joints, 6, 3); a joint with two or
+    more points at D >= 1 is marked ``broken``. Returns the number broken now."""
+    newly = 0
+    for j in prange(joints.shape[0]):
+        newly += _joint_step(j, positions, joints, sizes, properties, joint_material, damage,
+                             broken, detached, buffer)
+    return newly
 
 
 @kernel
-def gather_joint_forces(joint_force_buffer, node_offsets, node_slots, out):
-    """out[node] += the joint forces on it: ``node_slots[node_offsets[i]:node_offsets[i+1]]``
+def joint_forces_serial(positions, joints, sizes, properties, joint_material, damage, broken,
+                        detached, buffer):
+    """:func:`joint_forces` on one thread (small bodies: no thread start-up)."""
+    newly = 0
+    for j in range(joints.shape[0]):
+        newly += _joint_step(j, positions, joints, sizes, properties, joint_material, damage,
+                             broken, detached, buffer)
+    return newly
+
+
+@inline_kernel
+def _gather_node(node, flat, node_offsets, node_slots, out):
+    fx = fy = fz = 0.0
+    for s in range(node_offsets[node], node_offsets[node + 1]):
+        slot = node_slots[s]
+        fx += flat[slot, 0]
+        fy += flat[slot, 1]
+        fz += flat[slot, 2]
+    out[node, 0] = fx
+    out[node, 1] = fy
+    out[node, 2] = fz
+
+
+@parallel_kernel
+def gather_joint_forces(buffer, node_offsets, node_slots, out):
+    """out[node] = the joint forces on it: ``node_slots[node_offsets[i]:node_offsets[i+1]]``
     are the flat (joint * 6 + corner) slots of node i."""
-    flat = joint_force_buffer.reshape(-1, 3)
+    flat = buffer.reshape((-1, 3))
+    for node in prange(out.shape[0]):
+        _gather_node(node, flat, node_offsets, node_slots, out)
+
+
+@kernel
+def gather_joint_forces_serial(buffer, node_offsets, node_slots, out):
+    """:func:`gather_joint_forces` on one thread."""
+    flat = buffer.reshape((-1, 3))
     for node in range(out.shape[0]):
-        for s in range(node_offsets[node], node_offsets[node + 1]):
-            slot = node_slots[s]
-            for d in range(3):
-                out[node, d] += flat[slot, d]
+        _gather_node(node, flat, node_offsets, node_slots, out)
