@@ -15,7 +15,7 @@ GOOD = dict(tensile_strength=3e6, cohesion=6e6, friction_angle=30.0, fracture_en
 
 def test_every_shared_face_gets_one_joint_with_its_nodes_paired():
     nodes, tets = box_mesh((0.2, 0.05, 0.05), (4, 2, 2))
-    new_nodes, new_tets, joints, joint_tets, original = explode_mesh(nodes, tets)
+    new_nodes, new_tets, joints, joint_tets, face_joint, original, glued = explode_mesh(nodes, tets)
     assert new_nodes.shape == (4 * len(tets), 3) and new_tets.shape == tets.shape
     # 96 tets, 384 faces, 80 on the box's surface: 152 shared
     assert len(joints) == (4 * len(tets) - 80) // 2 == 152
@@ -27,6 +27,38 @@ def test_every_shared_face_gets_one_joint_with_its_nodes_paired():
     assert np.all(np.einsum("ij,ij->i", normal, outward) > 0)
     # each tet's nodes are its own
     assert np.array_equal(new_tets.ravel(), np.arange(new_nodes.shape[0]))
+    assert len(glued) == 0 and (face_joint == -1).sum() == 80 and (face_joint >= 0).sum() == 304
+
+
+def test_joints_only_in_a_region_keep_the_rest_of_the_mesh_whole():
+    """Cracking only in the half x > 0.1 of a bar: joints between its tets only, the others share
+    their nodes, and a tet beside the region shares nodes with the region's tets only where no
+    joint separates them."""
+    nodes, tets = box_mesh((0.2, 0.05, 0.05), (4, 2, 2))
+    centres = nodes[tets].mean(axis=1)
+    cracking = centres[:, 0] > 0.1
+    split = explode_mesh(nodes, tets, cracking)
+    both = cracking[split.joint_tets].all(axis=1)
+    # 48 tets in the half, 48 of their faces on its surface (the section at x = 0.1 included)
+    assert both.all() and len(split.joints) == (4 * cracking.sum() - 48) // 2
+    assert np.array_equal(split.nodes[split.joints[:, :3]], split.nodes[split.joints[:, 3:]])
+    # the whole half keeps one copy of each of its nodes (the section at x = 0.1 included)
+    whole = np.unique(split.tets[~cracking])
+    assert len(whole) == len(np.unique(tets[~cracking]))
+    # a body on it: one piece, its mass that of the solid bar
+    body = FracturingBody(nodes, tets, ElasticMaterial(density=2400.0), JointMaterial(**GOOD),
+                          cracking=cracking)
+    assert len(np.unique(body.fragments())) == 1
+    assert body.mass == pytest.approx(2400.0 * 0.2 * 0.05 * 0.05)
+    body.joint_broken[:] = True
+    table = body.fragment_table()
+    # every tet of the cracking half a fragment of its own but the 8 glued by a face to the other
+    # half, which stay with it
+    held = np.setdiff1d(np.unique(split.glued_tets), np.flatnonzero(~cracking))
+    assert len(held) == 8
+    assert len(table["mass"]) == cracking.sum() - 8 + 1
+    assert table["mass_fraction"][0] == pytest.approx((48 + 8) / 96)
+    assert table["mass"].sum() == pytest.approx(body.mass)
 
 
 def test_the_softening_curve_falls_from_one_to_zero():

@@ -20,14 +20,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from riprap.deformable.body import DeformableBody, stable_step_for
 from riprap.deformable.kernels import joints as joint_kernels
 from riprap.errors import CaseFileError
 
-__all__ = ["JointMaterial", "explode_mesh", "FracturingBody", "SOFTENING_AREA"]
+__all__ = ["JointMaterial", "ExplodedMesh", "explode_mesh", "FracturingBody", "SOFTENING_AREA"]
 
 
 def _softening_area(samples: int = 200_001) -> float:
@@ -88,19 +91,37 @@ class JointMaterial:
 _TET_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])   # outward, opposite corner k
 
 
-def explode_mesh(nodes, tets):
-    """Give every tet its own nodes and list the joints between formerly shared faces.
+class ExplodedMesh(NamedTuple):
+    """A mesh split along its joints (``explode_mesh``)."""
 
-    Returns (nodes (4 m, 3), tets (m, 4), joints (n, 6), joint_tets (n, 2), original_node (4 m,)):
-    tet t's corners are nodes 4t..4t+3; joint j holds tet ``joint_tets[j, 0]``'s face (nodes
-    ``joints[j, :3]``) to tet ``joint_tets[j, 1]``'s (``joints[j, 3:]``, paired in order), with
-    the face's normal (x1 - x0) x (x2 - x0) pointing out of the first tet.
-    """
+    #: (k, 3) node coordinates: one copy of an original node per group of its tets that no
+    #: joint separates.
+    nodes: np.ndarray
+    #: (m, 4) tets in those nodes, in the original order and orientation.
+    tets: np.ndarray
+    #: (n, 6) joint j holds face A (nodes ``joints[j, :3]``) to face B (``joints[j, 3:]``, paired
+    #: in order); (x1 - x0) x (x2 - x0) of face A points out of its tet.
+    joints: np.ndarray
+    #: (n, 2) the tets of faces A and B.
+    joint_tets: np.ndarray
+    #: (m, 4) the joint on tet t's face k (opposite its corner k), -1 on the mesh's surface, -2 on
+    #: a face shared with a tet it stays glued to (no joint between them).
+    face_joint: np.ndarray
+    #: (k,) the original node of every node.
+    original_node: np.ndarray
+    #: (g, 2) pairs of tets that share a face without a joint: they never part.
+    glued_tets: np.ndarray
+
+
+def explode_mesh(nodes, tets, cracking=None) -> ExplodedMesh:
+    """Split a mesh along the faces where it may crack: a joint between every two tets that share
+    a face and are both ``cracking`` (a mask over the tets; default all). Each side of a joint
+    gets its own copy of the face's nodes; tets that share a face without a joint keep sharing
+    their nodes (with joints everywhere, every tet has its own four)."""
     nodes = np.asarray(nodes, dtype=np.float64)
     tets = np.asarray(tets, dtype=np.int64)
     m = len(tets)
-    new_nodes = nodes[tets.reshape(-1)]
-    new_tets = np.arange(4 * m, dtype=np.int64).reshape(m, 4)
+    cracking = np.ones(m, dtype=bool) if cracking is None else np.asarray(cracking, dtype=bool)
     local_faces = tets[:, _TET_FACES]                                   # (m, 4, 3) global ids
     keys = np.sort(local_faces.reshape(-1, 3), axis=1)
     order = np.lexsort(keys.T[::-1])
@@ -109,22 +130,34 @@ def explode_mesh(nodes, tets):
     first = order[:-1][same]
     second = order[1:][same]
     tet_a, face_a = first // 4, first % 4
-    tet_b = second // 4
+    tet_b, face_b = second // 4, second % 4
     corners_a = _TET_FACES[face_a]                                      # local corners in A, (n, 3)
     global_ids = tets[tet_a[:, None], corners_a]                        # outward from A
     # B's local corner holding each of those global nodes
     match = tets[tet_b][:, None, :] == global_ids[:, :, None]           # (n, 3, 4)
     corners_b = np.argmax(match, axis=2)
-    joints = np.concatenate([4 * tet_a[:, None] + corners_a, 4 * tet_b[:, None] + corners_b], axis=1)
-    return (new_nodes, new_tets, joints.astype(np.int64), np.stack([tet_a, tet_b], axis=1),
-            tets.reshape(-1).copy())
-
-
-def _missing_corner(face_nodes):
-    """The local corner (0..3) of each exploded tet that a face (three of its nodes) leaves out:
-    the face is that tet's face k (``_TET_FACES[k]``)."""
-    local = face_nodes % 4
-    return 6 - local.sum(axis=1)
+    jointed = cracking[tet_a] & cracking[tet_b]
+    # a node's copies: its (tet, corner) incidences joined across the faces without a joint
+    glued_a = (4 * tet_a[:, None] + corners_a)[~jointed].ravel()
+    glued_b = (4 * tet_b[:, None] + corners_b)[~jointed].ravel()
+    incidences = 4 * m
+    same_node = coo_matrix((np.ones(glued_a.size), (glued_a, glued_b)),
+                           shape=(incidences, incidences))
+    _, copy_of = connected_components(same_node, directed=False)
+    new_tets = copy_of.reshape(m, 4).astype(np.int64)
+    original_node = np.zeros(int(copy_of.max()) + 1 if m else 0, dtype=np.int64)
+    original_node[copy_of] = tets.reshape(-1)
+    joints = np.concatenate([new_tets[tet_a[:, None], corners_a],
+                             new_tets[tet_b[:, None], corners_b]], axis=1)[jointed]
+    face_joint = np.full((m, 4), -1, dtype=np.int64)
+    face_joint[tet_a[~jointed], face_a[~jointed]] = -2
+    face_joint[tet_b[~jointed], face_b[~jointed]] = -2
+    n_joints = int(jointed.sum())
+    face_joint[tet_a[jointed], face_a[jointed]] = np.arange(n_joints)
+    face_joint[tet_b[jointed], face_b[jointed]] = np.arange(n_joints)
+    return ExplodedMesh(nodes[original_node], new_tets, joints.astype(np.int64),
+                        np.stack([tet_a, tet_b], axis=1)[jointed], face_joint, original_node,
+                        np.stack([tet_a, tet_b], axis=1)[~jointed])
 
 
 def node_slots(joints, n_nodes):
@@ -137,26 +170,32 @@ def node_slots(joints, n_nodes):
 
 
 class FracturingBody(DeformableBody):
-    """A deformable body that cracks: the exploded mesh of ``nodes``, ``tets`` with a joint
-    between every two tets that shared a face (``explode_mesh``), of ``joint_material``.
+    """A deformable body that cracks: the mesh ``nodes``, ``tets`` split by joints of
+    ``joint_material`` between every two tets that share a face and are both ``cracking`` (a mask
+    over the tets, default all; ``explode_mesh``).
 
     Other parameters as :class:`DeformableBody` (4-node tets only).
     """
 
     def __init__(self, nodes, tets, material, joint_material: JointMaterial, *,
-                 name: str = "body", gravity=(0.0, 0.0, 0.0), mass_damping: float = 0.0):
+                 name: str = "body", gravity=(0.0, 0.0, 0.0), mass_damping: float = 0.0,
+                 cracking=None):
         if not isinstance(joint_material, JointMaterial):
             raise CaseFileError(f"deformable body '{name}': joint_material must be a JointMaterial")
-        exploded, new_tets, joints, joint_tets, original = explode_mesh(nodes, tets)
-        super().__init__(exploded, new_tets, material, element_type="tet4", name=name,
+        split = explode_mesh(nodes, tets, cracking)
+        exploded, joints = split.nodes, split.joints
+        super().__init__(exploded, split.tets, material, element_type="tet4", name=name,
                          gravity=gravity, mass_damping=mass_damping)
         self.joint_material = joint_material
         #: The mesh before it was exploded (reference nodes and tets).
         self.original_nodes = np.asarray(nodes, dtype=np.float64).copy()
         self.original_tets = np.asarray(tets, dtype=np.int64).copy()
         self.joints = joints
-        self.joint_tets = joint_tets
-        self.original_node = original
+        self.joint_tets = split.joint_tets
+        self.original_node = split.original_node
+        #: The joint on tet t's face k, -1 on the surface, -2 glued (``ExplodedMesh.face_joint``).
+        self.face_joint = split.face_joint
+        self.glued_tets = split.glued_tets
         corners = exploded[joints[:, :3]]
         edges = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2)
         #: h of each joint (m): the mean edge of its face.
@@ -179,10 +218,6 @@ class FracturingBody(DeformableBody):
         self._joint_buffer = np.zeros((len(joints), 6, 3))
         self._joint_node_offsets, self._joint_node_slots = node_slots(joints, len(exploded))
         self._joint_node_forces = np.zeros((len(exploded), 3))
-        # tet t's face k (opposite corner k): the joint on it, or -1 on the body's surface
-        self.face_joint = np.full((len(new_tets), 4), -1, dtype=np.int64)
-        self.face_joint[joint_tets[:, 0], _missing_corner(joints[:, :3])] = np.arange(len(joints))
-        self.face_joint[joint_tets[:, 1], _missing_corner(joints[:, 3:])] = np.arange(len(joints))
 
     # ------------------------------------------------------------------ steps
     def stable_time_step(self) -> float:
@@ -234,11 +269,9 @@ class FracturingBody(DeformableBody):
 
     def fragments(self) -> np.ndarray:
         """Fragment number of every tet: tets joined by unbroken joints share one."""
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import connected_components
-
         intact = ~self.joint_broken
-        a, b = self.joint_tets[intact, 0], self.joint_tets[intact, 1]
+        a = np.concatenate([self.joint_tets[intact, 0], self.glued_tets[:, 0]])
+        b = np.concatenate([self.joint_tets[intact, 1], self.glued_tets[:, 1]])
         n = self.n_elements
         graph = coo_matrix((np.ones(a.size), (a, b)), shape=(n, n))
         _, labels = connected_components(graph, directed=False)
@@ -253,8 +286,10 @@ class FracturingBody(DeformableBody):
         labels = self.fragments()
         n = int(labels.max()) + 1 if len(labels) else 0
         volumes = np.bincount(labels, weights=self.elements.volumes, minlength=n)
-        # every tet owns its four nodes: a node's mass and momentum belong to its tet's fragment
-        node_fragment = np.repeat(labels, 4)
+        # a node's tets are all of one fragment (tets that share a node without a joint between
+        # them are glued): its mass and momentum belong to that fragment
+        node_fragment = np.zeros(len(self.masses), dtype=np.int64)
+        node_fragment[self.elements.elements.reshape(-1)] = np.repeat(labels, 4)
         masses = np.bincount(node_fragment, weights=self.masses, minlength=n)
         centres = np.stack([np.bincount(node_fragment, weights=self.masses * self.positions[:, d],
                                         minlength=n) for d in range(3)], axis=1) / masses[:, None]

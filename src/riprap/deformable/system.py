@@ -237,10 +237,12 @@ class DeformableSystem:
         joints (outward from their own tets), the tets touching them (by the mesh before it was
         exploded, so that a tet meeting the surface at a corner counts), keys of both that stay
         the same as the surface grows, and the fragment of each."""
-        open_face = body.face_joint < 0
-        open_face |= body.joint_detached[np.maximum(body.face_joint, 0)] & (body.face_joint >= 0)
+        face_joint = body.face_joint
+        open_face = (face_joint == -1) | ((face_joint >= 0)
+                                          & body.joint_detached[np.maximum(face_joint, 0)])
         tet_index, face_index = np.nonzero(open_face)
-        faces = 4 * tet_index[:, None] + _OUTWARD_FACES[face_index]
+        faces = np.take_along_axis(body.elements.elements[tet_index], _OUTWARD_FACES[face_index],
+                                   axis=1)
         on_surface = np.zeros(len(body.original_nodes), dtype=bool)
         on_surface[body.original_node[faces.ravel()]] = True
         layer = np.flatnonzero(on_surface[body.original_tets].any(axis=1))
