@@ -82,6 +82,11 @@ class RunSummary:
     # deformable bodies
     element_steps_per_second: float | None = None
     max_tensile_stress: float | None = None
+    # fracture (deformable runs with joints)
+    broken_joints: int | None = None
+    broken_area: float | None = None      # m^2, one side of the cracks
+    pieces: int | None = None             # deformable bodies and fragments, each counted once
+    fracture_energy: float | None = None  # J taken by the joints (stored and dissipated)
 
     def as_dict(self) -> dict:
         return {key: value for key, value in self.__dict__.items() if value is not None}
@@ -217,12 +222,15 @@ class Simulation:
     def add_deformable_body(self, *, shape: str, material, position,
                             orientation=(1.0, 0.0, 0.0, 0.0), velocity=(0.0, 0.0, 0.0),
                             angular_velocity=(0.0, 0.0, 0.0), element_type: str = "tet4",
-                            name: str | None = None) -> int:
+                            name: str | None = None, joints=None) -> int:
         """Add a deformable body (:class:`riprap.deformable.DeformableBody`) of a shape's mesh:
         ``material`` an :class:`riprap.deformable.ElasticMaterial`, ``position`` its centroid
         (m), ``orientation`` a quaternion (w, x, y, z) applied to the mesh as built, ``velocity``
-        and ``angular_velocity`` its initial rigid motion. Returns its index among the deformable
-        bodies."""
+        and ``angular_velocity`` its initial rigid motion. ``joints``: a
+        :class:`riprap.deformable.joints.JointMaterial` (joints between all its tets), or one with
+        a box ((lower), (upper)) in m at the start, joints only between tets whose centroids lie
+        in it: the body cracks (:class:`riprap.deformable.joints.FracturingBody`). Returns its
+        index among the deformable bodies."""
         from scipy.spatial.transform import Rotation
 
         from riprap.deformable.body import DeformableBody
@@ -234,8 +242,24 @@ class Simulation:
         rotation = Rotation.from_quat([x, y, z, w]).as_matrix()
         nodes = (mesh.nodes - centroid) @ rotation.T + np.asarray(position, dtype=np.float64)
         index = len(self.deformable_bodies)
-        body = DeformableBody(nodes, mesh.tets, material, element_type=element_type,
-                              name=name or f"{shape}_{index}")
+        name = name or f"{shape}_{index}"
+        if joints is None:
+            body = DeformableBody(nodes, mesh.tets, material, element_type=element_type, name=name)
+        else:
+            from riprap.deformable.joints import FracturingBody, check_crack_resolution
+
+            if element_type != "tet4":
+                raise CaseFileError(f"deformable body '{name}': joints need element_type 'tet4', "
+                                    f"not {element_type!r}")
+            joint_material, region = joints if isinstance(joints, tuple) else (joints, None)
+            cracking = None
+            if region is not None:
+                centres = nodes[mesh.tets].mean(axis=1)
+                lower, upper = (np.asarray(corner, dtype=np.float64) for corner in region)
+                cracking = np.all((centres >= lower) & (centres <= upper), axis=1)
+            check_crack_resolution(nodes, mesh.tets, name, cracking)
+            body = FracturingBody(nodes, mesh.tets, material, joint_material, name=name,
+                                  cracking=cracking)
         offsets = body.positions - np.asarray(position, dtype=np.float64)
         body.velocities[:] = np.asarray(velocity, dtype=np.float64) + np.cross(
             np.asarray(angular_velocity, dtype=np.float64), offsets)

@@ -151,6 +151,29 @@ class _BodyPlacer:
                 tensile_strength=spec.tensile_strength or None)
         return self._materials[name]
 
+    def _joint_material(self):
+        """The joints of ``[deformable] fracture``, every strength and energy checked > 0."""
+        from riprap.deformable.joints import JointMaterial
+
+        spec = self.spec
+        where = f"{self.case.source}: [deformable] fracture = true"
+        if spec.element_type != "tet4":
+            raise RiprapError(f"{where} needs element_type = \"tet4\" (joints hold the faces of "
+                              f"4-node tets), not {spec.element_type!r}")
+        hints = {"tensile_strength": "Pa; concrete about 3e6",
+                 "cohesion": "Pa; concrete about twice the tensile strength",
+                 "fracture_energy_mode_i": "J/m^2; concrete about 100",
+                 "fracture_energy_mode_ii": "J/m^2; concrete about 1000"}
+        for key, hint in hints.items():
+            if not getattr(spec, key) > 0:
+                raise RiprapError(f"{where} needs {key} > 0 ({hint}); it is {getattr(spec, key)!r}")
+        return JointMaterial(
+            tensile_strength=spec.tensile_strength, cohesion=spec.cohesion,
+            friction_angle=spec.friction_angle,
+            fracture_energy_mode_i=spec.fracture_energy_mode_i,
+            fracture_energy_mode_ii=spec.fracture_energy_mode_ii,
+            joint_penalty=spec.joint_penalty or 10.0 * spec.young_modulus)
+
     def __call__(self, *, shape, material, position, orientation=(1.0, 0.0, 0.0, 0.0),
                  velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0), fixed=False) -> None:
         index = self.count
@@ -159,10 +182,15 @@ class _BodyPlacer:
             if fixed:
                 raise RiprapError(f"{self.case.source}: [deformable] bodies selects body {index}, "
                                   "which is fixed; a fixed body cannot deform")
+            cracking = None
+            if self.spec.cracks(index):
+                cracking = (self._joint_material(), (self.spec.fracture_region_lower,
+                                                     self.spec.fracture_region_upper))
             self.sim.add_deformable_body(
                 shape=shape, material=self._elastic_material(material), position=position,
                 orientation=orientation, velocity=velocity, angular_velocity=angular_velocity,
-                element_type=self.spec.element_type, name=f"body_{index}")
+                element_type=self.spec.element_type, name=f"body_{index}",
+                joints=cracking)
             self.sim.deformable_case_index.append(index)
         else:
             self.rigid_case_index.append(index)
@@ -202,6 +230,17 @@ class _BodyPlacer:
             if missing:
                 raise RiprapError(f"{self.case.source}: [deformable] bodies lists {missing}, but the "
                                   f"case makes {self.count} bodies (numbered 0 to {self.count - 1})")
+        if spec is not None and spec.fracture and spec.fracture_bodies != "all":
+            missing = [i for i in spec.fracture_bodies if i >= self.count]
+            if missing:
+                raise RiprapError(f"{self.case.source}: [deformable] fracture_bodies lists {missing}, "
+                                  f"but the case makes {self.count} bodies (numbered 0 to "
+                                  f"{self.count - 1})")
+            rigid = [i for i in spec.fracture_bodies if not spec.selects(i)]
+            if rigid:
+                raise RiprapError(f"{self.case.source}: [deformable] fracture_bodies lists {rigid}, "
+                                  "which stay rigid (not in [deformable] bodies): joints crack "
+                                  "deformable bodies only; add them to bodies")
 
 
 def add_body_grid(sim: Simulation, grid, rng: np.random.Generator, place=None) -> None:

@@ -235,9 +235,23 @@ class DeformableSpec:
     tensile_strength: float = _default("deformable", "tensile_strength")
     contact_penalty: float = _default("deformable", "contact_penalty")
     mass_damping: float = _default("deformable", "mass_damping")
+    fracture: bool = _default("deformable", "fracture")
+    fracture_bodies: object = _default("deformable", "fracture_bodies")
+    cohesion: float = _default("deformable", "cohesion")
+    friction_angle: float = _default("deformable", "friction_angle")
+    fracture_energy_mode_i: float = _default("deformable", "fracture_energy_mode_i")
+    fracture_energy_mode_ii: float = _default("deformable", "fracture_energy_mode_ii")
+    joint_penalty: float = _default("deformable", "joint_penalty")
+    fracture_region_lower: tuple = _default("deformable", "fracture_region_lower")
+    fracture_region_upper: tuple = _default("deformable", "fracture_region_upper")
 
     def selects(self, index: int) -> bool:
         return self.bodies == "all" or index in self.bodies
+
+    def cracks(self, index: int) -> bool:
+        """Whether case body ``index`` gets joints."""
+        return bool(self.fracture) and self.selects(index) and (
+            self.fracture_bodies == "all" or index in self.fracture_bodies)
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -690,14 +690,40 @@ KEYS: tuple[Key, ...] = (
         "their 8 linear sub-tets). All deformable bodies of a run have the same.", default="tet4",
         choices=("tet4", "tet10")),
     Key("deformable", "tensile_strength", "number", "Pa",
-        "Tensile strength the largest principal stresses are compared with in units.csv; 0: none "
-        "given.", default=0.0, valid_range=_NON_NEGATIVE),
+        "Tensile strength the largest principal stresses are compared with in units.csv, and "
+        "the joints' with `fracture`; 0: none given.", default=0.0, valid_range=_NON_NEGATIVE),
     Key("deformable", "contact_penalty", "number", "Pa",
         "Penalty of the potential contact between deformable bodies and walls; 0: Young's "
         "modulus.", default=0.0, valid_range=_NON_NEGATIVE),
     Key("deformable", "mass_damping", "number", "1/s",
         "alpha of a force -alpha m v on every node: 0 for physics, a settling aid otherwise.",
         default=0.0, valid_range=_NON_NEGATIVE),
+    Key("deformable", "fracture", "boolean", "-",
+        "Joints between the tets of the bodies `fracture_bodies` selects: they crack at "
+        "`tensile_strength` and break into fragments (docs/fracture.md).", default=False),
+    Key("deformable", "fracture_bodies", "body_selection", "-",
+        "Which of the deformable bodies crack (case body numbers).", default="all"),
+    Key("deformable", "cohesion", "number", "Pa",
+        "Shear strength of the joints without normal stress (concrete: about twice the tensile "
+        "strength); needed with `fracture`.", default=0.0, valid_range=_NON_NEGATIVE),
+    Key("deformable", "friction_angle", "number", "deg",
+        "The joints' shear strength grows by tan(friction_angle) times the compression.",
+        default=30.0, valid_range=Range(minimum=0.0, maximum=90.0, maximum_inclusive=False)),
+    Key("deformable", "fracture_energy_mode_i", "number", "J/m^2",
+        "Energy a crack dissipates per unit area in opening (concrete: about 100); needed with "
+        "`fracture`.", default=0.0, valid_range=_NON_NEGATIVE),
+    Key("deformable", "fracture_energy_mode_ii", "number", "J/m^2",
+        "Energy a crack dissipates per unit area in sliding (concrete: about 10 times mode I); "
+        "needed with `fracture`.", default=0.0, valid_range=_NON_NEGATIVE),
+    Key("deformable", "joint_penalty", "number", "Pa",
+        "Stiffness of a joint per unit area times its size; 0: ten times `young_modulus` (stiffer "
+        "joints shorten the time step).", default=0.0, valid_range=_NON_NEGATIVE),
+    Key("deformable", "fracture_region_lower", "vector", "m",
+        "Lower corner of the box (at the start) where cracks may run: joints only between tets "
+        "whose centroids are inside; default everywhere.", default=(-1.0e9, -1.0e9, -1.0e9)),
+    Key("deformable", "fracture_region_upper", "vector", "m",
+        "Upper corner of that box.", default=(1.0e9, 1.0e9, 1.0e9),
+        greater_than="fracture_region_lower"),
     Key("output", "directory", "string", "-",
         "Output folder, relative to the current directory unless the command line overrides it.",
         default="riprap-out"),

@@ -32,8 +32,8 @@ NO_TET4_GRADIENTS = np.zeros((0, 4, 3))
 # The joint arguments of a run without joints (see finite_strain.advance_steps).
 NO_JOINTS = (np.zeros((0, 6), dtype=np.int64), np.zeros(0), np.zeros((1, 6)),
              np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0, dtype=np.bool_),
-             np.zeros(0, dtype=np.bool_), np.zeros((0, 6, 3)), np.zeros(1, dtype=np.int64),
-             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(1), False)
+             np.zeros((0, 6, 3)), np.zeros(1, dtype=np.int64),
+             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(1))
 
 # Bodies with fewer integration points than this step on one thread: starting the threads of a
 # parallel loop (twice a step) cost more than the work for the 480-tet cantilever of the tests

@@ -160,6 +160,38 @@ def explode_mesh(nodes, tets, cracking=None) -> ExplodedMesh:
                         np.stack([tet_a, tet_b], axis=1)[~jointed])
 
 
+#: A crack needs at least this many tets across a body's thinnest extent to find its own path.
+MIN_TETS_ACROSS = 3.0
+
+
+def check_crack_resolution(nodes, tets, name: str, cracking=None) -> None:
+    """Refuse a mesh too coarse to show a crack: fewer than ``MIN_TETS_ACROSS`` mean tet edges
+    across the body's thinnest extent (along its principal axes), or a region of cracking tets
+    with no two neighbours (no joint at all). Raises CaseFileError saying what is needed."""
+    nodes = np.asarray(nodes, dtype=np.float64)
+    tets = np.asarray(tets, dtype=np.int64)
+    corners = nodes[tets]
+    edges = corners[:, [1, 2, 3, 2, 3, 3]] - corners[:, [0, 0, 0, 1, 1, 2]]
+    mean_edge = float(np.linalg.norm(edges, axis=2).mean())
+    centred = nodes - nodes.mean(axis=0)
+    _, _, axes = np.linalg.svd(centred, full_matrices=False)
+    extents = np.ptp(centred @ axes.T, axis=0)
+    thinnest = float(extents.min())
+    if thinnest < MIN_TETS_ACROSS * mean_edge:
+        raise CaseFileError(
+            f"deformable body '{name}': its mesh is too coarse to show a crack: "
+            f"{thinnest / mean_edge:.1f} tet edges (mean {mean_edge:.3g} m) across its thinnest "
+            f"extent of {thinnest:.3g} m, where a crack needs at least {MIN_TETS_ACROSS:g}; mesh it "
+            f"finer (a shape's mesh_size of at most {thinnest / MIN_TETS_ACROSS:.3g} m)")
+    if cracking is not None:
+        split = explode_mesh(nodes, tets, cracking)
+        if len(split.joints) == 0:
+            raise CaseFileError(
+                f"deformable body '{name}': its fracture region holds {int(np.sum(cracking))} of "
+                "its tets and no two of them share a face, so it could never crack; move or "
+                "widen fracture_region_lower/upper to take in the part that should crack")
+
+
 def node_slots(joints, n_nodes):
     """(offsets, slots): ``slots[offsets[i]:offsets[i + 1]]`` are the flat (joint * 6 + corner)
     entries of a joint force buffer that act on node i."""
@@ -205,11 +237,12 @@ class FracturingBody(DeformableBody):
                                                          corners[:, 2] - corners[:, 0]), axis=1)
         #: Damage D of each joint's three points (0 intact .. 1 no strength left).
         self.joint_damage = np.zeros((len(joints), 3))
-        #: Joints with two points at D = 1: they only keep their faces from passing through.
+        #: Joints with two points at D = 1: they only keep their faces from passing through each
+        #: other (while the faces still face each other: slip below the joint's size).
         self.joint_broken = np.zeros(len(joints), dtype=np.bool_)
-        #: Broken joints between two fragments: no force at all (in a DeformableSystem, contact
-        #: takes over their faces).
-        self.joint_detached = np.zeros(len(joints), dtype=np.bool_)
+        #: Broken joints between two fragments: in a DeformableSystem their faces are contact
+        #: surfaces too, for every tet but the two the joint holds and their other neighbours.
+        self.joint_parted = np.zeros(len(joints), dtype=np.bool_)
         #: Work done by the joints on the nodes so far (J): minus the energy they stored and
         #: dissipated.
         self.joint_work = np.zeros(1)
@@ -250,16 +283,16 @@ class FracturingBody(DeformableBody):
         joint_kernels.joint_forces_serial(self.positions, self.joints, self.joint_sizes,
                                           self._joint_properties, self._joint_material_index,
                                           self.joint_damage, self.joint_broken,
-                                          self.joint_detached, self._joint_buffer)
+                                          self._joint_buffer)
         joint_kernels.gather_joint_forces_serial(self._joint_buffer, self._joint_node_offsets,
                                                  self._joint_node_slots, forces)
         return forces
 
     def _joint_arguments(self):
         return (self.joints, self.joint_sizes, self._joint_properties, self._joint_material_index,
-                self.joint_damage, self.joint_broken, self.joint_detached, self._joint_buffer,
+                self.joint_damage, self.joint_broken, self._joint_buffer,
                 self._joint_node_offsets, self._joint_node_slots, self._joint_node_forces,
-                self.joint_work, False)
+                self.joint_work)
 
     # ------------------------------------------------------------------ results
     @property

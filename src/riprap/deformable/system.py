@@ -103,6 +103,7 @@ class DeformableSystem:
         self._listed_positions = np.full_like(self.positions, np.inf)
         self.pair_listings = 0
         self.surface_rebuilds = 0
+        self._broken_at_check = 0
 
     # ------------------------------------------------------------------ assembly
     def _join(self, rigid_surfaces) -> None:
@@ -149,7 +150,7 @@ class DeformableSystem:
         self._offsets = np.r_[0, np.cumsum(counts)].astype(np.int64)
         self._slots = order.astype(np.int64)
         # contact surfaces: boundary triangles and the tets that touch the boundary; a fracturing
-        # body's also the faces of its detached joints (rebuilt when they change)
+        # body's also the faces of its parted joints (rebuilt when they change)
         self._surface_pieces = []            # per body (deformable, then rigid), or None
         self.potential_heights = []
         skin_heights = []
@@ -166,7 +167,7 @@ class DeformableSystem:
                 boundary_nodes[faces.ravel()] = True
                 layer = np.flatnonzero(boundary_nodes[mesh.tets].any(axis=1))
                 self._surface_pieces.append((faces, mesh.tets[layer], np.arange(len(faces)),
-                                             layer, None, None))
+                                             layer, None, None, None, None))
             heights = boundary_tet_heights(mesh)
             # the median boundary sub-tet height, over which a tet's potential rises by one
             self._wall_depth_of_body.append(float(np.median(heights)))
@@ -177,7 +178,7 @@ class DeformableSystem:
         self.proxy_node_offsets = [self.n_deformable_nodes]
         for r, (local_nodes, faces, layer_tets, height) in enumerate(proxies):
             self._surface_pieces.append((faces, layer_tets, np.arange(len(faces)),
-                                         np.arange(len(layer_tets)), None, None))
+                                         np.arange(len(layer_tets)), None, None, None, None))
             self._wall_depth_of_body.append(height)
             self.proxy_local_nodes.append(local_nodes)
             self.proxy_node_offsets.append(self.proxy_node_offsets[-1] + len(local_nodes))
@@ -204,7 +205,7 @@ class DeformableSystem:
 
     def _join_joints(self) -> None:
         """The joints of the fracturing bodies in one set of arrays (the bodies' damage, broken
-        and detached flags become views into them)."""
+        and parted flags become views into them)."""
         fracturing = [k for k, b in enumerate(self.bodies) if isinstance(b, FracturingBody)]
         self.fracturing_bodies = fracturing
         counts = [len(self.bodies[k].joints) for k in fracturing]
@@ -220,7 +221,7 @@ class DeformableSystem:
         sizes = np.concatenate([self.bodies[k].joint_sizes for k in fracturing])
         properties = np.concatenate([self.bodies[k]._joint_properties for k in fracturing])
         material = np.repeat(np.arange(len(fracturing), dtype=np.int64), counts)
-        for name in ("joint_damage", "joint_broken", "joint_detached"):
+        for name in ("joint_damage", "joint_broken", "joint_parted"):
             joined = np.concatenate([getattr(self.bodies[k], name) for k in fracturing])
             setattr(self, name, joined)
             for i, k in enumerate(fracturing):
@@ -229,17 +230,18 @@ class DeformableSystem:
         self.joint_work = np.zeros(1)
         self.joint_node_forces = np.zeros((n_nodes, 3))
         self.joint_data = (self.joints, sizes, properties, material, self.joint_damage,
-                           self.joint_broken, self.joint_detached, np.zeros((len(self.joints), 6, 3)),
-                           offsets, slots, self.joint_node_forces, self.joint_work, True)
+                           self.joint_broken, np.zeros((len(self.joints), 6, 3)),
+                           offsets, slots, self.joint_node_forces, self.joint_work)
 
     def _fracturing_surface(self, body) -> tuple:
-        """A fracturing body's contact surface now: its outer faces and the faces of its detached
+        """A fracturing body's contact surface now: its outer faces and the faces of its parted
         joints (outward from their own tets), the tets touching them (by the mesh before it was
         exploded, so that a tet meeting the surface at a corner counts), keys of both that stay
-        the same as the surface grows, and the fragment of each."""
+        the same as the surface grows, the fragment of each, and the original nodes of the
+        triangles' tets and of the tets (tets that shared one are left to their joints)."""
         face_joint = body.face_joint
         open_face = (face_joint == -1) | ((face_joint >= 0)
-                                          & body.joint_detached[np.maximum(face_joint, 0)])
+                                          & body.joint_parted[np.maximum(face_joint, 0)])
         tet_index, face_index = np.nonzero(open_face)
         faces = np.take_along_axis(body.elements.elements[tet_index], _OUTWARD_FACES[face_index],
                                    axis=1)
@@ -248,20 +250,30 @@ class DeformableSystem:
         layer = np.flatnonzero(on_surface[body.original_tets].any(axis=1))
         fragments = body.fragments()
         return (faces, body.elements.elements[layer], 4 * tet_index + face_index, layer,
-                fragments[tet_index], fragments[layer])
+                fragments[tet_index], fragments[layer], body.original_tets[tet_index],
+                body.original_tets[layer])
 
     def _build_contact_surfaces(self) -> None:
         """The contact arrays from every body's surface, in the order the walls need (deformable
         bodies' triangles and tets first); each triangle and tet keeps a key (body, local key) by
         which friction springs are carried over when a fracturing body's surface grows."""
         triangles, tets, triangle_body, tet_body, triangle_keys, tet_keys = [], [], [], [], [], []
-        triangle_group, tet_group, depths = [], [], []
+        triangle_group, tet_group, depths, triangle_origin, tet_origin = [], [], [], [], []
         offsets = np.r_[self.node_offsets[:-1], self.proxy_node_offsets[:-1]]
         group = 0
+        original_offset = 0
         for k, piece in enumerate(self._surface_pieces):
             if piece is None:
                 piece = self._fracturing_surface(self.bodies[k])
-            faces, layer_tets, face_keys, layer_keys, face_groups, layer_groups = piece
+            (faces, layer_tets, face_keys, layer_keys, face_groups, layer_groups, face_origin,
+             layer_origin) = piece
+            if face_origin is None:
+                triangle_origin.append(np.full((len(faces), 4), -1, dtype=np.int64))
+                tet_origin.append(np.full((len(layer_tets), 4), -1, dtype=np.int64))
+            else:
+                triangle_origin.append(face_origin + original_offset)
+                tet_origin.append(layer_origin + original_offset)
+                original_offset += len(self.bodies[k].original_nodes)
             triangles.append(faces + offsets[k])
             tets.append(layer_tets + offsets[k])
             triangle_body.append(np.full(len(faces), k, dtype=np.int64))
@@ -291,6 +303,8 @@ class DeformableSystem:
         self.tet_keys = np.concatenate(tet_keys)
         self.triangle_group = np.concatenate(triangle_group)
         self.tet_group = np.concatenate(tet_group)
+        self.triangle_origin = np.concatenate(triangle_origin)
+        self.tet_origin = np.concatenate(tet_origin)
         self.wall_depths = np.concatenate(depths)
         self.triangle_friction = self._body_friction[self.triangle_body]
         self.tet_friction = self._body_friction[self.tet_body]
@@ -298,8 +312,19 @@ class DeformableSystem:
         self.tet_damping = self._body_damping[self.tet_body]
         self.tet_heights = _subtet_heights(self._reference, self.contact_tets)
 
+    def rebuild_contact_surfaces(self) -> None:
+        """The contact surfaces from the joints' present state (after a restart): the friction
+        springs of the walls start empty, sized to the new surfaces; pairs are listed anew."""
+        self._build_contact_surfaces()
+        self.tet_stiffness = (self.tangential_stiffness_ratio * self.contact_penalty
+                              / self.tet_heights)
+        self.wall_triangle_springs = np.zeros((len(self.walls), self.n_wall_triangles, 3))
+        self.wall_tet_springs = np.zeros((len(self.walls), self.n_wall_tets, 3))
+        self._pairs = np.zeros((0, 2), dtype=np.int64)
+        self.pair_springs = np.zeros((0, 3))
+
     def update_fragments(self) -> None:
-        """After joints broke: detach the broken joints that now part two fragments, and if any
+        """After joints broke: mark the broken joints that now part two fragments, and if any
         did, rebuild the contact surfaces, carrying every friction spring over by its keys."""
         grew = False
         for k in self.fracturing_bodies:
@@ -309,21 +334,22 @@ class DeformableSystem:
             fragments = body.fragments()
             parted = body.joint_broken & (fragments[body.joint_tets[:, 0]]
                                           != fragments[body.joint_tets[:, 1]])
-            if (parted & ~body.joint_detached).any():
-                body.joint_detached |= parted
+            if (parted & ~body.joint_parted).any():
+                body.joint_parted |= parted
                 grew = True
         if not grew:
             return
         old_triangle_keys, old_tet_keys = self.triangle_keys, self.tet_keys
         old_wall_triangles, old_wall_tets = self.n_wall_triangles, self.n_wall_tets
-        self._build_contact_surfaces()
-        self.tet_stiffness = (self.tangential_stiffness_ratio * self.contact_penalty
-                              / self.tet_heights)
+        old_wall_triangle_springs, old_wall_tet_springs = (self.wall_triangle_springs,
+                                                           self.wall_tet_springs)
+        old_pairs, old_pair_springs = self._pairs, self.pair_springs
+        self.rebuild_contact_surfaces()
         triangle_from = _find_keys(old_triangle_keys, self.triangle_keys)
         tet_from = _find_keys(old_tet_keys, self.tet_keys)
-        self.wall_triangle_springs = _carried(self.wall_triangle_springs,
+        self.wall_triangle_springs = _carried(old_wall_triangle_springs,
                                               triangle_from[:self.n_wall_triangles], old_wall_triangles)
-        self.wall_tet_springs = _carried(self.wall_tet_springs, tet_from[:self.n_wall_tets],
+        self.wall_tet_springs = _carried(old_wall_tet_springs, tet_from[:self.n_wall_tets],
                                          old_wall_tets)
         # the listed pairs in the new numbering (pairs whose triangle or tet left the surface go)
         triangle_to = np.full(len(old_triangle_keys), -1, dtype=np.int64)
@@ -332,10 +358,10 @@ class DeformableSystem:
         tet_to = np.full(len(old_tet_keys), -1, dtype=np.int64)
         found = tet_from >= 0
         tet_to[tet_from[found]] = np.flatnonzero(found)
-        pairs = np.stack([triangle_to[self._pairs[:, 0]], tet_to[self._pairs[:, 1]]], axis=1)
+        pairs = np.stack([triangle_to[old_pairs[:, 0]], tet_to[old_pairs[:, 1]]], axis=1)
         kept = (pairs >= 0).all(axis=1)
         self._pairs = pairs[kept]
-        self.pair_springs = self.pair_springs[kept]
+        self.pair_springs = old_pair_springs[kept]
         self._list_pairs()
         self.surface_rebuilds += 1
 
@@ -430,7 +456,8 @@ class DeformableSystem:
     def _list_pairs(self) -> None:
         pairs = contact_kernels.candidate_pairs(self.positions, self.triangles,
                                                 self.triangle_group, self.contact_tets,
-                                                self.tet_group, self.skin, self.first_rigid_group)
+                                                self.tet_group, self.skin, self.first_rigid_group,
+                                                self.triangle_origin, self.tet_origin)
         self.pair_springs = contact_kernels.carry_springs(self._pairs, self.pair_springs, pairs,
                                                           len(self.contact_tets))
         self._pairs = pairs
@@ -443,6 +470,9 @@ class DeformableSystem:
         parallel = self.weights.size >= PARALLEL_POINTS
         remaining = int(n_steps)
         while remaining > 0:
+            chunk = remaining
+            if self.fracturing_bodies:
+                chunk = min(chunk, FRAGMENT_CHECK_STEPS - self.step_count % FRAGMENT_CHECK_STEPS)
             contact = (self.triangles[:self.n_wall_triangles], self.contact_tets[:self.n_wall_tets],
                        self.triangles, self.contact_tets, self.wall_depths, self._pairs,
                        self.contact_penalty, self.walls, self._listed_positions, self.skin,
@@ -451,7 +481,7 @@ class DeformableSystem:
                        self.wall_triangle_springs, self.wall_tet_springs, self.triangle_damping,
                        self.tet_damping)
             done, status, worst, value = finite_strain.advance_steps(
-                remaining, parallel, self.positions, self.velocities, self.elements,
+                chunk, parallel, self.positions, self.velocities, self.elements,
                 self.tet4_gradients, self.gradients, self.weights, self.materials,
                 self.element_material, self._element_forces, self.jacobians, self._offsets,
                 self._slots, self.masses, self.external_forces, self.contact_forces, self.gravity,
@@ -463,10 +493,13 @@ class DeformableSystem:
                 body.time = self.time
                 body.step_count = self.step_count
             remaining -= int(done)
+            if self.fracturing_bodies and self.step_count % FRAGMENT_CHECK_STEPS == 0:
+                broken = int(np.count_nonzero(self.joint_broken))
+                if broken != self._broken_at_check:
+                    self._broken_at_check = broken
+                    self.update_fragments()
             if status == finite_strain.REBUILD_CONTACTS:
                 self._list_pairs()
-            elif status == finite_strain.JOINTS_BROKE:
-                self.update_fragments()
             elif status == finite_strain.INVERTED:
                 k = int(np.searchsorted(self.element_offsets, worst, side="right") - 1)
                 body = self.bodies[k]
@@ -484,6 +517,12 @@ class DeformableSystem:
         n = self.n_deformable_nodes
         return 0.5 * float(np.sum(self.masses[:n, None] * self.velocities[:n] ** 2))
 
+
+#: Every this many steps (counted from the start, so that a restart checks at the same steps) the
+#: joints broken since are looked at, and those that part two fragments handed to the contact.
+#: Until then a broken joint keeps its faces apart itself (its compressive penalty); a piece
+#: flying at 30 m/s moves 2 mm in 100 steps of 0.7 microseconds, a small part of a face.
+FRAGMENT_CHECK_STEPS = 100
 
 # Keys of contact triangles and tets: body * _KEY_STRIDE + a key within the body.
 _KEY_STRIDE = 1 << 40

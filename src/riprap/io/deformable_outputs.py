@@ -1,7 +1,9 @@
 """``units.csv`` of a deformable run: one row per body with the largest tensile principal stress
 of the run (Pa), the element and point where it was and when, the largest at the end of the run
 (for a body brought to rest: its stresses at rest), and the ratio of the run's largest to the
-material's tensile strength where one is given (NaN otherwise)."""
+material's tensile strength where one is given (NaN otherwise); with fracture the broken joints'
+area (m^2, one side of the cracks), the number of pieces and the largest one's mass fraction
+(0, 1 and 1 for a body without joints)."""
 from __future__ import annotations
 
 import csv
@@ -12,7 +14,8 @@ __all__ = ["UNIT_COLUMNS", "write_units_csv"]
 UNIT_COLUMNS = ("body", "name", "mass_kg", "elements", "element_type", "max_tensile_stress_Pa",
                 "max_tensile_element", "max_tensile_x_m", "max_tensile_y_m", "max_tensile_z_m",
                 "max_tensile_time_s", "final_max_tensile_stress_Pa", "tensile_strength_Pa",
-                "stress_over_strength")
+                "stress_over_strength", "broken_area_m2", "fragments",
+                "largest_fragment_mass_fraction")
 
 
 def write_units_csv(path, rows) -> Path:

@@ -73,6 +73,7 @@ class DeformableModel(Model):
         # so far was found: the state the picture shows
         self._peak = None
         self._surfaces = None
+        self._crack_series = None
 
     # ------------------------------------------------------------------ clock
     @property
@@ -227,6 +228,9 @@ class DeformableModel(Model):
                 "record_stress": self.records.stress.copy(),
                 "record_element": self.records.element.copy(),
                 "record_point": self.records.point.copy(), "record_time": self.records.time.copy(),
+                **({"joint_damage": s.joint_damage.copy(), "joint_broken": s.joint_broken.copy(),
+                    "joint_parted": s.joint_parted.copy(), "joint_work": s.joint_work.copy()}
+                   if s.fracturing_bodies else {}),
                 **({f"rigid_{key}": value for key, value in self.rigid.solver.state_arrays().items()}
                    if self.rigid is not None else {})}
 
@@ -236,11 +240,18 @@ class DeformableModel(Model):
         s.step_count = int(arrays["clock"][1])
         s.positions[:] = arrays["positions"]
         s.velocities[:] = arrays["velocities"]
+        if s.fracturing_bodies:
+            # the cracks first: they decide the contact surfaces the springs below belong to
+            s.joint_damage[:] = arrays["joint_damage"]
+            s.joint_broken[:] = arrays["joint_broken"]
+            s.joint_parted[:] = arrays["joint_parted"]
+            s.joint_work[:] = arrays["joint_work"]
+            s.rebuild_contact_surfaces()
         s._pairs = np.array(arrays["contact_pairs"], dtype=np.int64).reshape(-1, 2)
         s._listed_positions[:] = arrays["listed_positions"]
         s.pair_springs = np.array(arrays["pair_springs"], dtype=np.float64).reshape(-1, 3)
-        s.wall_triangle_springs[:] = arrays["wall_triangle_springs"]
-        s.wall_tet_springs[:] = arrays["wall_tet_springs"]
+        s.wall_triangle_springs = np.array(arrays["wall_triangle_springs"], dtype=np.float64)
+        s.wall_tet_springs = np.array(arrays["wall_tet_springs"], dtype=np.float64)
         for body in s.bodies:
             body.time = s.time
             body.step_count = s.step_count
@@ -287,6 +298,8 @@ class DeformableModel(Model):
         self._picture = picture
         if paraview:
             self._series = vtk.ParaViewSeries(directory, "bodies", append=append)
+            if self.system.fracturing_bodies:
+                self._crack_series = vtk.ParaViewSeries(directory, "cracks", append=append)
             if self.rigid is not None:
                 self._rigid_series = vtk.ParaViewSeries(directory, "rigid_bodies", append=append)
                 self._rigid_contact_series = vtk.ParaViewSeries(directory, "rigid_contacts",
@@ -302,8 +315,10 @@ class DeformableModel(Model):
         reference = np.concatenate([b.elements.reference_nodes for b in s.bodies]
                                    + [s.positions[s.n_deformable_nodes:]])
         body_of_element = np.repeat(np.arange(len(s.bodies)), [b.n_elements for b in s.bodies])
+        fragment, damage = self._element_fracture_fields()
         cell_data = {
             "body": body_of_element,
+            "fragment": fragment, "damage": damage,
             "sigma_1": principal[:, 0], "sigma_2": principal[:, 1], "sigma_3": principal[:, 2],
             "differential_stress": principal[:, 0] - principal[:, 2],
             "von_mises": von_mises(stresses),
@@ -317,6 +332,46 @@ class DeformableModel(Model):
         return {"points": s.positions.copy(), "cells": corner_tets, "cell_data": cell_data,
                 "point_data": point_data}
 
+    def _element_fracture_fields(self):
+        """Per element: its fragment (numbered from 0 in each body, largest first; 0 in a body
+        without joints) and the largest damage of the joints on its faces (0 .. 1)."""
+        s = self.system
+        fragment = np.zeros(len(s.elements), dtype=np.int64)
+        damage = np.zeros(len(s.elements))
+        for k in s.fracturing_bodies:
+            body = s.bodies[k]
+            first = s.element_offsets[k]
+            fragment[first:first + body.n_elements] = body.fragment_table()["element_fragment"]
+            joint_damage = body.joint_damage.max(axis=1)
+            local = np.zeros(body.n_elements)
+            np.maximum.at(local, body.joint_tets[:, 0], joint_damage)
+            np.maximum.at(local, body.joint_tets[:, 1], joint_damage)
+            damage[first:first + body.n_elements] = local
+        return fragment, damage
+
+    def crack_fields(self) -> dict:
+        """The damaged joints of all bodies as triangles (their A faces, now): ``damage`` (the
+        largest of the three points), ``broken`` (1 or 0), ``opening`` (m, mean normal
+        separation of the faces), ``body``."""
+        s = self.system
+        if not s.fracturing_bodies:
+            return {"points": np.zeros((0, 3)), "cells": np.zeros((0, 3), dtype=np.int64),
+                    "cell_data": {}}
+        damaged = np.flatnonzero(s.joint_damage.max(axis=1) > 0.0)
+        joints = s.joints[damaged]
+        faces_a = s.positions[joints[:, :3]]
+        faces_b = s.positions[joints[:, 3:]]
+        normals = np.cross(faces_a[:, 1] - faces_a[:, 0], faces_a[:, 2] - faces_a[:, 0])
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+        opening = np.einsum("ij,ij->i", (faces_b - faces_a).mean(axis=1), normals)
+        joint_body = np.repeat(np.asarray(s.fracturing_bodies),
+                               np.diff(s.joint_offsets))[damaged]
+        return {"points": faces_a.reshape(-1, 3),
+                "cells": np.arange(3 * len(damaged), dtype=np.int64).reshape(-1, 3),
+                "cell_data": {"damage": s.joint_damage[damaged].max(axis=1),
+                              "broken": s.joint_broken[damaged].astype(np.int64),
+                              "opening": opening, "body": joint_body}}
+
     def write_frame(self, frame_index: int) -> None:
         if self._series is not None:
             fields = self.frame_fields()
@@ -324,6 +379,10 @@ class DeformableModel(Model):
             self._series.add(self.time, points=fields["points"][:n], cells=fields["cells"],
                              cell_data=fields["cell_data"],
                              point_data={k: v[:n] for k, v in fields["point_data"].items()})
+        if self._crack_series is not None:
+            cracks = self.crack_fields()
+            self._crack_series.add(self.time, points=cracks["points"], cells=cracks["cells"],
+                                   cell_type="triangle", cell_data=cracks["cell_data"])
         if self._rigid_series is not None:
             self.rigid._write_frame(self._rigid_series, self._rigid_contact_series, time=self.time)
 
@@ -345,6 +404,9 @@ class DeformableModel(Model):
                 "tensile_strength_Pa": strength if strength is not None else float("nan"),
                 "stress_over_strength": (self.records.stress[k] / strength
                                          if strength is not None else float("nan")),
+                **(body.breakage_summary() if k in self.system.fracturing_bodies
+                   else {"broken_area_m2": 0.0, "fragments": 1,
+                         "largest_fragment_mass_fraction": 1.0}),
             })
         return rows
 
@@ -354,6 +416,13 @@ class DeformableModel(Model):
         outputs = {"units": str(write_units_csv(self._directory / "units.csv", self.unit_rows()))}
         if self._series is not None:
             outputs["paraview"] = str(self._series.pvd_path)
+        if self._crack_series is not None:
+            outputs["cracks"] = str(self._crack_series.pvd_path)
+        if self.system.fracturing_bodies:
+            outputs["fragments"] = str(self.write_fragment_table(self._directory / "fragments.csv"))
+            if self._picture:
+                outputs["fragments_picture"] = str(self.write_fragment_picture(
+                    self._directory / "fragments.png"))
         if self._rigid_series is not None:
             outputs["rigid_bodies"] = str(self._rigid_series.pvd_path)
         if self._picture and self._peak is not None:
@@ -403,11 +472,52 @@ class DeformableModel(Model):
             value_label="largest principal stress sigma_1 (MPa, tension +)", colour_map=colour_map,
             value_range=value_range, title=title)
 
+    def write_fragment_table(self, path):
+        """``fragments.csv``: every piece of every cracking body, a body of its own: the unit it
+        came from, its tets, volume, mass, mass fraction of the unit, centre of mass, velocity."""
+        import csv
+
+        with open(path, "w", newline="") as stream:
+            writer = csv.writer(stream)
+            writer.writerow(["body", "name", "fragment", "elements", "volume_m3", "mass_kg",
+                             "mass_fraction", "x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s"])
+            for k in self.system.fracturing_bodies:
+                table = self.system.bodies[k].fragment_table()
+                for f in range(len(table["mass"])):
+                    writer.writerow([k, self.body_names[k], f, int(table["elements"][f])]
+                                    + [f"{v:.6g}" for v in (table["volume"][f], table["mass"][f],
+                                                            table["mass_fraction"][f],
+                                                            *table["centre"][f],
+                                                            *table["velocity"][f])])
+        return path
+
+    def write_fragment_picture(self, path):
+        """The bodies' surfaces now, the crack faces included, one colour per fragment (the
+        rigid bodies grey)."""
+        from riprap.io.picture import render_bodies_png
+
+        s = self.system
+        triangles = s.positions[s.triangles]
+        # one id per (body, fragment): the contact groups are exactly that
+        ids = s.triangle_group
+        rigid = np.unique(ids[s.triangle_body >= s.first_rigid_body])
+        pieces = int(s.first_rigid_group)
+        broken = sum(self.system.bodies[k].breakage_summary()["fragments"] - 1
+                     for k in s.fracturing_bodies)
+        return render_bodies_png(
+            path, triangles_world=triangles, body_ids=ids, grey_bodies=rigid,
+            title=f"t = {s.time:.4g} s: {pieces} pieces of {len(s.bodies)} deformable "
+                  f"bod{'y' if len(s.bodies) == 1 else 'ies'} ({broken} broken off), one colour each")
+
     def progress_text(self) -> str:
         s = self.system
         speed = float(np.linalg.norm(s.velocities, axis=1).max(initial=0.0))
+        cracks = ""
+        if s.fracturing_bodies:
+            cracks = (f"  broken joints {int(s.joint_broken.sum())}  pieces "
+                      f"{int(s.first_rigid_group)}")
         return (f"largest sigma1 {self.records.stress.max() / 1e6:.3g} MPa  fastest node "
-                f"{speed:.3g} m/s  dt {s.time_step:.2e} s")
+                f"{speed:.3g} m/s  dt {s.time_step:.2e} s{cracks}")
 
     def summary_fields(self, wall_time: float, steps: int) -> dict:
         s = self.system
@@ -416,7 +526,11 @@ class DeformableModel(Model):
                 "element_steps_per_second": steps * len(s.elements) / max(wall_time, 1e-9),
                 "kinetic_energy": s.kinetic_energy(),
                 "max_speed": float(np.linalg.norm(s.velocities, axis=1).max(initial=0.0)),
-                "max_tensile_stress": float(self.records.stress.max())}
+                "max_tensile_stress": float(self.records.stress.max()),
+                **({"broken_joints": int(s.joint_broken.sum()),
+                    "broken_area": float(sum(s.bodies[k].broken_area for k in s.fracturing_bodies)),
+                    "pieces": int(s.first_rigid_group), "fracture_energy": -float(s.joint_work[0])}
+                   if s.fracturing_bodies else {})}
 
     def failure_advice(self, good: dict) -> str:
         return ("An element inverted: the time step may be too long for the contact penalty, or "

@@ -26,7 +26,7 @@ import numpy as np
 
 from numba import prange
 
-from riprap._jit import kernel, parallel_kernel
+from riprap._jit import inline_kernel, kernel, parallel_kernel
 from riprap.solid.kernels.contact import plane_section
 
 MAX_VERTICES = 16
@@ -551,11 +551,27 @@ def slide_on_wall(nodes, count, node_force, normal_force, wall_normal, velocitie
         forces[node, 2] += share * fz
 
 
+@inline_kernel
+def _neighbours(triangle_origin, tri, tet_origin, tet):
+    """Whether the tet owning triangle ``tri`` and tet ``tet`` shared a node before their mesh was
+    split by joints (ids < 0: not split)."""
+    if triangle_origin[tri, 0] < 0 or tet_origin[tet, 0] < 0:
+        return False
+    for a in range(4):
+        for b in range(4):
+            if triangle_origin[tri, a] == tet_origin[tet, b]:
+                return True
+    return False
+
+
 @kernel
-def candidate_pairs(positions, triangles, triangle_body, tets, tet_body, skin, first_rigid_body):
+def candidate_pairs(positions, triangles, triangle_body, tets, tet_body, skin, first_rigid_body,
+                    triangle_origin, tet_origin):
     """(triangle, tet) pairs of different bodies, not both rigid (bodies from
     ``first_rigid_body`` on), whose boxes, grown by ``skin``, overlap: sorted by tet. Sweep along x
-    over the boxes of both sets."""
+    over the boxes of both sets. Pieces of one cracked body are bodies here; a triangle and a tet
+    that were neighbours in its mesh (``triangle_origin``, ``tet_origin``: the original node ids
+    of the triangle's tet and of the tet, -1 where not split) are left to their joints."""
     n_tri = triangles.shape[0]
     n_tet = tets.shape[0]
     # a rigid body's triangle or tet can only meet a deformable body near that body's box
@@ -624,6 +640,8 @@ def candidate_pairs(positions, triangles, triangle_body, tets, tet_body, skin, f
             if triangle_body[tri] == tet_body[tet]:
                 continue
             if triangle_body[tri] >= first_rigid_body and tet_body[tet] >= first_rigid_body:
+                continue
+            if _neighbours(triangle_origin, tri, tet_origin, tet):
                 continue
             if (boxes[idx, 1] > boxes[other, 4] or boxes[other, 1] > boxes[idx, 4]
                     or boxes[idx, 2] > boxes[other, 5] or boxes[other, 2] > boxes[idx, 5]):

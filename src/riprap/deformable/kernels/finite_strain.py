@@ -386,7 +386,6 @@ def _power(forces, velocities):
 DONE = 0
 INVERTED = 1
 REBUILD_CONTACTS = 2
-JOINTS_BROKE = 3
 #: Contact pairs are evaluated in parallel from this many on (below, threads cost more than
 #: they give: a pair takes about 0.2 microseconds).
 PARALLEL_PAIRS = 2000
@@ -408,20 +407,19 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     wall tets, the normal damping ratio per triangle and per tet).
     ``joint_data`` = the joints between tets of fracturing bodies (``riprap/deformable/kernels/joints.py``):
     (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
-    detached, a (n, 6, 3) buffer, the node-to-slot lists of the buffer, the joints' force on every
-    node, their work done on the nodes so far (1,, trapezoidal), whether to stop after a step that broke one).
+    a (n, 6, 3) buffer, the node-to-slot lists of the buffer, the joints' force on every
+    node, their work done on the nodes so far (1,), by the trapezoidal rule).
     Their forces join the contact forces.
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
     which ``element`` has J <= 0 (or a non-finite J); REBUILD_CONTACTS before a step once a node has
-    moved half the skin since the pairs were listed; JOINTS_BROKE after a step in which a joint
-    broke, if asked."""
+    moved half the skin since the pairs were listed."""
     (wall_triangles, wall_tets, triangles, contact_tets, wall_depths, pairs, penalty, walls,
      listed_positions, skin, totals, triangle_friction, tet_friction, tangential_ratio,
      tet_stiffness, pair_springs, wall_triangle_springs, wall_tet_springs, triangle_damping,
      tet_damping) = contact
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_detached, joint_buffer, joint_node_offsets, joint_node_slots, joint_node_forces,
-     joint_work, stop_on_break) = joint_data
+     joint_buffer, joint_node_offsets, joint_node_slots, joint_node_forces,
+     joint_work) = joint_data
     has_joints = joint_nodes.shape[0] > 0
     tet4 = elements.shape[1] == 4
     has_contact = triangles.shape[0] > 0
@@ -458,18 +456,17 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
                                                        wall_triangle_springs[w],
                                                        wall_tet_springs[w])
                 totals[w] = force
-        newly_broken = 0
         if has_joints:
             if parallel:
-                newly_broken = joint_kernels.joint_forces(
+                joint_kernels.joint_forces(
                     positions, joint_nodes, joint_sizes, joint_properties, joint_material,
-                    joint_damage, joint_broken, joint_detached, joint_buffer)
+                    joint_damage, joint_broken, joint_buffer)
                 joint_kernels.gather_joint_forces(joint_buffer, joint_node_offsets,
                                                   joint_node_slots, joint_node_forces)
             else:
-                newly_broken = joint_kernels.joint_forces_serial(
+                joint_kernels.joint_forces_serial(
                     positions, joint_nodes, joint_sizes, joint_properties, joint_material,
-                    joint_damage, joint_broken, joint_detached, joint_buffer)
+                    joint_damage, joint_broken, joint_buffer)
                 joint_kernels.gather_joint_forces_serial(joint_buffer, joint_node_offsets,
                                                          joint_node_slots, joint_node_forces)
             if has_contact:
@@ -505,6 +502,4 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
         if has_joints:
             # ... and opens this one
             joint_work[0] += 0.5 * time_step * _power(joint_node_forces, velocities)
-            if stop_on_break and newly_broken > 0:
-                return step + 1, JOINTS_BROKE, -1, 1.0
     return n_steps, DONE, -1, 1.0

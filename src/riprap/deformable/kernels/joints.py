@@ -63,8 +63,8 @@ def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penal
     tz = sz - opening * nz
     slip = math.sqrt(tx * tx + ty * ty + tz * tz)
     opening_peak = 2.0 * h * tensile / penalty
-    # the faces may not pass through each other (sigma = p o / h)
-    compression = 2.0 * opening / opening_peak * tensile if opening < 0.0 else 0.0
+    # the faces may not pass through each other (sigma = p o / h) while they face each other
+    compression = 2.0 * opening / opening_peak * tensile if opening < 0.0 and slip < h else 0.0
     if broken:
         sigma = compression
         tau = 0.0
@@ -110,15 +110,13 @@ def _put_vertex(buffer, j, k, fx, fy, fz):
 
 
 @inline_kernel
-def _joint(j, positions, joints, sizes, properties, joint_material, damage, broken, detached,
+def _joint(j, positions, joints, sizes, properties, joint_material, damage, broken,
            buffer):
     """Forces of joint ``j`` on its six nodes into ``buffer[j]`` (6, 3); updates its damage.
     Returns the number of its points at D >= 1."""
     for k in range(6):
         for d in range(3):
             buffer[j, k, d] = 0.0
-    if detached[j]:
-        return 0
     row = joint_material[j]
     tensile = properties[row, 0]
     cohesion = properties[row, 1]
@@ -182,12 +180,10 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
 
 
 @inline_kernel
-def _joint_step(j, positions, joints, sizes, properties, joint_material, damage, broken, detached,
-                buffer):
+def _joint_step(j, positions, joints, sizes, properties, joint_material, damage, broken, buffer):
     """``_joint``, then mark the joint broken once two of its points are at D >= 1; returns 1 if
     it broke now."""
-    failed = _joint(j, positions, joints, sizes, properties, joint_material, damage, broken,
-                    detached, buffer)
+    failed = _joint(j, positions, joints, sizes, properties, joint_material, damage, broken, buffer)
     if failed >= 2 and not broken[j]:
         broken[j] = True
         return 1
@@ -195,25 +191,24 @@ def _joint_step(j, positions, joints, sizes, properties, joint_material, damage,
 
 
 @parallel_kernel
-def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, detached,
-                 buffer):
+def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, buffer):
     """Forces of every joint (``_joint``) into ``buffer`` (n_joints, 6, 3); a joint with two or
     more points at D >= 1 is marked ``broken``. Returns the number broken now."""
     newly = 0
     for j in prange(joints.shape[0]):
         newly += _joint_step(j, positions, joints, sizes, properties, joint_material, damage,
-                             broken, detached, buffer)
+                             broken, buffer)
     return newly
 
 
 @kernel
 def joint_forces_serial(positions, joints, sizes, properties, joint_material, damage, broken,
-                        detached, buffer):
+                        buffer):
     """:func:`joint_forces` on one thread (small bodies: no thread start-up)."""
     newly = 0
     for j in range(joints.shape[0]):
         newly += _joint_step(j, positions, joints, sizes, properties, joint_material, damage,
-                             broken, detached, buffer)
+                             broken, buffer)
     return newly
 
 
