@@ -132,3 +132,45 @@ def test_bad_fracture_input_is_refused_by_name(tmp_path, changes, message):
 def test_a_mesh_too_coarse_to_crack_says_what_is_needed(tmp_path):
     with pytest.raises(RiprapError, match="too coarse to show a crack.*mesh_size of at most"):
         _run(_case(tmp_path, mesh_size=0.2), tmp_path / "out")
+
+
+def test_the_pieces_of_a_cracked_block_in_water_each_take_their_load(tmp_path):
+    """A block cut in two (the joints between the tets either side of x = 0.15 m broken) sinks in
+    still water: the fluid sees both pieces' closed surfaces, crack faces included (issue 16,
+    item 4), and loads each piece as much per volume as the other (measured within 0.1 %; the
+    pieces' own surfaces, not the block's shared out by mass), with no sideways force beyond a
+    few per cent of it (Archimedes on each closed surface)."""
+    import sys
+    from pathlib import Path
+
+    from riprap.case.build_fluid import build_fluid_run
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_deformable_in_water_run import CASE as WATER_CASE
+
+    text = WATER_CASE.format(end_time=0.02, more_bodies="").replace(
+        "mesh_size = 0.04", "mesh_size = 0.02").replace(
+        "tensile_strength = 1.0e4", "tensile_strength = 1.0e4\nfracture = true\ncohesion = 2.0e4\n"
+        "fracture_energy_mode_i = 1.0\nfracture_energy_mode_ii = 10.0")
+    path = tmp_path / "water.toml"
+    path.write_text(text)
+    sim = build_fluid_run(load_case(path), output_directory=tmp_path / "out", progress=False)
+    system = sim.model.system
+    body = system.bodies[0]
+    centres = body.positions[body.elements.elements].mean(axis=1)[:, 0]
+    sides = centres[body.joint_tets] < 0.15
+    cut = sides[:, 0] != sides[:, 1]
+    body.joint_broken[cut] = True
+    system.update_fragments()
+    assert sim.run().end_reason == "end_time"
+    outer = int((body.face_joint == -1).sum())
+    assert len(sim.model.solver.solids.triangles) == outer + 2 * int(cut.sum())
+    table = body.fragment_table()
+    assert len(table["mass"]) == 2
+    node_fragment = np.zeros(len(body.positions), dtype=np.int64)
+    node_fragment[body.elements.elements.ravel()] = np.repeat(table["element_fragment"], 4)
+    forces = np.array([body.external_forces[node_fragment == f].sum(axis=0) for f in range(2)])
+    per_volume = forces[:, 2] / table["volume"]
+    assert per_volume[0] == pytest.approx(per_volume[1], rel=0.02)
+    assert np.all(forces[:, 2] > 1000.0 * 9.81 * table["volume"])       # buoyancy and more
+    assert np.all(np.abs(forces[:, :2]).max(axis=1) < 0.05 * forces[:, 2])

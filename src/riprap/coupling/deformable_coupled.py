@@ -163,27 +163,44 @@ class DeformableBodies:
             self.fixed = np.zeros(n_deformable, dtype=bool)
             self.masses = self._deformable_masses.copy()
             self.densities = deformable_densities
-        triangles, starts = [], [0]
-        for k, body in enumerate(system.bodies):
-            faces, _ = boundary_faces_with_owners(body.elements.contact_tets())
-            triangles.append(faces + self.offsets[k])
-            starts.append(starts[-1] + len(faces))
-        #: Outward boundary triangles of every deformable body (the sub-tets' faces for 10-node
-        #: bodies): the surface the fluid grid sees; body k's from triangle_start[k].
-        self.triangles = np.concatenate(triangles).astype(np.int64)
-        self.triangle_start = np.asarray(starts, dtype=np.int64)
-        #: The deformable bodies' element faces on their surfaces (6 nodes for 10-node tets):
-        #: where the pressure loads them.
-        faces = [boundary_face_nodes(body.elements.elements) + self.offsets[k]
-                 for k, body in enumerate(system.bodies)]
-        self.load_faces = np.concatenate(faces).astype(np.int64)
-        self.load_face_body = np.repeat(np.arange(n_deformable), [len(f) for f in faces])
+        self._surface_version = None
+        self._build_surfaces()
         self.node_body = np.repeat(np.arange(n_deformable), np.diff(self.offsets))
         #: The fluid's force and torque on every body, held over the present step (N, N m).
         self.external_loads = np.zeros((self.n_bodies, 6))
         #: Force and torque of the deformable bodies' contacts on each rigid body, last step.
         self.rigid_contact_loads = np.zeros((n_rigid, 6))
         self.refresh()
+
+    def _build_surfaces(self) -> None:
+        """The surfaces the water sees: every deformable body's outward boundary triangles (the
+        sub-tets' faces for 10-node bodies), and its element faces on the surface (6 nodes for
+        10-node tets) where the pressure loads it. A cracked body's are its outer faces and the
+        faces of its parted joints (``DeformableSystem._fracturing_surface``): each fragment a
+        closed surface of its own, loaded on its crack faces too, not inside the intact
+        concrete. Rebuilt whenever the system's contact surfaces are."""
+        system = self.system
+        if self._surface_version == system.surface_rebuilds:
+            return
+        triangles, starts, faces = [], [0], []
+        for k, body in enumerate(system.bodies):
+            if k in system.fracturing_bodies:
+                surface = system._fracturing_surface(body)[0]
+                triangles.append(surface + self.offsets[k])
+                faces.append(surface + self.offsets[k])
+            else:
+                outer, _ = boundary_faces_with_owners(body.elements.contact_tets())
+                triangles.append(outer + self.offsets[k])
+                faces.append(boundary_face_nodes(body.elements.elements) + self.offsets[k])
+            starts.append(starts[-1] + len(triangles[-1]))
+        #: Outward boundary triangles of every deformable body: the surface the fluid grid sees;
+        #: body k's from triangle_start[k].
+        self.triangles = np.concatenate(triangles).astype(np.int64)
+        self.triangle_start = np.asarray(starts, dtype=np.int64)
+        #: The element faces on the bodies' surfaces, where the pressure loads them.
+        self.load_faces = np.concatenate(faces).astype(np.int64)
+        self.load_face_body = np.repeat(np.arange(len(system.bodies)), [len(f) for f in faces])
+        self._surface_version = system.surface_rebuilds
 
     def finalize(self) -> None:
         """Nothing to do: the system was built whole (the coupling's SolidSolver interface)."""
@@ -316,6 +333,7 @@ class DeformableBodies:
         s, n = self.system, self.system.n_deformable_nodes
         x, v = s.positions[:n], s.velocities[:n]
         centres, mean_velocities = self._deformable_positions, self._deformable_velocities
+        self._build_surfaces()
         # The mean pressure on each body's surface is left to its ambient_pressure: at depth it
         # is most of the pressure, and held fixed while the body turns it would be most of the
         # drift below.
@@ -351,6 +369,7 @@ class DeformableBodies:
                 "wall_triangle_springs": s.wall_triangle_springs.copy(),
                 "wall_tet_springs": s.wall_tet_springs.copy(),
                 "rigid_contact_loads": self.rigid_contact_loads.copy(),
+                **s.joint_state(),
                 **({f"rigid_{key}": value for key, value in self.rigid.state_arrays().items()}
                    if self.rigid is not None else {}),
                 **({"rigid_external_loads": self.rigid.external_loads.copy()}
@@ -362,11 +381,12 @@ class DeformableBodies:
         s.step_count = int(arrays["clock"][1])
         for name in ("positions", "velocities", "contact_forces", "external_forces"):
             getattr(s, name)[:] = arrays[name]
+        s.load_joint_state(arrays)
         s._pairs = np.array(arrays["contact_pairs"], dtype=np.int64).reshape(-1, 2)
         s._listed_positions[:] = arrays["listed_positions"]
         s.pair_springs = np.array(arrays["pair_springs"], dtype=np.float64).reshape(-1, 3)
-        s.wall_triangle_springs[:] = arrays["wall_triangle_springs"]
-        s.wall_tet_springs[:] = arrays["wall_tet_springs"]
+        s.wall_triangle_springs = np.array(arrays["wall_triangle_springs"], dtype=np.float64)
+        s.wall_tet_springs = np.array(arrays["wall_tet_springs"], dtype=np.float64)
         for body, ambient in zip(s.bodies, arrays["ambient_pressures"]):
             body.time = s.time
             body.step_count = s.step_count
@@ -459,6 +479,7 @@ class DeformableCoupledSolver(CoupledSolver):
                                                  poses=poses[rigid])
             blocks.update(zip(rigid.tolist(), fresh))
         if len(deformable):
+            bodies._build_surfaces()
             parts, starts = [], [0]
             for k in deformable:
                 part = bodies.triangles[bodies.triangle_start[k]:bodies.triangle_start[k + 1]]

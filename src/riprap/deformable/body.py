@@ -209,12 +209,16 @@ class DeformableBody:
         """The joint arguments of ``finite_strain.advance_steps`` (none: a body without joints)."""
         return NO_JOINTS
 
-    def _raise_inverted(self, worst: int, value: float) -> None:
+    def _raise_inverted(self, worst: int, value: float, time_step: float | None = None,
+                        stable: float | None = None) -> None:
+        """``time_step`` and ``stable``: the run's (a system's), where it is not the body's own."""
+        time_step = self.time_step if time_step is None else time_step
+        stable = self.stable_time_step() if stable is None else stable
         centre = self.positions[self.elements.corner_tets[worst]].mean(axis=0)
         raise InstabilityError(
             f"deformable body '{self.name}': element {worst} inverted (J = {value:.3g}) at "
             f"t = {self.time:.6g} s, near ({centre[0]:.4g}, {centre[1]:.4g}, {centre[2]:.4g}) m; "
-            f"time step {self.time_step:.3g} s (stable {self.stable_time_step():.3g} s): "
+            f"time step {time_step:.3g} s (stable {stable:.3g} s): "
             "the loads are too large for the mesh or the step too long")
 
     # ------------------------------------------------------------------ outputs

@@ -322,6 +322,27 @@ class DeformableSystem:
         self.wall_tet_springs = np.zeros((len(self.walls), self.n_wall_tets, 3))
         self._pairs = np.zeros((0, 2), dtype=np.int64)
         self.pair_springs = np.zeros((0, 3))
+        self.surface_rebuilds += 1
+
+    def joint_state(self) -> dict:
+        """The joints' state for a checkpoint (empty without fracturing bodies)."""
+        if not self.fracturing_bodies:
+            return {}
+        return {"joint_damage": self.joint_damage.copy(), "joint_broken": self.joint_broken.copy(),
+                "joint_parted": self.joint_parted.copy(), "joint_work": self.joint_work.copy(),
+                "joints_broken_at_check": np.array([self._broken_at_check])}
+
+    def load_joint_state(self, arrays: dict) -> None:
+        """Put back ``joint_state``'s arrays and the contact surfaces they make (before the
+        contact pairs and springs of the same checkpoint are put back)."""
+        if not self.fracturing_bodies:
+            return
+        self.joint_damage[:] = arrays["joint_damage"]
+        self.joint_broken[:] = arrays["joint_broken"]
+        self.joint_parted[:] = arrays["joint_parted"]
+        self.joint_work[:] = arrays["joint_work"]
+        self._broken_at_check = int(arrays["joints_broken_at_check"][0])
+        self.rebuild_contact_surfaces()
 
     def update_fragments(self) -> None:
         """After joints broke: mark the broken joints that now part two fragments, and if any
@@ -363,7 +384,6 @@ class DeformableSystem:
         self._pairs = pairs[kept]
         self.pair_springs = old_pair_springs[kept]
         self._list_pairs()
-        self.surface_rebuilds += 1
 
     # ------------------------------------------------------------------ rigid bodies
     @property
@@ -504,7 +524,8 @@ class DeformableSystem:
                 k = int(np.searchsorted(self.element_offsets, worst, side="right") - 1)
                 body = self.bodies[k]
                 body.jacobians[:] = self.jacobians[self.element_offsets[k]:self.element_offsets[k + 1]]
-                body._raise_inverted(int(worst - self.element_offsets[k]), float(value))
+                body._raise_inverted(int(worst - self.element_offsets[k]), float(value), dt,
+                                     self.stable_time_step())
 
     # ------------------------------------------------------------------ outputs
     @property

@@ -228,9 +228,7 @@ class DeformableModel(Model):
                 "record_stress": self.records.stress.copy(),
                 "record_element": self.records.element.copy(),
                 "record_point": self.records.point.copy(), "record_time": self.records.time.copy(),
-                **({"joint_damage": s.joint_damage.copy(), "joint_broken": s.joint_broken.copy(),
-                    "joint_parted": s.joint_parted.copy(), "joint_work": s.joint_work.copy()}
-                   if s.fracturing_bodies else {}),
+                **s.joint_state(),
                 **({f"rigid_{key}": value for key, value in self.rigid.solver.state_arrays().items()}
                    if self.rigid is not None else {})}
 
@@ -240,13 +238,8 @@ class DeformableModel(Model):
         s.step_count = int(arrays["clock"][1])
         s.positions[:] = arrays["positions"]
         s.velocities[:] = arrays["velocities"]
-        if s.fracturing_bodies:
-            # the cracks first: they decide the contact surfaces the springs below belong to
-            s.joint_damage[:] = arrays["joint_damage"]
-            s.joint_broken[:] = arrays["joint_broken"]
-            s.joint_parted[:] = arrays["joint_parted"]
-            s.joint_work[:] = arrays["joint_work"]
-            s.rebuild_contact_surfaces()
+        # the cracks first: they decide the contact surfaces the springs below belong to
+        s.load_joint_state(arrays)
         s._pairs = np.array(arrays["contact_pairs"], dtype=np.int64).reshape(-1, 2)
         s._listed_positions[:] = arrays["listed_positions"]
         s.pair_springs = np.array(arrays["pair_springs"], dtype=np.float64).reshape(-1, 3)
