@@ -487,7 +487,8 @@ class DeformableSystem:
     def step(self, n_steps: int = 1) -> None:
         """Advance ``n_steps`` steps; raises InstabilityError naming an element that inverts."""
         dt = self.time_step
-        parallel = self.weights.size >= PARALLEL_POINTS
+        # the joints are work of the same kind (one joint costs about one tet)
+        parallel = self.weights.size + len(self.joints) >= PARALLEL_POINTS
         remaining = int(n_steps)
         while remaining > 0:
             chunk = remaining
