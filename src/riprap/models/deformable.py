@@ -404,7 +404,7 @@ class DeformableModel(Model):
         return rows
 
     def close_outputs(self) -> dict:
-        from riprap.io.deformable_outputs import write_units_csv
+        from riprap.io.deformable_outputs import write_fragments_csv, write_units_csv
 
         outputs = {"units": str(write_units_csv(self._directory / "units.csv", self.unit_rows()))}
         if self._series is not None:
@@ -412,7 +412,8 @@ class DeformableModel(Model):
         if self._crack_series is not None:
             outputs["cracks"] = str(self._crack_series.pvd_path)
         if self.system.fracturing_bodies:
-            outputs["fragments"] = str(self.write_fragment_table(self._directory / "fragments.csv"))
+            outputs["fragments"] = str(write_fragments_csv(self._directory / "fragments.csv",
+                                                           self.fragment_rows()))
             if self._picture:
                 outputs["fragments_picture"] = str(self.write_fragment_picture(
                     self._directory / "fragments.png"))
@@ -465,24 +466,22 @@ class DeformableModel(Model):
             value_label="largest principal stress sigma_1 (MPa, tension +)", colour_map=colour_map,
             value_range=value_range, title=title)
 
-    def write_fragment_table(self, path):
-        """``fragments.csv``: every piece of every cracking body, a body of its own: the unit it
-        came from, its tets, volume, mass, mass fraction of the unit, centre of mass, velocity."""
-        import csv
-
-        with open(path, "w", newline="") as stream:
-            writer = csv.writer(stream)
-            writer.writerow(["body", "name", "fragment", "elements", "volume_m3", "mass_kg",
-                             "mass_fraction", "x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s"])
-            for k in self.system.fracturing_bodies:
-                table = self.system.bodies[k].fragment_table()
-                for f in range(len(table["mass"])):
-                    writer.writerow([k, self.body_names[k], f, int(table["elements"][f])]
-                                    + [f"{v:.6g}" for v in (table["volume"][f], table["mass"][f],
-                                                            table["mass_fraction"][f],
-                                                            *table["centre"][f],
-                                                            *table["velocity"][f])])
-        return path
+    def fragment_rows(self) -> list[dict]:
+        """Every piece of every cracking body, a body of its own: the unit it came from, its tets,
+        volume, mass, mass fraction of the unit, centre of mass, velocity (``fragments.csv``)."""
+        rows = []
+        for k in self.system.fracturing_bodies:
+            table = self.system.bodies[k].fragment_table()
+            for f in range(len(table["mass"])):
+                (x, y, z), (vx, vy, vz) = table["centre"][f], table["velocity"][f]
+                rows.append({"body": k, "name": self.body_names[k], "fragment": f,
+                             "elements": int(table["elements"][f]),
+                             "volume_m3": float(table["volume"][f]),
+                             "mass_kg": float(table["mass"][f]),
+                             "mass_fraction": float(table["mass_fraction"][f]),
+                             "x_m": float(x), "y_m": float(y), "z_m": float(z),
+                             "vx_m_s": float(vx), "vy_m_s": float(vy), "vz_m_s": float(vz)})
+        return rows
 
     def write_fragment_picture(self, path):
         """The bodies' surfaces now, the crack faces included, one colour per fragment (the
