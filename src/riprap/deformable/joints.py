@@ -1,9 +1,11 @@
-"""Fracture of deformable bodies: joint (cohesive) elements between the tets of an exploded mesh.
+"""Fracture of deformable bodies: joint (cohesive) elements between the tets of a split mesh.
 
-The mesh is exploded (every tet gets its own copy of its four nodes) and a joint holds each pair of
-faces that were shared (``explode_mesh``); the joints' law is Munjiza's combined single and smeared
-crack model (``riprap/deformable/kernels/joints.py``). A :class:`FracturingBody` is a
-:class:`DeformableBody` on the exploded mesh whose steps add the joints' forces.
+The mesh is split where it may crack (``explode_mesh``: each side of a joint its own copy of the
+face's nodes) and a joint holds each pair of faces that were shared; the joints' law is Munjiza's
+combined single and smeared crack model (``riprap/deformable/kernels/joints.py``). A
+:class:`FracturingBody` is a :class:`DeformableBody` on the split mesh whose steps add the joints'
+forces (inside the compiled step); in a :class:`riprap.deformable.system.DeformableSystem` its
+fragments are bodies of their own for the contact.
 
 Why the softening length is G / (f * 0.3863) and not Y3D's 3 G / f: the area under Hordijk's curve
 z(D) over D in [0, 1] is 0.3863 (``SOFTENING_AREA``), so a crack that opens from the strength to
@@ -11,10 +13,10 @@ z = 0 over a length o_t dissipates f_t o_t 0.3863 per unit area; Y3D's o_t = 3 G
 1.16 G_f. With o_t = G_f / (0.3863 f_t) it is G_f exactly (checked in
 ``tests/verification/test_fracture_mode_one.py``).
 
-Limits of this first part (issue 16): joints everywhere in a body (not yet in chosen regions);
-4-node tets only; a broken joint keeps its faces from passing through each other by the
-compressive penalty only (no friction, and faces that separate and meet elsewhere do not see each
-other: the body's self-contact is the next part); fragments are not yet separate bodies.
+Limits: 4-node tets only; a broken joint keeps its faces from passing through each other by the
+compressive penalty only (no friction between its faces until the pieces part and meet through
+the contact); energy is created where single tets are crushed against a rigid rock
+(docs/fracture.md, Limits).
 """
 from __future__ import annotations
 
