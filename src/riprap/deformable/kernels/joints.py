@@ -22,7 +22,8 @@ joint penalty), o_t, s_t the softening lengths:
 
 with a = 0.63, b = 1.8, c = 6 (Hordijk's curve). A joint whose points reach D = 1 at two of the
 three breaks: it then carries only the compressive penalty (its faces cannot pass through each
-other) and no tension or shear.
+other while they still face each other, slip below h) and no tension or shear. The compressive
+penalty of any joint acts only while the slip is below h.
 """
 import math
 
