@@ -257,7 +257,7 @@ class Simulation:
                 centres = nodes[mesh.tets].mean(axis=1)
                 lower, upper = (np.asarray(corner, dtype=np.float64) for corner in region)
                 cracking = np.all((centres >= lower) & (centres <= upper), axis=1)
-            check_crack_resolution(nodes, mesh.tets, name, cracking)
+            check_crack_resolution(nodes, mesh.tets, name)
             body = FracturingBody(nodes, mesh.tets, material, joint_material, name=name,
                                   cracking=cracking)
         offsets = body.positions - np.asarray(position, dtype=np.float64)

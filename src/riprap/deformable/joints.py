@@ -166,10 +166,10 @@ def explode_mesh(nodes, tets, cracking=None) -> ExplodedMesh:
 MIN_TETS_ACROSS = 3.0
 
 
-def check_crack_resolution(nodes, tets, name: str, cracking=None) -> None:
+def check_crack_resolution(nodes, tets, name: str) -> None:
     """Refuse a mesh too coarse to show a crack: fewer than ``MIN_TETS_ACROSS`` mean tet edges
-    across the body's thinnest extent (along its principal axes), or a region of cracking tets
-    with no two neighbours (no joint at all). Raises CaseFileError saying what is needed."""
+    across the body's thinnest extent (along its principal axes). Raises CaseFileError saying
+    what is needed."""
     nodes = np.asarray(nodes, dtype=np.float64)
     tets = np.asarray(tets, dtype=np.int64)
     corners = nodes[tets]
@@ -185,13 +185,6 @@ def check_crack_resolution(nodes, tets, name: str, cracking=None) -> None:
             f"{thinnest / mean_edge:.1f} tet edges (mean {mean_edge:.3g} m) across its thinnest "
             f"extent of {thinnest:.3g} m, where a crack needs at least {MIN_TETS_ACROSS:g}; mesh it "
             f"finer (a shape's mesh_size of at most {thinnest / MIN_TETS_ACROSS:.3g} m)")
-    if cracking is not None:
-        split = explode_mesh(nodes, tets, cracking)
-        if len(split.joints) == 0:
-            raise CaseFileError(
-                f"deformable body '{name}': its fracture region holds {int(np.sum(cracking))} of "
-                "its tets and no two of them share a face, so it could never crack; move or "
-                "widen fracture_region_lower/upper to take in the part that should crack")
 
 
 def node_slots(joints, n_nodes):
@@ -217,6 +210,11 @@ class FracturingBody(DeformableBody):
         if not isinstance(joint_material, JointMaterial):
             raise CaseFileError(f"deformable body '{name}': joint_material must be a JointMaterial")
         split = explode_mesh(nodes, tets, cracking)
+        if cracking is not None and len(split.joints) == 0:
+            raise CaseFileError(
+                f"deformable body '{name}': its fracture region holds {int(np.sum(cracking))} of "
+                "its tets and no two of them share a face, so it could never crack; move or "
+                "widen fracture_region_lower/upper to take in the part that should crack")
         exploded, joints = split.nodes, split.joints
         super().__init__(exploded, split.tets, material, element_type="tet4", name=name,
                          gravity=gravity, mass_damping=mass_damping)
