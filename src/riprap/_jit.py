@@ -13,10 +13,15 @@ Set ``NUMBA_DISABLE_JIT=1`` to run every kernel as plain Python (slow) for trace
 import os
 
 # OpenMP worker threads that spin while waiting steal the only other core of a small machine from
-# whatever else runs (or from the main thread): measured 70x slowdowns on a loaded 2-core box.
-# Passive waiting costs a few microseconds per parallel region instead. Must be set before numba
-# starts its thread pool; a user's own setting wins.
+# whatever else runs (or from the main thread): measured 70x slowdowns on a loaded 2-core box with
+# GNU OpenMP's default spin (300,000 polls). Sleeping at once costs a wake-up per parallel region
+# instead: about 70 microseconds here, a third of a fracturing unit's step, which runs three
+# regions back to back. A short spin (10,000 polls, tens of microseconds) catches the next region
+# of the same step and gives the core back soon after the step ends (bench/fracture.py: joint
+# kernel 0.27 -> 0.20 ms). Must be set before numba starts its thread pool; a user's own setting
+# wins.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 
 import numba  # noqa: E402
 

@@ -29,11 +29,15 @@ NO_CONTACT = (np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int64)
               np.zeros(1), np.zeros(0), np.zeros(0), 0.0, np.zeros(0), np.zeros((0, 3)),
               np.zeros((0, 0, 3)), np.zeros((0, 0, 3)), np.zeros(0), np.zeros(0))
 NO_TET4_GRADIENTS = np.zeros((0, 4, 3))
-# The joint arguments of a run without joints (see finite_strain.advance_steps).
-NO_JOINTS = (np.zeros((0, 6), dtype=np.int64), np.zeros(0), np.zeros((1, 6)),
-             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0, dtype=np.bool_),
-             np.zeros((0, 6, 3)), np.zeros(1, dtype=np.int64),
-             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(1))
+
+
+def no_joints(n_nodes: int) -> tuple:
+    """The joint arguments of a run without joints (see finite_strain.advance_steps): every
+    node's list of joint slots empty (the node update runs over them without a branch)."""
+    return (np.zeros((0, 6), dtype=np.int64), np.zeros(0), np.zeros((1, 6)),
+            np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0, dtype=np.bool_),
+            np.zeros((0, 6, 3)), np.zeros(n_nodes + 1, dtype=np.int64),
+            np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(1))
 
 # Bodies with fewer integration points than this step on one thread: starting the threads of a
 # parallel loop (twice a step) cost more than the work for the 480-tet cantilever of the tests
@@ -98,6 +102,7 @@ class DeformableBody:
         self.materials = material_table([material])
         self.element_material = np.zeros(n_el, dtype=np.int64)
         self.contact_forces = np.zeros((n_nodes, 3))
+        self._no_joints = None
         #: A uniform pressure all round the body that its nodes do not carry (Pa): it neither
         #: moves nor turns a closed body and strains it only isotropically (sigma = -p I, to
         #: first order in p / E), so it is added to the stresses instead. A body in a flow takes
@@ -207,7 +212,9 @@ class DeformableBody:
 
     def _joint_arguments(self):
         """The joint arguments of ``finite_strain.advance_steps`` (none: a body without joints)."""
-        return NO_JOINTS
+        if self._no_joints is None:
+            self._no_joints = no_joints(len(self.positions))
+        return self._no_joints
 
     def _raise_inverted(self, worst: int, value: float, time_step: float | None = None,
                         stable: float | None = None) -> None:

@@ -280,12 +280,12 @@ class FracturingBody(DeformableBody):
     def joint_forces(self) -> np.ndarray:
         """The joints' forces on the nodes (n, 3) at the present positions (updates damage)."""
         forces = np.zeros_like(self.positions)
-        joint_kernels.joint_forces_serial(self.positions, self.joints, self.joint_sizes,
-                                          self._joint_properties, self._joint_material_index,
-                                          self.joint_damage, self.joint_broken,
-                                          self._joint_buffer)
-        joint_kernels.gather_joint_forces_serial(self._joint_buffer, self._joint_node_offsets,
-                                                 self._joint_node_slots, forces)
+        joint_kernels.joint_forces(self.positions, self.joints, self.joint_sizes,
+                                   self._joint_properties, self._joint_material_index,
+                                   self.joint_damage, self.joint_broken,
+                                   self._joint_buffer)
+        joint_kernels.gather_joint_forces(self._joint_buffer, self._joint_node_offsets,
+                                           self._joint_node_slots, forces)
         return forces
 
     def _joint_arguments(self):

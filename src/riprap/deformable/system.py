@@ -16,9 +16,9 @@ import math
 
 import numpy as np
 
-from riprap.deformable.body import (NO_JOINTS, NO_TET4_GRADIENTS, PARALLEL_POINTS,
+from riprap.deformable.body import (NO_TET4_GRADIENTS, PARALLEL_POINTS,
                                     TIME_STEP_SAFETY, DeformableBody, material_table,
-                                    stable_step_for)
+                                    no_joints, stable_step_for)
 from riprap.deformable.elements import _OUTWARD_FACES
 from riprap.deformable.joints import FracturingBody, node_slots
 from riprap.deformable.kernels import contact as contact_kernels
@@ -213,7 +213,7 @@ class DeformableSystem:
         n_nodes = len(self.positions)
         if not fracturing:
             self.joints = np.zeros((0, 6), dtype=np.int64)
-            self.joint_data = NO_JOINTS
+            self.joint_data = no_joints(n_nodes)
             self.joint_work = np.zeros(1)
             return
         self.joints = np.concatenate([self.bodies[k].joints + self.node_offsets[k]

@@ -21,6 +21,7 @@ import numpy as np
 from riprap._jit import inline_kernel, kernel, parallel_kernel, prange
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import joints as joint_kernels
+from riprap.deformable.kernels.slots import slot_sum
 
 
 @inline_kernel
@@ -203,6 +204,31 @@ def tet4_element_forces(positions, velocities, tets, gradients, volumes,
                      element_material, element_forces, jacobians)
 
 
+#: Blocks of :func:`tet4_and_joint_forces`: each holds the same share of tets and of joints, so
+#: that the threads get equal work (a joint costs about twice a tet).
+FORCE_BLOCKS = 64
+
+
+@parallel_kernel
+def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, materials,
+                          element_material, element_forces, jacobians, joint_data):
+    """:func:`tet4_element` for every element and the joints' forces (``joint_data`` as in
+    :func:`advance_steps`) in one parallel loop: both only read the positions, so one region
+    instead of two (each region costs the threads a wake-up)."""
+    (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
+     joint_buffer) = (joint_data[0], joint_data[1], joint_data[2], joint_data[3], joint_data[4],
+                      joint_data[5], joint_data[6])
+    n_tets = tets.shape[0]
+    n_joints = joint_nodes.shape[0]
+    for block in prange(FORCE_BLOCKS):
+        for e in range(block * n_tets // FORCE_BLOCKS, (block + 1) * n_tets // FORCE_BLOCKS):
+            tet4_element(e, positions, velocities, tets, gradients, volumes, materials,
+                         element_material, element_forces, jacobians)
+        for j in range(block * n_joints // FORCE_BLOCKS, (block + 1) * n_joints // FORCE_BLOCKS):
+            joint_kernels.joint_step(j, positions, joint_nodes, joint_sizes, joint_properties,
+                                     joint_material, joint_damage, joint_broken, joint_buffer)
+
+
 @kernel
 def element_forces_serial(positions, velocities, elements, tet4_gradients, gradients, weights,
                           materials, element_material, element_forces, jacobians):
@@ -229,52 +255,87 @@ def general_element_forces(positions, velocities, elements, gradients, weights,
 @inline_kernel
 def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained, prescribed_velocities,
-                time_step, nodal_forces):
-    """Central-difference update of node ``n`` (see :func:`central_difference_update`)."""
+                time_step, nodal_forces, joint_flat, joint_offsets, joint_slots):
+    """Central-difference update of node ``n`` (see :func:`central_difference_update`); returns
+    the work of the joints' force on it over the step."""
     m = masses[n]
-    for i in range(3):
-        total = (external_forces[n, i] + contact_forces[n, i] + m * gravity[i]
-                 - mass_damping * m * velocities[n, i])
-        for s in range(node_offsets[n], node_offsets[n + 1]):
-            total += flat_forces[node_slots[s], i]
-        nodal_forces[n, i] = total
-        if constrained[n, i]:
-            velocity = prescribed_velocities[n, i]
-        else:
-            velocity = velocities[n, i] + time_step * total / m
-        velocities[n, i] = velocity
-        positions[n, i] += time_step * velocity
+    # written out per axis: a helper per axis (inlined) made the one-thread loop 2 to 3 times
+    # slower (numba 0.68, this machine), the threaded one not
+    ex, ey, ez = slot_sum(n, flat_forces, node_offsets, node_slots)
+    jx, jy, jz = slot_sum(n, joint_flat, joint_offsets, joint_slots)
+    # the trapezoidal rule for the joints' work, exact for a linear spring (the rectangle rule
+    # gains k dx^2 / 2 a step: a steady drift while the joints vibrate): this step's force over
+    # the intervals on both sides of it, each at its velocity
+    before = velocities[n, 0]
+    total = (external_forces[n, 0] + contact_forces[n, 0] + m * gravity[0]
+             - mass_damping * m * before + ex + jx)
+    nodal_forces[n, 0] = total
+    velocity = prescribed_velocities[n, 0] if constrained[n, 0] else before + time_step * total / m
+    velocities[n, 0] = velocity
+    positions[n, 0] += time_step * velocity
+    wx = (before + velocity) * jx
+    before = velocities[n, 1]
+    total = (external_forces[n, 1] + contact_forces[n, 1] + m * gravity[1]
+             - mass_damping * m * before + ey + jy)
+    nodal_forces[n, 1] = total
+    velocity = prescribed_velocities[n, 1] if constrained[n, 1] else before + time_step * total / m
+    velocities[n, 1] = velocity
+    positions[n, 1] += time_step * velocity
+    wy = (before + velocity) * jy
+    before = velocities[n, 2]
+    total = (external_forces[n, 2] + contact_forces[n, 2] + m * gravity[2]
+             - mass_damping * m * before + ez + jz)
+    nodal_forces[n, 2] = total
+    velocity = prescribed_velocities[n, 2] if constrained[n, 2] else before + time_step * total / m
+    velocities[n, 2] = velocity
+    positions[n, 2] += time_step * velocity
+    wz = (before + velocity) * jz
+    work = 0.5 * time_step * (wx + wy + wz)
+    return work
 
 
 @parallel_kernel
 def central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
                               masses, external_forces, contact_forces, gravity, mass_damping,
-                              constrained, prescribed_velocities, time_step, nodal_forces):
-    """Sum the element forces at every node, add loads, gravity and mass-proportional damping, and
-    advance the half-step velocity and the position (central difference / leapfrog).
+                              constrained, prescribed_velocities, time_step, nodal_forces,
+                              joint_data):
+    """Sum the element forces at every node, add loads, gravity, mass-proportional damping and the
+    joints' forces, and advance the half-step velocity and the position (central difference /
+    leapfrog). Returns the joints' work over the step.
 
     ``node_slots[node_offsets[n]:node_offsets[n + 1]]`` lists the flat (element, local node)
-    entries of ``element_forces`` that act on node n. Components flagged in ``constrained`` take
+    entries of ``element_forces`` that act on node n; ``joint_data`` (see :func:`advance_steps`)
+    likewise the slots of the joints' buffer. Components flagged in ``constrained`` take
     ``prescribed_velocities`` instead. ``nodal_forces`` receives the total force at every node (for
     reactions and outputs)."""
     flat = element_forces.reshape((-1, 3))
+    joint_flat = joint_data[6].reshape((-1, 3))
+    joint_offsets, joint_slots = joint_data[7], joint_data[8]
+    work = 0.0
     for n in prange(positions.shape[0]):
-        update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
-                    external_forces, contact_forces, gravity, mass_damping, constrained,
-                    prescribed_velocities, time_step, nodal_forces)
+        work += update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
+                            external_forces, contact_forces, gravity, mass_damping, constrained,
+                            prescribed_velocities, time_step, nodal_forces, joint_flat,
+                            joint_offsets, joint_slots)
+    return work
 
 
 @kernel
 def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
                                      node_slots, masses, external_forces, contact_forces, gravity,
                                      mass_damping, constrained, prescribed_velocities, time_step,
-                                     nodal_forces):
+                                     nodal_forces, joint_data):
     """:func:`central_difference_update` on one thread (small bodies: no thread start-up)."""
     flat = element_forces.reshape((-1, 3))
+    joint_flat = joint_data[6].reshape((-1, 3))
+    joint_offsets, joint_slots = joint_data[7], joint_data[8]
+    work = 0.0
     for n in range(positions.shape[0]):
-        update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
-                    external_forces, contact_forces, gravity, mass_damping, constrained,
-                    prescribed_velocities, time_step, nodal_forces)
+        work += update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
+                            external_forces, contact_forces, gravity, mass_damping, constrained,
+                            prescribed_velocities, time_step, nodal_forces, joint_flat,
+                            joint_offsets, joint_slots)
+    return work
 
 
 @parallel_kernel
@@ -372,16 +433,6 @@ def smallest_jacobian(jacobians):
     return worst, value
 
 
-@kernel
-def _power(forces, velocities):
-    """sum of forces . velocities over the nodes (W)."""
-    power = 0.0
-    for n in range(forces.shape[0]):
-        power += (forces[n, 0] * velocities[n, 0] + forces[n, 1] * velocities[n, 1]
-                  + forces[n, 2] * velocities[n, 2])
-    return power
-
-
 #: Status codes of :func:`advance_steps`.
 DONE = 0
 INVERTED = 1
@@ -409,7 +460,8 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
     a (n, 6, 3) buffer, the node-to-slot lists of the buffer, the joints' force on every
     node, their work done on the nodes so far (1,), by the trapezoidal rule).
-    Their forces join the contact forces.
+    Their forces are added in the node update (not to ``contact_forces``), which also sums
+    their work.
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
     which ``element`` has J <= 0 (or a non-finite J); REBUILD_CONTACTS before a step once a node has
     moved half the skin since the pairs were listed."""
@@ -456,28 +508,17 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
                                                        wall_triangle_springs[w],
                                                        wall_tet_springs[w])
                 totals[w] = force
-        if has_joints:
-            if parallel:
+        if has_joints and parallel:
+            # (joints exist only between 4-node tets); their forces join the node update, which
+            # also sums their work
+            tet4_and_joint_forces(positions, velocities, elements, tet4_gradients, weights[:, 0],
+                                  materials, element_material, element_forces, jacobians,
+                                  joint_data)
+        elif not parallel:
+            if has_joints:
                 joint_kernels.joint_forces(
                     positions, joint_nodes, joint_sizes, joint_properties, joint_material,
                     joint_damage, joint_broken, joint_buffer)
-                joint_kernels.gather_joint_forces(joint_buffer, joint_node_offsets,
-                                                  joint_node_slots, joint_node_forces)
-            else:
-                joint_kernels.joint_forces_serial(
-                    positions, joint_nodes, joint_sizes, joint_properties, joint_material,
-                    joint_damage, joint_broken, joint_buffer)
-                joint_kernels.gather_joint_forces_serial(joint_buffer, joint_node_offsets,
-                                                         joint_node_slots, joint_node_forces)
-            if has_contact:
-                contact_forces += joint_node_forces
-            else:
-                contact_forces[:] = joint_node_forces
-            # the joints' work by the trapezoidal rule, exact for a linear spring (the rectangle
-            # rule gains k dx^2 / 2 a step: a steady drift while the joints vibrate): this force
-            # closes the last interval, with the velocity over it
-            joint_work[0] += 0.5 * time_step * _power(joint_node_forces, velocities)
-        if not parallel:
             element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
                                   weights, materials, element_material, element_forces, jacobians)
         elif tet4:
@@ -490,16 +531,14 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
         if not value > 0.0:
             return step, INVERTED, worst, value
         if parallel:
-            central_difference_update(positions, velocities, element_forces, node_offsets,
-                                      node_slots, masses, external_forces, contact_forces,
-                                      gravity, mass_damping, constrained, prescribed_velocities,
-                                      time_step, nodal_forces)
+            work = central_difference_update(
+                positions, velocities, element_forces, node_offsets, node_slots, masses,
+                external_forces, contact_forces, gravity, mass_damping, constrained,
+                prescribed_velocities, time_step, nodal_forces, joint_data)
         else:
-            central_difference_update_serial(positions, velocities, element_forces, node_offsets,
-                                             node_slots, masses, external_forces, contact_forces,
-                                             gravity, mass_damping, constrained,
-                                             prescribed_velocities, time_step, nodal_forces)
-        if has_joints:
-            # ... and opens this one
-            joint_work[0] += 0.5 * time_step * _power(joint_node_forces, velocities)
+            work = central_difference_update_serial(
+                positions, velocities, element_forces, node_offsets, node_slots, masses,
+                external_forces, contact_forces, gravity, mass_damping, constrained,
+                prescribed_velocities, time_step, nodal_forces, joint_data)
+        joint_work[0] += work
     return n_steps, DONE, -1, 1.0

@@ -27,7 +27,8 @@ penalty of any joint acts only while the slip is below h.
 """
 import math
 
-from riprap._jit import inline_kernel, kernel, parallel_kernel, prange
+from riprap._jit import inline_kernel, kernel
+from riprap.deformable.kernels.slots import slot_sum
 
 SOFTENING_A = 0.63
 SOFTENING_B = 1.8
@@ -54,49 +55,48 @@ def _rising(ratio):
 
 
 @inline_kernel
-def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penalty, softening_i,
-                    softening_ii, damage_before, broken):
+def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penalty_over_h,
+                    two_h_over_p, opening_peak, inverse_opening_peak, tensile_over_energy_i,
+                    inverse_energy_ii, damage_before, broken):
     """Traction (pulling face A towards B) at one point of a joint whose faces are apart by
-    (sx, sy, sz), mid-surface normal n; and the point's damage after it."""
+    (sx, sy, sz), mid-surface normal n; and the point's damage after it. ``opening_peak`` =
+    2 h f_t / p; the slip at the shear strength f_s is likewise 2 h f_s / p. (Divisions and
+    square roots are most of a joint's cost: each is taken once per joint where it can be.)"""
     opening = sx * nx + sy * ny + sz * nz
     tx = sx - opening * nx
     ty = sy - opening * ny
     tz = sz - opening * nz
     slip = math.sqrt(tx * tx + ty * ty + tz * tz)
-    opening_peak = 2.0 * h * tensile / penalty
     # the faces may not pass through each other (sigma = p o / h) while they face each other
-    compression = 2.0 * opening / opening_peak * tensile if opening < 0.0 and slip < h else 0.0
+    compression = opening * penalty_over_h if opening < 0.0 and slip < h else 0.0
+    # tau / slip: the shear traction along the slip vector
+    shear_over_slip = 0.0
     if broken:
         sigma = compression
-        tau = 0.0
         current = damage_before
     else:
         shear_strength = cohesion - tan_phi * compression
-        slip_peak = 2.0 * h * shear_strength / penalty
-        excess_o = max(opening - opening_peak, 0.0) * tensile / softening_i
-        excess_s = max(slip - slip_peak, 0.0) * shear_strength / softening_ii
-        now = math.sqrt(excess_o * excess_o + excess_s * excess_s)
-        current = max(damage_before, min(now, 1.0))
+        slip_peak = two_h_over_p * shear_strength
+        excess_o = max(opening - opening_peak, 0.0) * tensile_over_energy_i
+        excess_s = max(slip - slip_peak, 0.0) * shear_strength * inverse_energy_ii
+        current = damage_before
+        if excess_o > 0.0 or excess_s > 0.0:
+            current = max(damage_before, min(math.sqrt(excess_o * excess_o + excess_s * excess_s),
+                                             1.0))
         z = softening(current)
         if opening < 0.0:
             sigma = compression
         elif opening < opening_peak:
-            sigma = _rising(opening / opening_peak) * z * tensile
+            sigma = _rising(opening * inverse_opening_peak) * z * tensile
         else:
             sigma = z * tensile
         if slip < slip_peak:
-            tau = _rising(slip / slip_peak) * z * shear_strength
-        else:
-            tau = z * shear_strength
-    fx = sigma * nx
-    fy = sigma * ny
-    fz = sigma * nz
-    if slip > 0.0 and tau != 0.0:
-        scale = tau / slip
-        fx += scale * tx
-        fy += scale * ty
-        fz += scale * tz
-    return fx, fy, fz, current
+            # (2 - r) r z f_s / slip with r = slip / slip_peak and f_s / slip_peak = p / (2 h)
+            shear_over_slip = (2.0 - slip / slip_peak) * z * 0.5 * penalty_over_h
+        elif slip > 0.0:
+            shear_over_slip = z * shear_strength / slip
+    return (sigma * nx + shear_over_slip * tx, sigma * ny + shear_over_slip * ty,
+            sigma * nz + shear_over_slip * tz, current)
 
 
 @inline_kernel
@@ -115,17 +115,18 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
            buffer):
     """Forces of joint ``j`` on its six nodes into ``buffer[j]`` (6, 3); updates its damage.
     Returns the number of its points at D >= 1."""
-    for k in range(6):
-        for d in range(3):
-            buffer[j, k, d] = 0.0
     row = joint_material[j]
     tensile = properties[row, 0]
     cohesion = properties[row, 1]
     tan_phi = properties[row, 2]
     penalty = properties[row, 3]
-    softening_i = properties[row, 4]
-    softening_ii = properties[row, 5]
     h = sizes[j]
+    penalty_over_h = penalty / h
+    two_h_over_p = 2.0 / penalty_over_h
+    opening_peak = two_h_over_p * tensile
+    inverse_opening_peak = 1.0 / opening_peak
+    tensile_over_energy_i = tensile / properties[row, 4]
+    inverse_energy_ii = 1.0 / properties[row, 5]
     a0, a1, a2 = joints[j, 0], joints[j, 1], joints[j, 2]
     b0, b1, b2 = joints[j, 3], joints[j, 4], joints[j, 5]
     # separations at the vertices and the mid-surface's corners
@@ -152,10 +153,14 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     nz = e1x * e2y - e1y * e2x
     twice_area = math.sqrt(nx * nx + ny * ny + nz * nz)
     if twice_area <= 0.0:
+        for k in range(6):
+            for d in range(3):
+                buffer[j, k, d] = 0.0
         return 0
-    nx /= twice_area
-    ny /= twice_area
-    nz /= twice_area
+    inverse = 1.0 / twice_area
+    nx *= inverse
+    ny *= inverse
+    nz *= inverse
     # a third of the area per point, half of that to each of the point's two vertices
     share = twice_area / 12.0
     is_broken = broken[j]
@@ -163,13 +168,16 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     # point q sits midway between vertices q and q + 1
     t0x, t0y, t0z, damage[j, 0] = _point_traction(
         0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, h, tensile, cohesion,
-        tan_phi, penalty, softening_i, softening_ii, damage[j, 0], is_broken)
+        tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
+        tensile_over_energy_i, inverse_energy_ii, damage[j, 0], is_broken)
     t1x, t1y, t1z, damage[j, 1] = _point_traction(
         0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, h, tensile, cohesion,
-        tan_phi, penalty, softening_i, softening_ii, damage[j, 1], is_broken)
+        tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
+        tensile_over_energy_i, inverse_energy_ii, damage[j, 1], is_broken)
     t2x, t2y, t2z, damage[j, 2] = _point_traction(
         0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, h, tensile, cohesion,
-        tan_phi, penalty, softening_i, softening_ii, damage[j, 2], is_broken)
+        tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
+        tensile_over_energy_i, inverse_energy_ii, damage[j, 2], is_broken)
     for q in range(3):
         if damage[j, q] >= 1.0:
             failed += 1
@@ -181,7 +189,7 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
 
 
 @inline_kernel
-def _joint_step(j, positions, joints, sizes, properties, joint_material, damage, broken, buffer):
+def joint_step(j, positions, joints, sizes, properties, joint_material, damage, broken, buffer):
     """``_joint``, then mark the joint broken once two of its points are at D >= 1; returns 1 if
     it broke now."""
     failed = _joint(j, positions, joints, sizes, properties, joint_material, damage, broken, buffer)
@@ -191,53 +199,23 @@ def _joint_step(j, positions, joints, sizes, properties, joint_material, damage,
     return 0
 
 
-@parallel_kernel
+@kernel
 def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, buffer):
     """Forces of every joint (``_joint``) into ``buffer`` (n_joints, 6, 3); a joint with two or
-    more points at D >= 1 is marked ``broken``. Returns the number broken now."""
-    newly = 0
-    for j in prange(joints.shape[0]):
-        newly += _joint_step(j, positions, joints, sizes, properties, joint_material, damage,
-                             broken, buffer)
-    return newly
-
-
-@kernel
-def joint_forces_serial(positions, joints, sizes, properties, joint_material, damage, broken,
-                        buffer):
-    """:func:`joint_forces` on one thread (small bodies: no thread start-up)."""
+    more points at D >= 1 is marked ``broken``. Returns the number broken now. (On threads, the
+    joints run in the loop of the tets' forces: ``finite_strain.tet4_and_joint_forces``.)"""
     newly = 0
     for j in range(joints.shape[0]):
-        newly += _joint_step(j, positions, joints, sizes, properties, joint_material, damage,
+        newly += joint_step(j, positions, joints, sizes, properties, joint_material, damage,
                              broken, buffer)
     return newly
 
 
-@inline_kernel
-def _gather_node(node, flat, node_offsets, node_slots, out):
-    fx = fy = fz = 0.0
-    for s in range(node_offsets[node], node_offsets[node + 1]):
-        slot = node_slots[s]
-        fx += flat[slot, 0]
-        fy += flat[slot, 1]
-        fz += flat[slot, 2]
-    out[node, 0] = fx
-    out[node, 1] = fy
-    out[node, 2] = fz
-
-
-@parallel_kernel
+@kernel
 def gather_joint_forces(buffer, node_offsets, node_slots, out):
     """out[node] = the joint forces on it: ``node_slots[node_offsets[i]:node_offsets[i+1]]``
-    are the flat (joint * 6 + corner) slots of node i."""
-    flat = buffer.reshape((-1, 3))
-    for node in prange(out.shape[0]):
-        _gather_node(node, flat, node_offsets, node_slots, out)
-
-
-@kernel
-def gather_joint_forces_serial(buffer, node_offsets, node_slots, out):
-    """:func:`gather_joint_forces` on one thread."""
+    are the flat (joint * 6 + corner) slots of node i. (The time step sums them in the node
+    update instead: ``finite_strain.update_node``.)"""
     flat = buffer.reshape((-1, 3))
     for node in range(out.shape[0]):
-        _gather_node(node, flat, node_offsets, node_slots, out)
+        out[node, 0], out[node, 1], out[node, 2] = slot_sum(node, flat, node_offsets, node_slots)
