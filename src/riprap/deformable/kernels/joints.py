@@ -20,12 +20,14 @@ joint penalty), o_t, s_t the softening lengths:
     tau     likewise with |s|, s_p, f_s
     z(D)    = [1 - (a + b - 1)/(a + b) exp(D (a + c b)/((a + b)(1 - a - b)))] [a (1 - D) + b (1 - D)^c]
 
-with a = 0.63, b = 1.8, c = 6 (Hordijk's curve). A joint whose points reach D = 1 at two of the
-three breaks: it then carries only the compressive penalty (its faces cannot pass through each
-other while they still face each other, slip below h) and no tension or shear. The compressive
-penalty of any joint acts only while the slip is below h.
+with a = 0.63, b = 1.8, c = 6 (Hordijk's curve). The compressive penalty acts only while the
+slip is below h. A joint whose points reach D = 1 at two of the three breaks: it then carries no
+tension or shear, only the compressive penalty, applied to both faces at one place
+(``_broken_joint``).
 """
 import math
+
+import numpy as np
 
 from riprap._jit import inline_kernel, kernel
 from riprap.deformable.kernels.slots import slot_sum
@@ -57,7 +59,7 @@ def _rising(ratio):
 @inline_kernel
 def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penalty_over_h,
                     two_h_over_p, opening_peak, inverse_opening_peak, tensile_over_energy_i,
-                    inverse_energy_ii, damage_before, broken):
+                    inverse_energy_ii, damage_before):
     """Traction (pulling face A towards B) at one point of a joint whose faces are apart by
     (sx, sy, sz), mid-surface normal n; and the point's damage after it. ``opening_peak`` =
     2 h f_t / p; the slip at the shear strength f_s is likewise 2 h f_s / p. (Divisions and
@@ -71,30 +73,26 @@ def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penal
     compression = opening * penalty_over_h if opening < 0.0 and slip < h else 0.0
     # tau / slip: the shear traction along the slip vector
     shear_over_slip = 0.0
-    if broken:
+    shear_strength = cohesion - tan_phi * compression
+    slip_peak = two_h_over_p * shear_strength
+    excess_o = max(opening - opening_peak, 0.0) * tensile_over_energy_i
+    excess_s = max(slip - slip_peak, 0.0) * shear_strength * inverse_energy_ii
+    current = damage_before
+    if excess_o > 0.0 or excess_s > 0.0:
+        current = max(damage_before, min(math.sqrt(excess_o * excess_o + excess_s * excess_s),
+                                         1.0))
+    z = softening(current)
+    if opening < 0.0:
         sigma = compression
-        current = damage_before
+    elif opening < opening_peak:
+        sigma = _rising(opening * inverse_opening_peak) * z * tensile
     else:
-        shear_strength = cohesion - tan_phi * compression
-        slip_peak = two_h_over_p * shear_strength
-        excess_o = max(opening - opening_peak, 0.0) * tensile_over_energy_i
-        excess_s = max(slip - slip_peak, 0.0) * shear_strength * inverse_energy_ii
-        current = damage_before
-        if excess_o > 0.0 or excess_s > 0.0:
-            current = max(damage_before, min(math.sqrt(excess_o * excess_o + excess_s * excess_s),
-                                             1.0))
-        z = softening(current)
-        if opening < 0.0:
-            sigma = compression
-        elif opening < opening_peak:
-            sigma = _rising(opening * inverse_opening_peak) * z * tensile
-        else:
-            sigma = z * tensile
-        if slip < slip_peak:
-            # (2 - r) r z f_s / slip with r = slip / slip_peak and f_s / slip_peak = p / (2 h)
-            shear_over_slip = (2.0 - slip / slip_peak) * z * 0.5 * penalty_over_h
-        elif slip > 0.0:
-            shear_over_slip = z * shear_strength / slip
+        sigma = z * tensile
+    if slip < slip_peak:
+        # (2 - r) r z f_s / slip with r = slip / slip_peak and f_s / slip_peak = p / (2 h)
+        shear_over_slip = (2.0 - slip / slip_peak) * z * 0.5 * penalty_over_h
+    elif slip > 0.0:
+        shear_over_slip = z * shear_strength / slip
     return (sigma * nx + shear_over_slip * tx, sigma * ny + shear_over_slip * ty,
             sigma * nz + shear_over_slip * tz, current)
 
@@ -108,6 +106,73 @@ def _put_vertex(buffer, j, k, fx, fy, fz):
     buffer[j, 3 + k, 0] = -fx
     buffer[j, 3 + k, 1] = -fy
     buffer[j, 3 + k, 2] = -fz
+
+
+@inline_kernel
+def _spread_on_face(buffer, j, corners, face, point_row, wx, wy, wz, fx, fy, fz):
+    """Force (fx, fy, fz) on the face whose corners are rows ``face``..``face + 2`` of
+    ``corners``, at the point ``w`` away (in the face's plane) from the midpoint of the edge from
+    row ``point_row`` to the next: shared by the corners' barycentric coordinates there."""
+    ux = corners[face + 1, 0] - corners[face, 0]
+    uy = corners[face + 1, 1] - corners[face, 1]
+    uz = corners[face + 1, 2] - corners[face, 2]
+    vx = corners[face + 2, 0] - corners[face, 0]
+    vy = corners[face + 2, 1] - corners[face, 1]
+    vz = corners[face + 2, 2] - corners[face, 2]
+    cx = uy * vz - uz * vy
+    cy = uz * vx - ux * vz
+    cz = ux * vy - uy * vx
+    c2 = cx * cx + cy * cy + cz * cz
+    weights = np.zeros(3)
+    q = point_row - face
+    weights[q] = 0.5
+    weights[(q + 1) % 3] = 0.5
+    if c2 > 0.0:
+        shift_1 = ((wy * vz - wz * vy) * cx + (wz * vx - wx * vz) * cy + (wx * vy - wy * vx) * cz) / c2
+        shift_2 = ((uy * wz - uz * wy) * cx + (uz * wx - ux * wz) * cy + (ux * wy - uy * wx) * cz) / c2
+        weights[0] -= shift_1 + shift_2
+        weights[1] += shift_1
+        weights[2] += shift_2
+    for k in range(3):
+        buffer[j, face + k, 0] += weights[k] * fx
+        buffer[j, face + k, 1] += weights[k] * fy
+        buffer[j, face + k, 2] += weights[k] * fz
+
+
+@inline_kernel
+def _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, buffer):
+    """Forces of broken joint ``j``: the intact joint's compressive penalty at each point (opening
+    below zero, slip below h; mid-surface normal n), but acting on both faces at one place, midway
+    between the point of A and the point of B, by each face's barycentric coordinates there. The
+    two forces then lie on one line and turn neither piece: at the points themselves they would
+    make a couple once the faces have slid (examples/11: four broken joints put 66 J into
+    pieces sliding on their cracks)."""
+    corners = np.empty((6, 3))
+    for k in range(6):
+        for d in range(3):
+            corners[k, d] = positions[joints[j, k], d]
+            buffer[j, k, d] = 0.0
+    share = twice_area / 6.0       # a third of the area per point
+    for q in range(3):
+        r = (q + 1) % 3
+        sx = 0.5 * (corners[3 + q, 0] + corners[3 + r, 0] - corners[q, 0] - corners[r, 0])
+        sy = 0.5 * (corners[3 + q, 1] + corners[3 + r, 1] - corners[q, 1] - corners[r, 1])
+        sz = 0.5 * (corners[3 + q, 2] + corners[3 + r, 2] - corners[q, 2] - corners[r, 2])
+        opening = sx * nx + sy * ny + sz * nz
+        if opening >= 0.0:
+            continue
+        tx = sx - opening * nx
+        ty = sy - opening * ny
+        tz = sz - opening * nz
+        if tx * tx + ty * ty + tz * tz >= h * h:
+            continue
+        magnitude = share * opening * penalty_over_h       # < 0: pushes A away from B
+        fx = magnitude * nx
+        fy = magnitude * ny
+        fz = magnitude * nz
+        _spread_on_face(buffer, j, corners, 0, q, 0.5 * sx, 0.5 * sy, 0.5 * sz, fx, fy, fz)
+        _spread_on_face(buffer, j, corners, 3, 3 + q, -0.5 * sx, -0.5 * sy, -0.5 * sz,
+                        -fx, -fy, -fz)
 
 
 @inline_kernel
@@ -161,23 +226,25 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     nx *= inverse
     ny *= inverse
     nz *= inverse
+    if broken[j]:
+        _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, buffer)
+        return 2
     # a third of the area per point, half of that to each of the point's two vertices
     share = twice_area / 12.0
-    is_broken = broken[j]
     failed = 0
     # point q sits midway between vertices q and q + 1
     t0x, t0y, t0z, damage[j, 0] = _point_traction(
         0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, h, tensile, cohesion,
         tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        tensile_over_energy_i, inverse_energy_ii, damage[j, 0], is_broken)
+        tensile_over_energy_i, inverse_energy_ii, damage[j, 0])
     t1x, t1y, t1z, damage[j, 1] = _point_traction(
         0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, h, tensile, cohesion,
         tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        tensile_over_energy_i, inverse_energy_ii, damage[j, 1], is_broken)
+        tensile_over_energy_i, inverse_energy_ii, damage[j, 1])
     t2x, t2y, t2z, damage[j, 2] = _point_traction(
         0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, h, tensile, cohesion,
         tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        tensile_over_energy_i, inverse_energy_ii, damage[j, 2], is_broken)
+        tensile_over_energy_i, inverse_energy_ii, damage[j, 2])
     for q in range(3):
         if damage[j, q] >= 1.0:
             failed += 1
