@@ -122,3 +122,31 @@ def test_a_broken_joint_pushes_slid_faces_apart_without_turning_them():
         else:
             # (round-off openings of the joints inside the halves aside)
             assert np.abs(forces[right]).max() < 1e-9 * scale
+
+
+def test_a_broken_joint_whose_faces_slid_apart_or_sank_in_lets_go_for_good():
+    """Broken joints across a cut are released once their faces no longer face each other: slid
+    by more than the joint's size, or pressed deeper than 1 % of it into each other (a penalty
+    that deep would press with p / 100: the faces got there some other way). Released, they push
+    no more, even where the faces come back to face each other 10 micrometres deep (which, never
+    released, they push apart: the test above)."""
+    nodes, tets = box_mesh((0.2, 0.1, 0.1), (2, 1, 1))
+    centres_x = None
+    for first_move in ("slide", "sink"):
+        body = FracturingBody(nodes, tets, ElasticMaterial(density=2400.0), JointMaterial(**GOOD))
+        body.joint_broken[:] = True
+        if centres_x is None:
+            centres_x = body.positions[body.elements.elements].mean(axis=1)[:, 0]
+        right = np.zeros(len(body.positions), dtype=bool)
+        right[body.elements.elements[centres_x > 0.1].ravel()] = True
+        cut = body.joint_tets
+        across = (centres_x[cut[:, 0]] > 0.1) != (centres_x[cut[:, 1]] > 0.1)
+        size = body.joint_sizes[across].min()
+        move = [-1e-5, 1.5 * size, 0.0] if first_move == "slide" else [-0.05 * size, 0.0, 0.0]
+        body.positions[right] += move
+        body.joint_forces()
+        assert body.joint_released[across].all() and not body.joint_released[~across].any()
+        body.positions[:] = body.elements.reference_nodes
+        body.positions[right] += [-1e-5, 0.4 * size, 0.0]
+        forces = body.joint_forces()
+        assert np.abs(forces[right, 0].sum()) < 1e-6, first_move

@@ -1,5 +1,5 @@
 """The unit-breakage example (examples/11_unit_breakage: a Core-Loc-like unit, H = 1 m, landing at
-2.43 m/s on six fixed rocks, 6 ms) run as shipped: its joints take energy from the unit and never
+2.43 m/s on six fixed rocks, 20 ms) run as shipped: its joints take energy from the unit and never
 give more back than they took.
 
 The joints' work on the nodes (``fracture_energy`` = minus that work: what they store and
@@ -7,8 +7,9 @@ dissipate) must be positive and at least G_I times the broken area (every broken
 released at least its mode I fracture energy in the mixed-mode law, Munjiza, Andrews & White
 1999; here G_II = 10 G_I). Before broken joints pushed their faces apart at one place
 (riprap/deformable/kernels/joints.py, ``_broken_joint``), four joints whose pieces slid along the
-crack pumped 66 J into them: ``fracture_energy`` was -66 J. Measured now: +46 J against
-G_I A = 6.8 J (54 joints, 0.068 m^2).
+crack pumped 66 J into them in 6 ms: ``fracture_energy`` was -66 J. Measured now (20 ms,
+friction_angle 0): +129 J against G_I A = 16 J (126 joints, 0.159 m^2). (With friction_angle
+30 degrees it is -881 J at 20 ms: docs/fracture.md, Limits.)
 """
 from pathlib import Path
 

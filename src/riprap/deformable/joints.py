@@ -243,6 +243,9 @@ class FracturingBody(DeformableBody):
         #: Broken joints between two fragments: in a DeformableSystem their faces are contact
         #: surfaces too, for every tet but the two the joint holds and their other neighbours.
         self.joint_parted = np.zeros(len(joints), dtype=np.bool_)
+        #: Broken joints whose faces slid apart by the joint's size or more: they no longer face
+        #: each other, and the joint acts no more (kernels/joints.py, ``_broken_joint``).
+        self.joint_released = np.zeros(len(joints), dtype=np.bool_)
         #: Work done by the joints on the nodes so far (J): minus the energy they stored and
         #: dissipated.
         self.joint_work = np.zeros(1)
@@ -250,7 +253,6 @@ class FracturingBody(DeformableBody):
         self._joint_material_index = np.zeros(len(joints), dtype=np.int64)
         self._joint_buffer = np.zeros((len(joints), 6, 3))
         self._joint_node_offsets, self._joint_node_slots = node_slots(joints, len(exploded))
-        self._joint_node_forces = np.zeros((len(exploded), 3))
 
     # ------------------------------------------------------------------ steps
     def stable_time_step(self) -> float:
@@ -282,7 +284,7 @@ class FracturingBody(DeformableBody):
         forces = np.zeros_like(self.positions)
         joint_kernels.joint_forces(self.positions, self.joints, self.joint_sizes,
                                    self._joint_properties, self._joint_material_index,
-                                   self.joint_damage, self.joint_broken,
+                                   self.joint_damage, self.joint_broken, self.joint_released,
                                    self._joint_buffer)
         joint_kernels.gather_joint_forces(self._joint_buffer, self._joint_node_offsets,
                                            self._joint_node_slots, forces)
@@ -291,7 +293,7 @@ class FracturingBody(DeformableBody):
     def _joint_arguments(self):
         return (self.joints, self.joint_sizes, self._joint_properties, self._joint_material_index,
                 self.joint_damage, self.joint_broken, self._joint_buffer,
-                self._joint_node_offsets, self._joint_node_slots, self._joint_node_forces,
+                self._joint_node_offsets, self._joint_node_slots, self.joint_released,
                 self.joint_work)
 
     # ------------------------------------------------------------------ results

@@ -216,8 +216,8 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
     :func:`advance_steps`) in one parallel loop: both only read the positions, so one region
     instead of two (each region costs the threads a wake-up)."""
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer) = (joint_data[0], joint_data[1], joint_data[2], joint_data[3], joint_data[4],
-                      joint_data[5], joint_data[6])
+     joint_buffer, joint_released) = (joint_data[0], joint_data[1], joint_data[2], joint_data[3],
+                                      joint_data[4], joint_data[5], joint_data[6], joint_data[9])
     n_tets = tets.shape[0]
     n_joints = joint_nodes.shape[0]
     for block in prange(FORCE_BLOCKS):
@@ -226,7 +226,8 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
                          element_material, element_forces, jacobians)
         for j in range(block * n_joints // FORCE_BLOCKS, (block + 1) * n_joints // FORCE_BLOCKS):
             joint_kernels.joint_step(j, positions, joint_nodes, joint_sizes, joint_properties,
-                                     joint_material, joint_damage, joint_broken, joint_buffer)
+                                     joint_material, joint_damage, joint_broken, joint_released,
+                                     joint_buffer)
 
 
 @kernel
@@ -255,9 +256,10 @@ def general_element_forces(positions, velocities, elements, gradients, weights,
 @inline_kernel
 def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained, prescribed_velocities,
-                time_step, nodal_forces, joint_flat, joint_offsets, joint_slots):
+                time_step, nodal_forces, joint_flat, joint_offsets, joint_slots, listed_positions):
     """Central-difference update of node ``n`` (see :func:`central_difference_update`); returns
-    the work of the joints' force on it over the step."""
+    the work of the joints' force on it over the step and its squared distance from
+    ``listed_positions`` after it."""
     m = masses[n]
     # written out per axis: a helper per axis (inlined) made the one-thread loop 2 to 3 times
     # slower (numba 0.68, this machine), the threaded one not
@@ -291,17 +293,21 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
     positions[n, 2] += time_step * velocity
     wz = (before + velocity) * jz
     work = 0.5 * time_step * (wx + wy + wz)
-    return work
+    mx = positions[n, 0] - listed_positions[n, 0]
+    my = positions[n, 1] - listed_positions[n, 1]
+    mz = positions[n, 2] - listed_positions[n, 2]
+    return work, mx * mx + my * my + mz * mz
 
 
 @parallel_kernel
 def central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
                               masses, external_forces, contact_forces, gravity, mass_damping,
                               constrained, prescribed_velocities, time_step, nodal_forces,
-                              joint_data):
+                              joint_data, listed_positions):
     """Sum the element forces at every node, add loads, gravity, mass-proportional damping and the
     joints' forces, and advance the half-step velocity and the position (central difference /
-    leapfrog). Returns the joints' work over the step.
+    leapfrog). Returns the joints' work over the step and the largest squared distance of a node
+    from ``listed_positions`` after it (pass ``positions`` itself where none is wanted).
 
     ``node_slots[node_offsets[n]:node_offsets[n + 1]]`` lists the flat (element, local node)
     entries of ``element_forces`` that act on node n; ``joint_data`` (see :func:`advance_steps`)
@@ -312,30 +318,38 @@ def central_difference_update(positions, velocities, element_forces, node_offset
     joint_flat = joint_data[6].reshape((-1, 3))
     joint_offsets, joint_slots = joint_data[7], joint_data[8]
     work = 0.0
+    largest = 0.0
     for n in prange(positions.shape[0]):
-        work += update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
-                            external_forces, contact_forces, gravity, mass_damping, constrained,
-                            prescribed_velocities, time_step, nodal_forces, joint_flat,
-                            joint_offsets, joint_slots)
-    return work
+        node_work, moved = update_node(n, positions, velocities, flat, node_offsets, node_slots,
+                                       masses, external_forces, contact_forces, gravity,
+                                       mass_damping, constrained, prescribed_velocities,
+                                       time_step, nodal_forces, joint_flat, joint_offsets,
+                                       joint_slots, listed_positions)
+        work += node_work
+        largest = max(largest, moved)
+    return work, largest
 
 
 @kernel
 def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
                                      node_slots, masses, external_forces, contact_forces, gravity,
                                      mass_damping, constrained, prescribed_velocities, time_step,
-                                     nodal_forces, joint_data):
+                                     nodal_forces, joint_data, listed_positions):
     """:func:`central_difference_update` on one thread (small bodies: no thread start-up)."""
     flat = element_forces.reshape((-1, 3))
     joint_flat = joint_data[6].reshape((-1, 3))
     joint_offsets, joint_slots = joint_data[7], joint_data[8]
     work = 0.0
+    largest = 0.0
     for n in range(positions.shape[0]):
-        work += update_node(n, positions, velocities, flat, node_offsets, node_slots, masses,
-                            external_forces, contact_forces, gravity, mass_damping, constrained,
-                            prescribed_velocities, time_step, nodal_forces, joint_flat,
-                            joint_offsets, joint_slots)
-    return work
+        node_work, moved = update_node(n, positions, velocities, flat, node_offsets, node_slots,
+                                       masses, external_forces, contact_forces, gravity,
+                                       mass_damping, constrained, prescribed_velocities,
+                                       time_step, nodal_forces, joint_flat, joint_offsets,
+                                       joint_slots, listed_positions)
+        work += node_work
+        largest = max(largest, moved)
+    return work, largest
 
 
 @parallel_kernel
@@ -458,8 +472,9 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     wall tets, the normal damping ratio per triangle and per tet).
     ``joint_data`` = the joints between tets of fracturing bodies (``riprap/deformable/kernels/joints.py``):
     (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
-    a (n, 6, 3) buffer, the node-to-slot lists of the buffer, the joints' force on every
-    node, their work done on the nodes so far (1,), by the trapezoidal rule).
+    a (n, 6, 3) buffer, the node-to-slot lists of the buffer, released (broken joints whose
+    faces slid apart: no force any more), their work done on the nodes so far (1,), by the
+    trapezoidal rule).
     Their forces are added in the node update (not to ``contact_forces``), which also sums
     their work.
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
@@ -470,20 +485,26 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
      tet_stiffness, pair_springs, wall_triangle_springs, wall_tet_springs, triangle_damping,
      tet_damping) = contact
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer, joint_node_offsets, joint_node_slots, joint_node_forces,
+     joint_buffer, joint_node_offsets, joint_node_slots, joint_released,
      joint_work) = joint_data
     has_joints = joint_nodes.shape[0] > 0
     tet4 = elements.shape[1] == 4
     has_contact = triangles.shape[0] > 0
     half_skin_squared = 0.25 * skin * skin
+    # the largest squared move since the pairs were listed: looked at over all nodes once here
+    # (rigid nodes are placed between calls), then given by each step's node update
+    largest_move = 0.0
+    moves_from = listed_positions if has_contact else positions
+    if has_contact:
+        for n in range(positions.shape[0]):
+            moved = 0.0
+            for i in range(3):
+                moved += (positions[n, i] - listed_positions[n, i]) ** 2
+            largest_move = max(largest_move, moved)
     for step in range(n_steps):
         if has_contact:
-            for n in range(positions.shape[0]):
-                moved = 0.0
-                for i in range(3):
-                    moved += (positions[n, i] - listed_positions[n, i]) ** 2
-                if moved > half_skin_squared:
-                    return step, REBUILD_CONTACTS, -1, 1.0
+            if largest_move > half_skin_squared:
+                return step, REBUILD_CONTACTS, -1, 1.0
             contact_forces[:] = 0.0
             totals[:] = 0.0
             if pairs.shape[0] >= PARALLEL_PAIRS:
@@ -518,7 +539,7 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
             if has_joints:
                 joint_kernels.joint_forces(
                     positions, joint_nodes, joint_sizes, joint_properties, joint_material,
-                    joint_damage, joint_broken, joint_buffer)
+                    joint_damage, joint_broken, joint_released, joint_buffer)
             element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
                                   weights, materials, element_material, element_forces, jacobians)
         elif tet4:
@@ -531,14 +552,14 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
         if not value > 0.0:
             return step, INVERTED, worst, value
         if parallel:
-            work = central_difference_update(
+            work, largest_move = central_difference_update(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, nodal_forces, joint_data)
+                prescribed_velocities, time_step, nodal_forces, joint_data, moves_from)
         else:
-            work = central_difference_update_serial(
+            work, largest_move = central_difference_update_serial(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, nodal_forces, joint_data)
+                prescribed_velocities, time_step, nodal_forces, joint_data, moves_from)
         joint_work[0] += work
     return n_steps, DONE, -1, 1.0

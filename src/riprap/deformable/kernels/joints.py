@@ -22,8 +22,8 @@ joint penalty), o_t, s_t the softening lengths:
 
 with a = 0.63, b = 1.8, c = 6 (Hordijk's curve). The compressive penalty acts only while the
 slip is below h. A joint whose points reach D = 1 at two of the three breaks: it then carries no
-tension or shear, only the compressive penalty, applied to both faces at one place
-(``_broken_joint``).
+tension or shear, only the compressive penalty, applied to both faces at one place, until its
+faces have slid h apart (``_broken_joint``).
 """
 import math
 
@@ -58,12 +58,13 @@ def _rising(ratio):
 
 @inline_kernel
 def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penalty_over_h,
-                    two_h_over_p, opening_peak, inverse_opening_peak, tensile_over_energy_i,
-                    inverse_energy_ii, damage_before):
+                    two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak_open,
+                    tensile_over_energy_i, inverse_energy_ii, damage_before):
     """Traction (pulling face A towards B) at one point of a joint whose faces are apart by
     (sx, sy, sz), mid-surface normal n; and the point's damage after it. ``opening_peak`` =
-    2 h f_t / p; the slip at the shear strength f_s is likewise 2 h f_s / p. (Divisions and
-    square roots are most of a joint's cost: each is taken once per joint where it can be.)"""
+    2 h f_t / p; the slip at the shear strength f_s is likewise 2 h f_s / p (its inverse given
+    for f_s = c, faces not pressed together). (Divisions and square roots are most of a joint's
+    cost: each is taken once per joint where it can be.)"""
     opening = sx * nx + sy * ny + sz * nz
     tx = sx - opening * nx
     ty = sy - opening * ny
@@ -90,7 +91,8 @@ def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penal
         sigma = z * tensile
     if slip < slip_peak:
         # (2 - r) r z f_s / slip with r = slip / slip_peak and f_s / slip_peak = p / (2 h)
-        shear_over_slip = (2.0 - slip / slip_peak) * z * 0.5 * penalty_over_h
+        inverse_slip_peak = inverse_slip_peak_open if compression == 0.0 else 1.0 / slip_peak
+        shear_over_slip = (2.0 - slip * inverse_slip_peak) * z * 0.5 * penalty_over_h
     elif slip > 0.0:
         shear_over_slip = z * shear_strength / slip
     return (sigma * nx + shear_over_slip * tx, sigma * ny + shear_over_slip * ty,
@@ -139,44 +141,90 @@ def _spread_on_face(buffer, j, corners, face, point_row, wx, wy, wz, fx, fy, fz)
         buffer[j, face + k, 2] += weights[k] * fz
 
 
+#: A broken joint whose faces have turned from each other beyond this cosine (about 25 degrees)
+#: or interpenetrate deeper than this fraction of its size is released (``_broken_joint``).
+RELEASE_FACE_COSINE = 0.9
+RELEASE_PENETRATION = 0.01
+
+
 @inline_kernel
-def _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, buffer):
+def _face_cosine(corners):
+    """Cosine of the angle between the normals of the faces (rows 0-2 and 3-5 of ``corners``)."""
+    ax = (corners[1, 1] - corners[0, 1]) * (corners[2, 2] - corners[0, 2]) - (
+        corners[1, 2] - corners[0, 2]) * (corners[2, 1] - corners[0, 1])
+    ay = (corners[1, 2] - corners[0, 2]) * (corners[2, 0] - corners[0, 0]) - (
+        corners[1, 0] - corners[0, 0]) * (corners[2, 2] - corners[0, 2])
+    az = (corners[1, 0] - corners[0, 0]) * (corners[2, 1] - corners[0, 1]) - (
+        corners[1, 1] - corners[0, 1]) * (corners[2, 0] - corners[0, 0])
+    bx = (corners[4, 1] - corners[3, 1]) * (corners[5, 2] - corners[3, 2]) - (
+        corners[4, 2] - corners[3, 2]) * (corners[5, 1] - corners[3, 1])
+    by = (corners[4, 2] - corners[3, 2]) * (corners[5, 0] - corners[3, 0]) - (
+        corners[4, 0] - corners[3, 0]) * (corners[5, 2] - corners[3, 2])
+    bz = (corners[4, 0] - corners[3, 0]) * (corners[5, 1] - corners[3, 1]) - (
+        corners[4, 1] - corners[3, 1]) * (corners[5, 0] - corners[3, 0])
+    lengths = math.sqrt((ax * ax + ay * ay + az * az) * (bx * bx + by * by + bz * bz))
+    if lengths <= 0.0:
+        return -1.0
+    return (ax * bx + ay * by + az * bz) / lengths
+
+
+@inline_kernel
+def _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, released,
+                  buffer):
     """Forces of broken joint ``j``: the intact joint's compressive penalty at each point (opening
-    below zero, slip below h; mid-surface normal n), but acting on both faces at one place, midway
-    between the point of A and the point of B, by each face's barycentric coordinates there. The
-    two forces then lie on one line and turn neither piece: at the points themselves they would
-    make a couple once the faces have slid (examples/11: four broken joints put 66 J into
-    pieces sliding on their cracks)."""
+    below zero), but acting on both faces at one place, midway between the point of A and the
+    point of B, by each face's barycentric coordinates there. The two forces then lie on one line
+    and turn neither piece: at the points themselves they would make a couple once the faces have
+    slid (examples/11: four broken joints put 66 J into pieces sliding on their cracks).
+
+    The joint is ``released`` for good (no force ever after) once its faces no longer face each
+    other: a point has slid h or more, or the faces have turned more than about 25 degrees
+    (``RELEASE_FACE_COSINE``) from each other, or a point lies deeper than
+    ``RELEASE_PENETRATION`` h in the other face (a penalty that deep would press with p / 100, far
+    beyond any concrete's strength: the faces got there without it, by sliding or turning, and
+    switching it on would throw them apart). Unreleased, joints whose slip came back under h, or
+    whose faces had turned, put up to 25 kJ into a unit dropped from 1 m in a single step."""
     corners = np.empty((6, 3))
     for k in range(6):
         for d in range(3):
             corners[k, d] = positions[joints[j, k], d]
             buffer[j, k, d] = 0.0
-    share = twice_area / 6.0       # a third of the area per point
+    if released[j]:
+        return
+    if _face_cosine(corners) < RELEASE_FACE_COSINE:
+        released[j] = True
+        return
+    separations = np.empty((3, 3))
+    openings = np.empty(3)
     for q in range(3):
         r = (q + 1) % 3
-        sx = 0.5 * (corners[3 + q, 0] + corners[3 + r, 0] - corners[q, 0] - corners[r, 0])
-        sy = 0.5 * (corners[3 + q, 1] + corners[3 + r, 1] - corners[q, 1] - corners[r, 1])
-        sz = 0.5 * (corners[3 + q, 2] + corners[3 + r, 2] - corners[q, 2] - corners[r, 2])
-        opening = sx * nx + sy * ny + sz * nz
-        if opening >= 0.0:
+        for d in range(3):
+            separations[q, d] = 0.5 * (corners[3 + q, d] + corners[3 + r, d]
+                                       - corners[q, d] - corners[r, d])
+        opening = separations[q, 0] * nx + separations[q, 1] * ny + separations[q, 2] * nz
+        openings[q] = opening
+        tx = separations[q, 0] - opening * nx
+        ty = separations[q, 1] - opening * ny
+        tz = separations[q, 2] - opening * nz
+        if tx * tx + ty * ty + tz * tz >= h * h or opening < -RELEASE_PENETRATION * h:
+            released[j] = True
+            return
+    share = twice_area / 6.0       # a third of the area per point
+    for q in range(3):
+        if openings[q] >= 0.0:
             continue
-        tx = sx - opening * nx
-        ty = sy - opening * ny
-        tz = sz - opening * nz
-        if tx * tx + ty * ty + tz * tz >= h * h:
-            continue
-        magnitude = share * opening * penalty_over_h       # < 0: pushes A away from B
+        magnitude = share * openings[q] * penalty_over_h       # < 0: pushes A away from B
         fx = magnitude * nx
         fy = magnitude * ny
         fz = magnitude * nz
+        sx, sy, sz = separations[q, 0], separations[q, 1], separations[q, 2]
         _spread_on_face(buffer, j, corners, 0, q, 0.5 * sx, 0.5 * sy, 0.5 * sz, fx, fy, fz)
         _spread_on_face(buffer, j, corners, 3, 3 + q, -0.5 * sx, -0.5 * sy, -0.5 * sz,
                         -fx, -fy, -fz)
 
 
 @inline_kernel
-def _joint(j, positions, joints, sizes, properties, joint_material, damage, broken,
+def _joint(j, positions, joints, sizes, properties, joint_material, damage, broken, released,
            buffer):
     """Forces of joint ``j`` on its six nodes into ``buffer[j]`` (6, 3); updates its damage.
     Returns the number of its points at D >= 1."""
@@ -190,6 +238,7 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     two_h_over_p = 2.0 / penalty_over_h
     opening_peak = two_h_over_p * tensile
     inverse_opening_peak = 1.0 / opening_peak
+    inverse_slip_peak_open = 1.0 / (two_h_over_p * cohesion)
     tensile_over_energy_i = tensile / properties[row, 4]
     inverse_energy_ii = 1.0 / properties[row, 5]
     a0, a1, a2 = joints[j, 0], joints[j, 1], joints[j, 2]
@@ -227,7 +276,8 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     ny *= inverse
     nz *= inverse
     if broken[j]:
-        _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, buffer)
+        _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, released,
+                      buffer)
         return 2
     # a third of the area per point, half of that to each of the point's two vertices
     share = twice_area / 12.0
@@ -236,15 +286,15 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     t0x, t0y, t0z, damage[j, 0] = _point_traction(
         0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, h, tensile, cohesion,
         tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        tensile_over_energy_i, inverse_energy_ii, damage[j, 0])
+        inverse_slip_peak_open, tensile_over_energy_i, inverse_energy_ii, damage[j, 0])
     t1x, t1y, t1z, damage[j, 1] = _point_traction(
         0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, h, tensile, cohesion,
         tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        tensile_over_energy_i, inverse_energy_ii, damage[j, 1])
+        inverse_slip_peak_open, tensile_over_energy_i, inverse_energy_ii, damage[j, 1])
     t2x, t2y, t2z, damage[j, 2] = _point_traction(
         0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, h, tensile, cohesion,
         tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        tensile_over_energy_i, inverse_energy_ii, damage[j, 2])
+        inverse_slip_peak_open, tensile_over_energy_i, inverse_energy_ii, damage[j, 2])
     for q in range(3):
         if damage[j, q] >= 1.0:
             failed += 1
@@ -256,10 +306,12 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
 
 
 @inline_kernel
-def joint_step(j, positions, joints, sizes, properties, joint_material, damage, broken, buffer):
+def joint_step(j, positions, joints, sizes, properties, joint_material, damage, broken, released,
+               buffer):
     """``_joint``, then mark the joint broken once two of its points are at D >= 1; returns 1 if
     it broke now."""
-    failed = _joint(j, positions, joints, sizes, properties, joint_material, damage, broken, buffer)
+    failed = _joint(j, positions, joints, sizes, properties, joint_material, damage, broken,
+                    released, buffer)
     if failed >= 2 and not broken[j]:
         broken[j] = True
         return 1
@@ -267,14 +319,15 @@ def joint_step(j, positions, joints, sizes, properties, joint_material, damage, 
 
 
 @kernel
-def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, buffer):
+def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, released,
+                 buffer):
     """Forces of every joint (``_joint``) into ``buffer`` (n_joints, 6, 3); a joint with two or
     more points at D >= 1 is marked ``broken``. Returns the number broken now. (On threads, the
     joints run in the loop of the tets' forces: ``finite_strain.tet4_and_joint_forces``.)"""
     newly = 0
     for j in range(joints.shape[0]):
         newly += joint_step(j, positions, joints, sizes, properties, joint_material, damage,
-                             broken, buffer)
+                             broken, released, buffer)
     return newly
 
 
