@@ -15,8 +15,8 @@ z = 0 over a length o_t dissipates f_t o_t 0.3863 per unit area; Y3D's o_t = 3 G
 
 Limits: 4-node tets only; a broken joint keeps its faces from passing through each other by the
 compressive penalty only (no friction between its faces until the pieces part and meet through
-the contact); energy is created where single tets are crushed against a rigid rock
-(docs/fracture.md, Limits).
+the contact), and lets go once they no longer face each other; a friction angle above 0 pumps
+energy into a unit that keeps crushing on a rock (docs/fracture.md, Limits).
 """
 from __future__ import annotations
 
