@@ -8,17 +8,19 @@ lands on the corner of one fluke, falls onto a rigid floor (friction 0.6, restit
 ``HEIGHTS`` (started 0.2 mm above the floor at sqrt(2 g h)), followed for 3 ms after it lands,
 with the stable step times 0.9 and times 0.45.
 
-Stated, as the issue asks (measured on this machine, 2026-11-26 session 10; step x 0.9 / x 0.45):
-from 1 cm no joint breaks (largest damage 0.18); from 2 cm the fluke's corner chips: 12 / 11
-broken joints, 48 / 44 cm^2 of crack, 5 / 4 pieces, the largest 99.9 % of the unit; from 5 cm
-35 / 33 joints, 157 / 146 cm^2, 12 / 12 pieces. It breaks first between 1 and 2 cm at both steps;
-at each height the broken area at the two steps agrees within ``AREA_TOLERANCE`` = 30 % (measured
-10 % and 7 %).
+Stated, as the issue asks (measured on this machine, 2026-11-26 session 11, joints with friction
+as a sliding spring; step x 0.9 / x 0.45): from 3 cm no joint breaks; from 5 cm 4 / 4 joints
+break at the fluke's corner (20 cm^2 of crack, still one piece); from 10 cm 9 / 9 joints,
+40 cm^2, 3 pieces, the largest 99.9 % of the unit. It breaks first between 3 and 5 cm at both
+steps; at each height the broken area at the two steps agrees within ``AREA_TOLERANCE`` = 30 %
+(measured: the same joints break). Higher, for the record: 20 cm 29 / 29 joints, 10 pieces;
+50 cm 175 / 173 joints, 42 / 41 pieces, the largest 88 %. (Before the joints' friction slid,
+session 10, the first break was between 1 and 2 cm and drops from 10 cm stopped on an inverted
+element: the elastic friction law pumped energy into the crushed corner.)
 
 No published figure is compared: a corner landing on a rigid floor concentrates the contact
 stress on a few tets, so the height of the first chip depends on the mesh (finer tets, higher
-stress at the corner). Larger drops of this unit on this floor crush the corner until an element
-inverts (0.1 m at the longer step): the run stops there with a checkpoint (docs/fracture.md).
+stress at the corner).
 """
 import numpy as np
 import pytest
@@ -30,7 +32,7 @@ from riprap.deformable.system import DeformableSystem
 from riprap.geometry.armour_units import armour_unit
 
 YOUNG = 30e9
-HEIGHTS = (0.01, 0.02, 0.05)
+HEIGHTS = (0.03, 0.05, 0.1)
 STEP_FACTORS = (0.9, 0.45)
 AREA_TOLERANCE = 0.30
 GAP = 2e-4
@@ -72,7 +74,7 @@ def _first_break(results, factor):
 
 def test_the_height_of_the_first_break_does_not_depend_on_the_step(drops):
     first = [_first_break(drops, factor) for factor in STEP_FACTORS]
-    assert first[0] == first[1] == 0.02
+    assert first[0] == first[1] == 0.05
 
 
 def test_the_broken_area_does_not_depend_on_the_step(drops):

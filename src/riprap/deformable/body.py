@@ -37,7 +37,8 @@ def no_joints(n_nodes: int) -> tuple:
     return (np.zeros((0, 6), dtype=np.int64), np.zeros(0), np.zeros((1, 6)),
             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0, dtype=np.bool_),
             np.zeros((0, 6, 3)), np.zeros(n_nodes + 1, dtype=np.int64),
-            np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.bool_), np.zeros(1))
+            np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.bool_), np.zeros(1),
+            np.zeros((0, 3, 2)))
 
 # Bodies with fewer integration points than this step on one thread: starting the threads of a
 # parallel loop (twice a step) cost more than the work for the 480-tet cantilever of the tests

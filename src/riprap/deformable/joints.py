@@ -246,6 +246,9 @@ class FracturingBody(DeformableBody):
         #: Broken joints whose faces slid apart by the joint's size or more: they no longer face
         #: each other, and the joint acts no more (kernels/joints.py, ``_broken_joint``).
         self.joint_released = np.zeros(len(joints), dtype=np.bool_)
+        #: Friction anchor of each joint's three points (m): the slip, along two axes in the
+        #: joint's plane that turn with it, at which its friction force is nil.
+        self.joint_friction_anchor = np.zeros((len(joints), 3, 2))
         #: Work done by the joints on the nodes so far (J): minus the energy they stored and
         #: dissipated.
         self.joint_work = np.zeros(1)
@@ -260,7 +263,8 @@ class FracturingBody(DeformableBody):
         bounded by sqrt(omega_element^2 + omega_joint^2), omega_joint^2 the largest over the
         nodes of the joints' Gershgorin row sum at the node over its mass: (p / h) (2 A / 3) per
         joint (a node's two points, each a third of the area, each shared by its two vertices
-        and read from both faces)."""
+        and read from both faces), twice that with friction (its spring, p / h, acts along the
+        joint's plane on top of the cohesion's, whose slope is p / h at most)."""
         if self._stable_time_step is None:
             omega_elements = float(self.elements.largest_element_frequencies(self.material).max())
             omega = math.hypot(omega_elements, self.joint_frequency())
@@ -274,7 +278,8 @@ class FracturingBody(DeformableBody):
         if not len(self.joints):
             return 0.0
         stiffness = np.zeros(len(self.masses))
-        per_joint = (self.joint_material.joint_penalty / self.joint_sizes
+        springs = 2.0 if self.joint_material.friction_angle > 0.0 else 1.0
+        per_joint = (springs * self.joint_material.joint_penalty / self.joint_sizes
                      * self.joint_areas * (2.0 / 3.0))
         np.add.at(stiffness, self.joints.reshape(-1), np.repeat(per_joint, 6))
         return float(np.sqrt((stiffness / self.masses).max()))
@@ -285,7 +290,7 @@ class FracturingBody(DeformableBody):
         joint_kernels.joint_forces(self.positions, self.joints, self.joint_sizes,
                                    self._joint_properties, self._joint_material_index,
                                    self.joint_damage, self.joint_broken, self.joint_released,
-                                   self._joint_buffer)
+                                   self.joint_friction_anchor, self._joint_buffer)
         joint_kernels.gather_joint_forces(self._joint_buffer, self._joint_node_offsets,
                                            self._joint_node_slots, forces)
         return forces
@@ -294,7 +299,7 @@ class FracturingBody(DeformableBody):
         return (self.joints, self.joint_sizes, self._joint_properties, self._joint_material_index,
                 self.joint_damage, self.joint_broken, self._joint_buffer,
                 self._joint_node_offsets, self._joint_node_slots, self.joint_released,
-                self.joint_work)
+                self.joint_work, self.joint_friction_anchor)
 
     # ------------------------------------------------------------------ results
     @property

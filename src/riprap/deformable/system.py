@@ -221,7 +221,8 @@ class DeformableSystem:
         sizes = np.concatenate([self.bodies[k].joint_sizes for k in fracturing])
         properties = np.concatenate([self.bodies[k]._joint_properties for k in fracturing])
         material = np.repeat(np.arange(len(fracturing), dtype=np.int64), counts)
-        for name in ("joint_damage", "joint_broken", "joint_parted", "joint_released"):
+        for name in ("joint_damage", "joint_broken", "joint_parted", "joint_released",
+                     "joint_friction_anchor"):
             joined = np.concatenate([getattr(self.bodies[k], name) for k in fracturing])
             setattr(self, name, joined)
             for i, k in enumerate(fracturing):
@@ -230,7 +231,8 @@ class DeformableSystem:
         self.joint_work = np.zeros(1)
         self.joint_data = (self.joints, sizes, properties, material, self.joint_damage,
                            self.joint_broken, np.zeros((len(self.joints), 6, 3)),
-                           offsets, slots, self.joint_released, self.joint_work)
+                           offsets, slots, self.joint_released, self.joint_work,
+                           self.joint_friction_anchor)
 
     def _fracturing_surface(self, body) -> tuple:
         """A fracturing body's contact surface now: its outer faces and the faces of its parted
@@ -330,6 +332,7 @@ class DeformableSystem:
         return {"joint_damage": self.joint_damage.copy(), "joint_broken": self.joint_broken.copy(),
                 "joint_parted": self.joint_parted.copy(), "joint_work": self.joint_work.copy(),
                 "joint_released": self.joint_released.copy(),
+                "joint_friction_anchor": self.joint_friction_anchor.copy(),
                 "joints_broken_at_check": np.array([self._broken_at_check])}
 
     def load_joint_state(self, arrays: dict) -> None:
@@ -341,6 +344,7 @@ class DeformableSystem:
         self.joint_broken[:] = arrays["joint_broken"]
         self.joint_parted[:] = arrays["joint_parted"]
         self.joint_released[:] = arrays.get("joint_released", False)
+        self.joint_friction_anchor[:] = arrays.get("joint_friction_anchor", 0.0)
         self.joint_work[:] = arrays["joint_work"]
         self._broken_at_check = int(arrays["joints_broken_at_check"][0])
         self.rebuild_contact_surfaces()

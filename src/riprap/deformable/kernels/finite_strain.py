@@ -216,8 +216,9 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
     :func:`advance_steps`) in one parallel loop: both only read the positions, so one region
     instead of two (each region costs the threads a wake-up)."""
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer, joint_released) = (joint_data[0], joint_data[1], joint_data[2], joint_data[3],
-                                      joint_data[4], joint_data[5], joint_data[6], joint_data[9])
+     joint_buffer, joint_released, joint_anchors) = (
+        joint_data[0], joint_data[1], joint_data[2], joint_data[3], joint_data[4], joint_data[5],
+        joint_data[6], joint_data[9], joint_data[11])
     n_tets = tets.shape[0]
     n_joints = joint_nodes.shape[0]
     for block in prange(FORCE_BLOCKS):
@@ -227,7 +228,7 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
         for j in range(block * n_joints // FORCE_BLOCKS, (block + 1) * n_joints // FORCE_BLOCKS):
             joint_kernels.joint_step(j, positions, joint_nodes, joint_sizes, joint_properties,
                                      joint_material, joint_damage, joint_broken, joint_released,
-                                     joint_buffer)
+                                     joint_anchors, joint_buffer)
 
 
 @kernel
@@ -474,7 +475,7 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
     a (n, 6, 3) buffer, the node-to-slot lists of the buffer, released (broken joints whose
     faces slid apart: no force any more), their work done on the nodes so far (1,), by the
-    trapezoidal rule).
+    trapezoidal rule, and the friction anchors of their points (n, 3, 2)).
     Their forces are added in the node update (not to ``contact_forces``), which also sums
     their work.
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
@@ -486,7 +487,7 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
      tet_damping) = contact
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
      joint_buffer, joint_node_offsets, joint_node_slots, joint_released,
-     joint_work) = joint_data
+     joint_work, joint_anchors) = joint_data
     has_joints = joint_nodes.shape[0] > 0
     tet4 = elements.shape[1] == 4
     has_contact = triangles.shape[0] > 0
@@ -539,7 +540,7 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
             if has_joints:
                 joint_kernels.joint_forces(
                     positions, joint_nodes, joint_sizes, joint_properties, joint_material,
-                    joint_damage, joint_broken, joint_released, joint_buffer)
+                    joint_damage, joint_broken, joint_released, joint_anchors, joint_buffer)
             element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
                                   weights, materials, element_material, element_forces, jacobians)
         elif tet4:

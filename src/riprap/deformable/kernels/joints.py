@@ -9,18 +9,25 @@ delta = x_B - x_A gives the opening o = delta . n and the slip vector s = delta 
 stresses (tension and shear positive) pull A towards B with the traction sigma n + tau s / |s|
 over a third of the mid-surface's area each, shared by the point's two vertices.
 
-Per point, with f_t the tensile strength, f_s = c - tan(phi) min(sigma, 0) the shear strength,
-o_p = 2 h f_t / p and s_p = 2 h f_s / p the openings at the strengths (h the joint's size, p the
-joint penalty), o_t, s_t the softening lengths:
+Per point, with f_t the tensile strength, c the cohesion, o_p = 2 h f_t / p and s_p = 2 h c / p
+the openings at the strengths (h the joint's size, p the joint penalty), o_t, s_t the softening
+lengths:
 
     damage  D = max(D_before, sqrt(max(o - o_p, 0)^2 / o_t^2 + max(|s| - s_p, 0)^2 / s_t^2)), <= 1
     sigma   = 2 (o / o_p) f_t in compression (o < 0, undamaged: the faces may not interpenetrate)
             = (2 r - r^2) z(D) f_t,  r = o / o_p,  for 0 <= o < o_p
             = z(D) f_t                             for o >= o_p
-    tau     likewise with |s|, s_p, f_s
+    tau     likewise with |s|, s_p, c; plus friction (below)
     z(D)    = [1 - (a + b - 1)/(a + b) exp(D (a + c b)/((a + b)(1 - a - b)))] [a (1 - D) + b (1 - D)^c]
 
-with a = 0.63, b = 1.8, c = 6 (Hordijk's curve). The compressive penalty acts only while the
+with a = 0.63, b = 1.8, c = 6 (Hordijk's curve). Friction adds to tau: a spring of stiffness p / h
+from an anchor (per point, in axes of the joint's plane), no stronger than tan(phi) times the
+compression; where it would be, the anchor moves with the slip (Coulomb's law with a stick
+range, as in the contact). The joint's shear strength is so c z(D) + tan(phi) (-sigma): Munjiza's
+f_s = c - tan(phi) sigma, but its friction part dissipates, and it survives the cohesion's
+softening. (Munjiza's law with f_s in the softening curve returns shear work along another path
+than it took it: a unit crushing on a rock gained 881 J from its joints; docs/fracture.md.)
+The compressive penalty acts only while the
 slip is below h. A joint whose points reach D = 1 at two of the three breaks: it then carries no
 tension or shear, only the compressive penalty, applied to both faces at one place, until its
 faces have slid h apart (``_broken_joint``).
@@ -57,14 +64,16 @@ def _rising(ratio):
 
 
 @inline_kernel
-def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penalty_over_h,
-                    two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak_open,
-                    tensile_over_energy_i, inverse_energy_ii, damage_before):
-    """Traction (pulling face A towards B) at one point of a joint whose faces are apart by
-    (sx, sy, sz), mid-surface normal n; and the point's damage after it. ``opening_peak`` =
-    2 h f_t / p; the slip at the shear strength f_s is likewise 2 h f_s / p (its inverse given
-    for f_s = c, faces not pressed together). (Divisions and square roots are most of a joint's
-    cost: each is taken once per joint where it can be.)"""
+def _point_traction(sx, sy, sz, nx, ny, nz, t1x, t1y, t1z, t2x, t2y, t2z, h, tensile, cohesion,
+                    tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
+                    inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii, damage_before,
+                    anchors, j, q):
+    """Traction (pulling face A towards B) at point ``q`` of joint ``j`` whose faces are apart
+    by (sx, sy, sz), mid-surface normal n and in-plane axes t1, t2; and the point's damage after
+    it. ``opening_peak`` = 2 h f_t / p; ``inverse_slip_peak`` = p / (2 h c). Moves the point's
+    friction anchor (``anchors[j, q]``, the slip along t1, t2 at which its friction is nil) where
+    the friction slides. (Divisions and square roots are most of a joint's cost: each is taken
+    once per joint where it can be.)"""
     opening = sx * nx + sy * ny + sz * nz
     tx = sx - opening * nx
     ty = sy - opening * ny
@@ -72,12 +81,11 @@ def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penal
     slip = math.sqrt(tx * tx + ty * ty + tz * tz)
     # the faces may not pass through each other (sigma = p o / h) while they face each other
     compression = opening * penalty_over_h if opening < 0.0 and slip < h else 0.0
-    # tau / slip: the shear traction along the slip vector
+    # tau / slip: the cohesive shear traction along the slip vector
     shear_over_slip = 0.0
-    shear_strength = cohesion - tan_phi * compression
-    slip_peak = two_h_over_p * shear_strength
+    slip_peak = two_h_over_p * cohesion
     excess_o = max(opening - opening_peak, 0.0) * tensile_over_energy_i
-    excess_s = max(slip - slip_peak, 0.0) * shear_strength * inverse_energy_ii
+    excess_s = max(slip - slip_peak, 0.0) * cohesion * inverse_energy_ii
     current = damage_before
     if excess_o > 0.0 or excess_s > 0.0:
         current = max(damage_before, min(math.sqrt(excess_o * excess_o + excess_s * excess_s),
@@ -90,13 +98,36 @@ def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, tan_phi, penal
     else:
         sigma = z * tensile
     if slip < slip_peak:
-        # (2 - r) r z f_s / slip with r = slip / slip_peak and f_s / slip_peak = p / (2 h)
-        inverse_slip_peak = inverse_slip_peak_open if compression == 0.0 else 1.0 / slip_peak
+        # (2 - r) r z c / slip with r = slip / slip_peak and c / slip_peak = p / (2 h)
         shear_over_slip = (2.0 - slip * inverse_slip_peak) * z * 0.5 * penalty_over_h
     elif slip > 0.0:
-        shear_over_slip = z * shear_strength / slip
-    return (sigma * nx + shear_over_slip * tx, sigma * ny + shear_over_slip * ty,
-            sigma * nz + shear_over_slip * tz, current)
+        shear_over_slip = z * cohesion / slip
+    fx = sigma * nx + shear_over_slip * tx
+    fy = sigma * ny + shear_over_slip * ty
+    fz = sigma * nz + shear_over_slip * tz
+    if tan_phi > 0.0:
+        # Coulomb friction on top of the cohesion: a spring of stiffness p / h from the anchor,
+        # no stronger than tan(phi) times the compression; where it would be, the anchor
+        # follows the slip (it slides: the work is dissipated, as in the contact's friction).
+        # Munjiza's f_s = c - tan(phi) sigma inside the elastic-like law above gave the energy
+        # back on a different path from the one it took: a unit crushing on a rock gained
+        # 881 J from its joints (docs/fracture.md).
+        along_1 = tx * t1x + ty * t1y + tz * t1z
+        along_2 = tx * t2x + ty * t2y + tz * t2z
+        friction_1 = penalty_over_h * (along_1 - anchors[j, q, 0])
+        friction_2 = penalty_over_h * (along_2 - anchors[j, q, 1])
+        limit = -tan_phi * compression
+        squared = friction_1 * friction_1 + friction_2 * friction_2
+        if squared > limit * limit:
+            scale = limit / math.sqrt(squared) if limit > 0.0 else 0.0
+            friction_1 *= scale
+            friction_2 *= scale
+            anchors[j, q, 0] = along_1 - friction_1 / penalty_over_h
+            anchors[j, q, 1] = along_2 - friction_2 / penalty_over_h
+        fx += friction_1 * t1x + friction_2 * t2x
+        fy += friction_1 * t1y + friction_2 * t2y
+        fz += friction_1 * t1z + friction_2 * t2z
+    return fx, fy, fz, current
 
 
 @inline_kernel
@@ -225,9 +256,9 @@ def _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_are
 
 @inline_kernel
 def _joint(j, positions, joints, sizes, properties, joint_material, damage, broken, released,
-           buffer):
-    """Forces of joint ``j`` on its six nodes into ``buffer[j]`` (6, 3); updates its damage.
-    Returns the number of its points at D >= 1."""
+           anchors, buffer):
+    """Forces of joint ``j`` on its six nodes into ``buffer[j]`` (6, 3); updates its damage and
+    friction anchors. Returns the number of its points at D >= 1."""
     row = joint_material[j]
     tensile = properties[row, 0]
     cohesion = properties[row, 1]
@@ -238,7 +269,7 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     two_h_over_p = 2.0 / penalty_over_h
     opening_peak = two_h_over_p * tensile
     inverse_opening_peak = 1.0 / opening_peak
-    inverse_slip_peak_open = 1.0 / (two_h_over_p * cohesion)
+    inverse_slip_peak = 1.0 / (two_h_over_p * cohesion)
     tensile_over_energy_i = tensile / properties[row, 4]
     inverse_energy_ii = 1.0 / properties[row, 5]
     a0, a1, a2 = joints[j, 0], joints[j, 1], joints[j, 2]
@@ -279,22 +310,35 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
         _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, released,
                       buffer)
         return 2
+    # in-plane axes that turn with the joint, for the friction anchors
+    u1x, u1y, u1z = e1x, e1y, e1z
+    if tan_phi > 0.0:
+        inverse = 1.0 / math.sqrt(e1x * e1x + e1y * e1y + e1z * e1z)
+        u1x *= inverse
+        u1y *= inverse
+        u1z *= inverse
+    u2x = ny * u1z - nz * u1y
+    u2y = nz * u1x - nx * u1z
+    u2z = nx * u1y - ny * u1x
     # a third of the area per point, half of that to each of the point's two vertices
     share = twice_area / 12.0
     failed = 0
     # point q sits midway between vertices q and q + 1
     t0x, t0y, t0z, damage[j, 0] = _point_traction(
-        0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, h, tensile, cohesion,
-        tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        inverse_slip_peak_open, tensile_over_energy_i, inverse_energy_ii, damage[j, 0])
+        0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, u1x, u1y, u1z,
+        u2x, u2y, u2z, h, tensile, cohesion, tan_phi, penalty_over_h, two_h_over_p, opening_peak,
+        inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii,
+        damage[j, 0], anchors, j, 0)
     t1x, t1y, t1z, damage[j, 1] = _point_traction(
-        0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, h, tensile, cohesion,
-        tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        inverse_slip_peak_open, tensile_over_energy_i, inverse_energy_ii, damage[j, 1])
+        0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, u1x, u1y, u1z,
+        u2x, u2y, u2z, h, tensile, cohesion, tan_phi, penalty_over_h, two_h_over_p, opening_peak,
+        inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii,
+        damage[j, 1], anchors, j, 1)
     t2x, t2y, t2z, damage[j, 2] = _point_traction(
-        0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, h, tensile, cohesion,
-        tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        inverse_slip_peak_open, tensile_over_energy_i, inverse_energy_ii, damage[j, 2])
+        0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, u1x, u1y, u1z,
+        u2x, u2y, u2z, h, tensile, cohesion, tan_phi, penalty_over_h, two_h_over_p, opening_peak,
+        inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii,
+        damage[j, 2], anchors, j, 2)
     for q in range(3):
         if damage[j, q] >= 1.0:
             failed += 1
@@ -307,11 +351,11 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
 
 @inline_kernel
 def joint_step(j, positions, joints, sizes, properties, joint_material, damage, broken, released,
-               buffer):
+               anchors, buffer):
     """``_joint``, then mark the joint broken once two of its points are at D >= 1; returns 1 if
     it broke now."""
     failed = _joint(j, positions, joints, sizes, properties, joint_material, damage, broken,
-                    released, buffer)
+                    released, anchors, buffer)
     if failed >= 2 and not broken[j]:
         broken[j] = True
         return 1
@@ -320,14 +364,14 @@ def joint_step(j, positions, joints, sizes, properties, joint_material, damage, 
 
 @kernel
 def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, released,
-                 buffer):
+                 anchors, buffer):
     """Forces of every joint (``_joint``) into ``buffer`` (n_joints, 6, 3); a joint with two or
     more points at D >= 1 is marked ``broken``. Returns the number broken now. (On threads, the
     joints run in the loop of the tets' forces: ``finite_strain.tet4_and_joint_forces``.)"""
     newly = 0
     for j in range(joints.shape[0]):
         newly += joint_step(j, positions, joints, sizes, properties, joint_material, damage,
-                             broken, released, buffer)
+                             broken, released, anchors, buffer)
     return newly
 
 
