@@ -707,9 +707,9 @@ KEYS: tuple[Key, ...] = (
         "Shear strength of the joints without normal stress (concrete: about twice the tensile "
         "strength); needed with `fracture`.", default=0.0, valid_range=_NON_NEGATIVE),
     Key("deformable", "friction_angle", "number", "deg",
-        "The joints' shear strength grows by tan(friction_angle) times the compression. Above 0 "
-        "the joints pump energy into a long crushing contact (a unit on a rock corner for more "
-        "than a few ms: docs/fracture.md); 0 is safe.",
+        "Coulomb friction between the faces of each joint under compression, on top of the "
+        "cohesion: the joints' shear strength grows by tan(friction_angle) times the compression, "
+        "and the friction part stays once the cohesion has softened.",
         default=30.0, valid_range=Range(minimum=0.0, maximum=90.0, maximum_inclusive=False)),
     Key("deformable", "fracture_energy_mode_i", "number", "J/m^2",
         "Energy a crack dissipates per unit area in opening (concrete: about 100); needed with "

@@ -34,7 +34,7 @@ NO_TET4_GRADIENTS = np.zeros((0, 4, 3))
 def no_joints(n_nodes: int) -> tuple:
     """The joint arguments of a run without joints (see finite_strain.advance_steps): every
     node's list of joint slots empty (the node update runs over them without a branch)."""
-    return (np.zeros((0, 6), dtype=np.int64), np.zeros(0), np.zeros((1, 6)),
+    return (np.zeros((0, 6), dtype=np.int64), np.zeros(0), np.zeros((1, 9)),
             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0, dtype=np.bool_),
             np.zeros((0, 6, 3)), np.zeros(n_nodes + 1, dtype=np.int64),
             np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.bool_), np.zeros(1),

@@ -15,8 +15,8 @@ z = 0 over a length o_t dissipates f_t o_t 0.3863 per unit area; Y3D's o_t = 3 G
 
 Limits: 4-node tets only; a broken joint keeps its faces from passing through each other by the
 compressive penalty only (no friction between its faces until the pieces part and meet through
-the contact), and lets go once they no longer face each other; a friction angle above 0 pumps
-energy into a unit that keeps crushing on a rock (docs/fracture.md, Limits).
+the contact), and lets go once they no longer face each other; single-tet chips crushed off
+under a rock leave fast (docs/fracture.md, Limits).
 """
 from __future__ import annotations
 
@@ -83,11 +83,13 @@ class JointMaterial:
                                 "[0, 90) degrees")
 
     def kernel_row(self) -> np.ndarray:
-        """(f_t, c, tan phi, p, G_I / area, G_II / area) as the kernel reads them."""
-        return np.array([self.tensile_strength, self.cohesion,
-                         math.tan(math.radians(self.friction_angle)), self.joint_penalty,
-                         self.fracture_energy_mode_i / SOFTENING_AREA,
-                         self.fracture_energy_mode_ii / SOFTENING_AREA])
+        """(f_t, c, tan phi, p, f_t area / G_I, area / G_II, 2 / p, 1 / (2 f_t), 1 / (2 c)) as
+        the kernel reads them (area: ``SOFTENING_AREA``; the inverses taken here, once)."""
+        f_t, c, p = self.tensile_strength, self.cohesion, self.joint_penalty
+        return np.array([f_t, c, math.tan(math.radians(self.friction_angle)), p,
+                         f_t * SOFTENING_AREA / self.fracture_energy_mode_i,
+                         SOFTENING_AREA / self.fracture_energy_mode_ii,
+                         2.0 / p, 0.5 / f_t, 0.5 / c])
 
 
 _TET_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])   # outward, opposite corner k
@@ -246,8 +248,9 @@ class FracturingBody(DeformableBody):
         #: Broken joints whose faces slid apart by the joint's size or more: they no longer face
         #: each other, and the joint acts no more (kernels/joints.py, ``_broken_joint``).
         self.joint_released = np.zeros(len(joints), dtype=np.bool_)
-        #: Friction anchor of each joint's three points (m): the slip, along two axes in the
-        #: joint's plane that turn with it, at which its friction force is nil.
+        #: Friction anchor of each joint's three points: the slip at which its friction force
+        #: is nil, as multiples of the joint's two edges from its first corner (it turns with
+        #: the joint).
         self.joint_friction_anchor = np.zeros((len(joints), 3, 2))
         #: Work done by the joints on the nodes so far (J): minus the energy they stored and
         #: dissipated.

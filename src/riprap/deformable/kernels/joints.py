@@ -21,16 +21,16 @@ lengths:
     z(D)    = [1 - (a + b - 1)/(a + b) exp(D (a + c b)/((a + b)(1 - a - b)))] [a (1 - D) + b (1 - D)^c]
 
 with a = 0.63, b = 1.8, c = 6 (Hordijk's curve). Friction adds to tau: a spring of stiffness p / h
-from an anchor (per point, in axes of the joint's plane), no stronger than tan(phi) times the
+from an anchor (per point, in multiples of the joint's edges), no stronger than tan(phi) times the
 compression; where it would be, the anchor moves with the slip (Coulomb's law with a stick
 range, as in the contact). The joint's shear strength is so c z(D) + tan(phi) (-sigma): Munjiza's
 f_s = c - tan(phi) sigma, but its friction part dissipates, and it survives the cohesion's
 softening. (Munjiza's law with f_s in the softening curve returns shear work along another path
 than it took it: a unit crushing on a rock gained 881 J from its joints; docs/fracture.md.)
-The compressive penalty acts only while the
-slip is below h. A joint whose points reach D = 1 at two of the three breaks: it then carries no
-tension or shear, only the compressive penalty, applied to both faces at one place, until its
-faces have slid h apart (``_broken_joint``).
+The compressive penalty acts only while the slip is below h. A joint whose points reach D = 1 at
+two of the three breaks: it then carries no tension, shear or friction, only the compressive
+penalty, applied to both faces at one place, until its faces have slid h apart
+(``_broken_joint``).
 """
 import math
 
@@ -64,16 +64,28 @@ def _rising(ratio):
 
 
 @inline_kernel
-def _point_traction(sx, sy, sz, nx, ny, nz, t1x, t1y, t1z, t2x, t2y, t2z, h, tensile, cohesion,
-                    tan_phi, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-                    inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii, damage_before,
-                    anchors, j, q):
+def _edge_coordinates(rx, ry, rz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram):
+    """(a, b) with r = a e1 + b e2, for r in the plane of e1 and e2 (``inverse_gram`` =
+    1 / |e1 x e2|^2, the inverse of their Gram determinant)."""
+    on_1 = rx * e1x + ry * e1y + rz * e1z
+    on_2 = rx * e2x + ry * e2y + rz * e2z
+    g11 = e1x * e1x + e1y * e1y + e1z * e1z
+    g12 = e1x * e2x + e1y * e2y + e1z * e2z
+    g22 = e2x * e2x + e2y * e2y + e2z * e2z
+    return (on_1 * g22 - on_2 * g12) * inverse_gram, (on_2 * g11 - on_1 * g12) * inverse_gram
+
+
+@inline_kernel
+def _point_traction(sx, sy, sz, nx, ny, nz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h, two_h_over_p,
+                    opening_peak, inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i,
+                    inverse_energy_ii, damage_before, anchors, j, q):
     """Traction (pulling face A towards B) at point ``q`` of joint ``j`` whose faces are apart
-    by (sx, sy, sz), mid-surface normal n and in-plane axes t1, t2; and the point's damage after
-    it. ``opening_peak`` = 2 h f_t / p; ``inverse_slip_peak`` = p / (2 h c). Moves the point's
-    friction anchor (``anchors[j, q]``, the slip along t1, t2 at which its friction is nil) where
-    the friction slides. (Divisions and square roots are most of a joint's cost: each is taken
-    once per joint where it can be.)"""
+    by (sx, sy, sz), mid-surface normal n and edges e1, e2 (``inverse_gram`` = 1 / |e1 x e2|^2);
+    and the point's damage after it.
+    ``opening_peak`` = 2 h f_t / p; ``inverse_slip_peak`` = p / (2 h c). Moves the point's
+    friction anchor (``anchors[j, q]``: the slip, as multiples of e1 and e2, at which its
+    friction is nil) where the friction slides. (Divisions and square roots are most of a joint's
+    cost: each is taken once per joint where it can be.)"""
     opening = sx * nx + sy * ny + sz * nz
     tx = sx - opening * nx
     ty = sy - opening * ny
@@ -111,22 +123,37 @@ def _point_traction(sx, sy, sz, nx, ny, nz, t1x, t1y, t1z, t2x, t2y, t2z, h, ten
         # follows the slip (it slides: the work is dissipated, as in the contact's friction).
         # Munjiza's f_s = c - tan(phi) sigma inside the elastic-like law above gave the energy
         # back on a different path from the one it took: a unit crushing on a rock gained
-        # 881 J from its joints (docs/fracture.md).
-        along_1 = tx * t1x + ty * t1y + tz * t1z
-        along_2 = tx * t2x + ty * t2y + tz * t2z
-        friction_1 = penalty_over_h * (along_1 - anchors[j, q, 0])
-        friction_2 = penalty_over_h * (along_2 - anchors[j, q, 1])
-        limit = -tan_phi * compression
-        squared = friction_1 * friction_1 + friction_2 * friction_2
-        if squared > limit * limit:
-            scale = limit / math.sqrt(squared) if limit > 0.0 else 0.0
-            friction_1 *= scale
-            friction_2 *= scale
-            anchors[j, q, 0] = along_1 - friction_1 / penalty_over_h
-            anchors[j, q, 1] = along_2 - friction_2 / penalty_over_h
-        fx += friction_1 * t1x + friction_2 * t2x
-        fy += friction_1 * t1y + friction_2 * t2y
-        fz += friction_1 * t1z + friction_2 * t2z
+        # 881 J from its joints (docs/fracture.md). The anchor is held in multiples of the
+        # joint's own edges, so it turns (and stretches) with the joint.
+        if compression == 0.0:
+            # faces not pressed together: no friction, and none kept (NaN: it starts afresh
+            # where they are pressed again)
+            anchors[j, q, 0] = math.nan
+        else:
+            first = anchors[j, q, 0]
+            second = anchors[j, q, 1]
+            if first != first:
+                first, second = _edge_coordinates(tx, ty, tz, e1x, e1y, e1z, e2x, e2y, e2z,
+                                                  inverse_gram)
+                anchors[j, q, 0] = first
+                anchors[j, q, 1] = second
+            ux = tx - first * e1x - second * e2x
+            uy = ty - first * e1y - second * e2y
+            uz = tz - first * e1z - second * e2z
+            limit = -tan_phi * compression
+            squared = (ux * ux + uy * uy + uz * uz) * penalty_over_h * penalty_over_h
+            if squared > limit * limit:
+                # slides: the spring keeps tan(phi) sigma, the anchor comes to the slip minus
+                # the spring's stretch
+                scale = limit / math.sqrt(squared)
+                ux *= scale
+                uy *= scale
+                uz *= scale
+                anchors[j, q, 0], anchors[j, q, 1] = _edge_coordinates(
+                    tx - ux, ty - uy, tz - uz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram)
+            fx += penalty_over_h * ux
+            fy += penalty_over_h * uy
+            fz += penalty_over_h * uz
     return fx, fy, fz, current
 
 
@@ -263,15 +290,15 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     tensile = properties[row, 0]
     cohesion = properties[row, 1]
     tan_phi = properties[row, 2]
-    penalty = properties[row, 3]
     h = sizes[j]
-    penalty_over_h = penalty / h
-    two_h_over_p = 2.0 / penalty_over_h
+    # one division per joint: the rest are the material's, taken once (JointMaterial.kernel_row)
+    penalty_over_h = properties[row, 3] / h
+    two_h_over_p = h * properties[row, 6]
     opening_peak = two_h_over_p * tensile
-    inverse_opening_peak = 1.0 / opening_peak
-    inverse_slip_peak = 1.0 / (two_h_over_p * cohesion)
-    tensile_over_energy_i = tensile / properties[row, 4]
-    inverse_energy_ii = 1.0 / properties[row, 5]
+    inverse_opening_peak = penalty_over_h * properties[row, 7]
+    inverse_slip_peak = penalty_over_h * properties[row, 8]
+    tensile_over_energy_i = properties[row, 4]
+    inverse_energy_ii = properties[row, 5]
     a0, a1, a2 = joints[j, 0], joints[j, 1], joints[j, 2]
     b0, b1, b2 = joints[j, 3], joints[j, 4], joints[j, 5]
     # separations at the vertices and the mid-surface's corners
@@ -310,34 +337,29 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
         _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, released,
                       buffer)
         return 2
-    # in-plane axes that turn with the joint, for the friction anchors
-    u1x, u1y, u1z = e1x, e1y, e1z
-    if tan_phi > 0.0:
-        inverse = 1.0 / math.sqrt(e1x * e1x + e1y * e1y + e1z * e1z)
-        u1x *= inverse
-        u1y *= inverse
-        u1z *= inverse
-    u2x = ny * u1z - nz * u1y
-    u2y = nz * u1x - nx * u1z
-    u2z = nx * u1y - ny * u1x
+    # for the friction anchors: the Gram determinant of the edges is |e1 x e2|^2
+    inverse_gram = inverse * inverse
     # a third of the area per point, half of that to each of the point's two vertices
     share = twice_area / 12.0
     failed = 0
     # point q sits midway between vertices q and q + 1
     t0x, t0y, t0z, damage[j, 0] = _point_traction(
-        0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, u1x, u1y, u1z,
-        u2x, u2y, u2z, h, tensile, cohesion, tan_phi, penalty_over_h, two_h_over_p, opening_peak,
-        inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii,
+        0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, e1x, e1y, e1z,
+        e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h,
+        two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak,
+        tensile_over_energy_i, inverse_energy_ii,
         damage[j, 0], anchors, j, 0)
     t1x, t1y, t1z, damage[j, 1] = _point_traction(
-        0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, u1x, u1y, u1z,
-        u2x, u2y, u2z, h, tensile, cohesion, tan_phi, penalty_over_h, two_h_over_p, opening_peak,
-        inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii,
+        0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, e1x, e1y, e1z,
+        e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h,
+        two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak,
+        tensile_over_energy_i, inverse_energy_ii,
         damage[j, 1], anchors, j, 1)
     t2x, t2y, t2z, damage[j, 2] = _point_traction(
-        0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, u1x, u1y, u1z,
-        u2x, u2y, u2z, h, tensile, cohesion, tan_phi, penalty_over_h, two_h_over_p, opening_peak,
-        inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii,
+        0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, e1x, e1y, e1z,
+        e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h,
+        two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak,
+        tensile_over_energy_i, inverse_energy_ii,
         damage[j, 2], anchors, j, 2)
     for q in range(3):
         if damage[j, q] >= 1.0:
