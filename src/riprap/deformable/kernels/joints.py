@@ -78,7 +78,7 @@ def _edge_coordinates(rx, ry, rz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram):
 @inline_kernel
 def _point_traction(sx, sy, sz, nx, ny, nz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h, two_h_over_p,
                     opening_peak, inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i,
-                    inverse_energy_ii, damage_before, anchors, j, q):
+                    inverse_energy_ii, damage, anchors, j, q):
     """Traction (pulling face A towards B) at point ``q`` of joint ``j`` whose faces are apart
     by (sx, sy, sz), mid-surface normal n and edges e1, e2 (``inverse_gram`` = 1 / |e1 x e2|^2);
     and the point's damage after it.
@@ -98,10 +98,13 @@ def _point_traction(sx, sy, sz, nx, ny, nz, e1x, e1y, e1z, e2x, e2y, e2z, invers
     slip_peak = two_h_over_p * cohesion
     excess_o = max(opening - opening_peak, 0.0) * tensile_over_energy_i
     excess_s = max(slip - slip_peak, 0.0) * cohesion * inverse_energy_ii
-    current = damage_before
+    current = damage[j, q]
     if excess_o > 0.0 or excess_s > 0.0:
-        current = max(damage_before, min(math.sqrt(excess_o * excess_o + excess_s * excess_s),
-                                         1.0))
+        grown = min(math.sqrt(excess_o * excess_o + excess_s * excess_s), 1.0)
+        if grown > current:
+            # (stored only when it grows: a store every step would dirty the whole array)
+            current = grown
+            damage[j, q] = grown
     z = softening(current)
     if opening < 0.0:
         sigma = compression
@@ -127,8 +130,9 @@ def _point_traction(sx, sy, sz, nx, ny, nz, e1x, e1y, e1z, e2x, e2y, e2z, invers
         # joint's own edges, so it turns (and stretches) with the joint.
         if compression == 0.0:
             # faces not pressed together: no friction, and none kept (NaN: it starts afresh
-            # where they are pressed again)
-            anchors[j, q, 0] = math.nan
+            # where they are pressed again; looked at first: a store would dirty the line)
+            if anchors[j, q, 0] == anchors[j, q, 0]:
+                anchors[j, q, 0] = math.nan
         else:
             first = anchors[j, q, 0]
             second = anchors[j, q, 1]
@@ -341,29 +345,26 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     inverse_gram = inverse * inverse
     # a third of the area per point, half of that to each of the point's two vertices
     share = twice_area / 12.0
-    failed = 0
     # point q sits midway between vertices q and q + 1
-    t0x, t0y, t0z, damage[j, 0] = _point_traction(
+    t0x, t0y, t0z, d0 = _point_traction(
         0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, e1x, e1y, e1z,
         e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h,
         two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak,
         tensile_over_energy_i, inverse_energy_ii,
-        damage[j, 0], anchors, j, 0)
-    t1x, t1y, t1z, damage[j, 1] = _point_traction(
+        damage, anchors, j, 0)
+    t1x, t1y, t1z, d1 = _point_traction(
         0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, e1x, e1y, e1z,
         e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h,
         two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak,
         tensile_over_energy_i, inverse_energy_ii,
-        damage[j, 1], anchors, j, 1)
-    t2x, t2y, t2z, damage[j, 2] = _point_traction(
+        damage, anchors, j, 1)
+    t2x, t2y, t2z, d2 = _point_traction(
         0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, e1x, e1y, e1z,
         e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h,
         two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak,
         tensile_over_energy_i, inverse_energy_ii,
-        damage[j, 2], anchors, j, 2)
-    for q in range(3):
-        if damage[j, q] >= 1.0:
-            failed += 1
+        damage, anchors, j, 2)
+    failed = int(d0 >= 1.0) + int(d1 >= 1.0) + int(d2 >= 1.0)
     # vertex k takes the points on its two edges: q = k and q = k - 1
     _put_vertex(buffer, j, 0, share * (t0x + t2x), share * (t0y + t2y), share * (t0z + t2z))
     _put_vertex(buffer, j, 1, share * (t0x + t1x), share * (t0y + t1y), share * (t0z + t1z))
