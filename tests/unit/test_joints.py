@@ -93,32 +93,44 @@ def test_an_unloaded_body_keeps_its_joints_and_its_shape():
     assert len(np.unique(body.fragments())) == 1
 
 
-def test_a_broken_joint_pushes_slid_faces_apart_without_turning_them():
+@pytest.mark.parametrize("friction_angle", [0.0, 30.0])
+def test_a_broken_joint_pushes_slid_faces_apart_without_turning_them(friction_angle):
     """Two halves of a block cut by broken joints, one slid along the cut by 0.4 joint sizes and
     pressed 10 micrometres into the other: the joints push them apart (a compressive force on
     each half, across the cut), and the forces on all nodes sum to nothing and turn nothing:
     sum f = 0 and sum x x f = 0 to round-off. (The intact joint's pair, applied at each face's own
-    point, would make a couple of the slip times the force.) Slid past the faces (slip above h):
-    no force across the cut."""
+    point, would make a couple of the slip times the force.) With friction (30 degrees; the
+    anchors at the faces' first place, so it slides) the crack's faces also resist the slip with
+    tan(phi) times the push, and the only couple is that friction's across the 10 micrometres
+    between the faces: |sum x x f| = |f_t| 1e-5 m. Slid past the faces (slip above h): no force
+    across the cut."""
     nodes, tets = box_mesh((0.2, 0.1, 0.1), (2, 1, 1))
-    body = FracturingBody(nodes, tets, ElasticMaterial(density=2400.0), JointMaterial(**GOOD))
+    joints = JointMaterial(**dict(GOOD, friction_angle=friction_angle))
+    body = FracturingBody(nodes, tets, ElasticMaterial(density=2400.0), joints)
     body.joint_broken[:] = True
     centres = body.positions[body.elements.elements].mean(axis=1)
     right = np.zeros(len(body.positions), dtype=bool)
     right[body.elements.elements[centres[:, 0] > 0.1].ravel()] = True
     # only the joints across the cut at x = 0.1 matter: the rest stay at zero opening
     size = body.joint_sizes.mean()
+    depth = 1e-5
     for slip, pushed in ((0.4 * size, True), (1.5 * size, False)):
         body.positions[:] = body.elements.reference_nodes
-        body.positions[right] += [-1e-5, slip, 0.0]
+        body.positions[right] += [-depth, slip, 0.0]
+        body.joint_friction_anchor[:] = 0.0
         forces = body.joint_forces()
         across = forces[right, 0].sum()
         if pushed:
             assert across > 0.0, "the slid half is pushed back out of the cut"
             scale = np.abs(forces).max()
             assert np.abs(forces.sum(axis=0)).max() < 1e-9 * scale
+            along = forces[right, 1].sum()
+            tan_phi = np.tan(np.radians(friction_angle))
+            assert along == pytest.approx(-tan_phi * across, rel=1e-9, abs=1e-9 * scale)
             torque = np.cross(body.positions, forces).sum(axis=0)
-            assert np.abs(torque).max() < 1e-9 * scale * 0.2
+            assert np.abs(torque[:2]).max() < 1e-9 * scale * 0.2
+            assert abs(torque[2]) == pytest.approx(abs(along) * depth, rel=1e-6,
+                                                   abs=1e-9 * scale * 0.2)
         else:
             # (round-off openings of the joints inside the halves aside)
             assert np.abs(forces[right]).max() < 1e-9 * scale

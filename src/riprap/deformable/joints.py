@@ -14,9 +14,8 @@ z = 0 over a length o_t dissipates f_t o_t 0.3863 per unit area; Y3D's o_t = 3 G
 ``tests/verification/test_fracture_mode_one.py``).
 
 Limits: 4-node tets only; a broken joint keeps its faces from passing through each other by the
-compressive penalty only (no friction between its faces until the pieces part and meet through
-the contact), and lets go once they no longer face each other; single-tet chips crushed off
-under a rock leave fast (docs/fracture.md, Limits).
+compressive penalty (with the joint's friction) until they no longer face each other, then lets
+go for good; single-tet chips crushed off under a rock leave fast (docs/fracture.md, Limits).
 """
 from __future__ import annotations
 

@@ -28,8 +28,8 @@ f_s = c - tan(phi) sigma, but its friction part dissipates, and it survives the 
 softening. (Munjiza's law with f_s in the softening curve returns shear work along another path
 than it took it: a unit crushing on a rock gained 881 J from its joints; docs/fracture.md.)
 The compressive penalty acts only while the slip is below h. A joint whose points reach D = 1 at
-two of the three breaks: it then carries no tension, shear or friction, only the compressive
-penalty, applied to both faces at one place, until its faces have slid h apart
+two of the three breaks: it then carries no tension or shear, only the compressive penalty and
+the friction, applied to both faces at one place, until its faces have slid h apart
 (``_broken_joint``).
 """
 import math
@@ -73,6 +73,45 @@ def _edge_coordinates(rx, ry, rz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram):
     g12 = e1x * e2x + e1y * e2y + e1z * e2z
     g22 = e2x * e2x + e2y * e2y + e2z * e2z
     return (on_1 * g22 - on_2 * g12) * inverse_gram, (on_2 * g11 - on_1 * g12) * inverse_gram
+
+
+@inline_kernel
+def _friction(tx, ty, tz, compression, tan_phi, penalty_over_h, e1x, e1y, e1z, e2x, e2y, e2z,
+              inverse_gram, anchors, j, q):
+    """Friction stress (pulling face A towards B) at point ``q`` of joint ``j``, slipped by t
+    in the joint's plane and pressed by ``compression`` (<= 0): a spring of stiffness p / h from
+    the point's anchor, no stronger than tan(phi) (-compression); where it would be, the anchor
+    follows the slip (it slides: the work is dissipated, as in the contact's friction). The
+    anchor is held in multiples of the joint's edges e1, e2, so it turns (and stretches) with the
+    joint."""
+    if compression == 0.0:
+        # faces not pressed together: no friction, and none kept (NaN: it starts afresh where
+        # they are pressed again; looked at first: a store would dirty the line)
+        if anchors[j, q, 0] == anchors[j, q, 0]:
+            anchors[j, q, 0] = math.nan
+        return 0.0, 0.0, 0.0
+    first = anchors[j, q, 0]
+    second = anchors[j, q, 1]
+    if first != first:
+        first, second = _edge_coordinates(tx, ty, tz, e1x, e1y, e1z, e2x, e2y, e2z,
+                                          inverse_gram)
+        anchors[j, q, 0] = first
+        anchors[j, q, 1] = second
+    ux = tx - first * e1x - second * e2x
+    uy = ty - first * e1y - second * e2y
+    uz = tz - first * e1z - second * e2z
+    limit = -tan_phi * compression
+    squared = (ux * ux + uy * uy + uz * uz) * penalty_over_h * penalty_over_h
+    if squared > limit * limit:
+        # slides: the spring keeps tan(phi) sigma, the anchor comes to the slip minus the
+        # spring's stretch
+        scale = limit / math.sqrt(squared)
+        ux *= scale
+        uy *= scale
+        uz *= scale
+        anchors[j, q, 0], anchors[j, q, 1] = _edge_coordinates(
+            tx - ux, ty - uy, tz - uz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram)
+    return penalty_over_h * ux, penalty_over_h * uy, penalty_over_h * uz
 
 
 @inline_kernel
@@ -121,43 +160,15 @@ def _point_traction(sx, sy, sz, nx, ny, nz, e1x, e1y, e1z, e2x, e2y, e2z, invers
     fy = sigma * ny + shear_over_slip * ty
     fz = sigma * nz + shear_over_slip * tz
     if tan_phi > 0.0:
-        # Coulomb friction on top of the cohesion: a spring of stiffness p / h from the anchor,
-        # no stronger than tan(phi) times the compression; where it would be, the anchor
-        # follows the slip (it slides: the work is dissipated, as in the contact's friction).
-        # Munjiza's f_s = c - tan(phi) sigma inside the elastic-like law above gave the energy
-        # back on a different path from the one it took: a unit crushing on a rock gained
-        # 881 J from its joints (docs/fracture.md). The anchor is held in multiples of the
-        # joint's own edges, so it turns (and stretches) with the joint.
-        if compression == 0.0:
-            # faces not pressed together: no friction, and none kept (NaN: it starts afresh
-            # where they are pressed again; looked at first: a store would dirty the line)
-            if anchors[j, q, 0] == anchors[j, q, 0]:
-                anchors[j, q, 0] = math.nan
-        else:
-            first = anchors[j, q, 0]
-            second = anchors[j, q, 1]
-            if first != first:
-                first, second = _edge_coordinates(tx, ty, tz, e1x, e1y, e1z, e2x, e2y, e2z,
-                                                  inverse_gram)
-                anchors[j, q, 0] = first
-                anchors[j, q, 1] = second
-            ux = tx - first * e1x - second * e2x
-            uy = ty - first * e1y - second * e2y
-            uz = tz - first * e1z - second * e2z
-            limit = -tan_phi * compression
-            squared = (ux * ux + uy * uy + uz * uz) * penalty_over_h * penalty_over_h
-            if squared > limit * limit:
-                # slides: the spring keeps tan(phi) sigma, the anchor comes to the slip minus
-                # the spring's stretch
-                scale = limit / math.sqrt(squared)
-                ux *= scale
-                uy *= scale
-                uz *= scale
-                anchors[j, q, 0], anchors[j, q, 1] = _edge_coordinates(
-                    tx - ux, ty - uy, tz - uz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram)
-            fx += penalty_over_h * ux
-            fy += penalty_over_h * uy
-            fz += penalty_over_h * uz
+        # Coulomb friction on top of the cohesion (``_friction``). Munjiza's f_s = c - tan(phi)
+        # sigma inside the elastic-like law above gave the energy back on a different path from
+        # the one it took: a unit crushing on a rock gained 881 J from its joints
+        # (docs/fracture.md).
+        gx, gy, gz = _friction(tx, ty, tz, compression, tan_phi, penalty_over_h, e1x, e1y, e1z,
+                               e2x, e2y, e2z, inverse_gram, anchors, j, q)
+        fx += gx
+        fy += gy
+        fz += gz
     return fx, fy, fz, current
 
 
@@ -232,12 +243,14 @@ def _face_cosine(corners):
 
 @inline_kernel
 def _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, released,
-                  buffer):
-    """Forces of broken joint ``j``: the intact joint's compressive penalty at each point (opening
-    below zero), but acting on both faces at one place, midway between the point of A and the
-    point of B, by each face's barycentric coordinates there. The two forces then lie on one line
-    and turn neither piece: at the points themselves they would make a couple once the faces have
-    slid (examples/11: four broken joints put 66 J into pieces sliding on their cracks).
+                  tan_phi, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram, anchors, buffer):
+    """Forces of broken joint ``j``: the intact joint's compressive penalty and friction at each
+    point (opening below zero), but acting on both faces at one place, midway between the point
+    of A and the point of B, by each face's barycentric coordinates there. The two forces then lie
+    on one line and turn neither piece (but for the friction's couple across the penetration
+    depth): at the points themselves they would make a couple of the slip times the force once
+    the faces have slid (examples/11: four broken joints put 66 J into pieces sliding on their
+    cracks).
 
     The joint is ``released`` for good (no force ever after) once its faces no longer face each
     other: a point has slid h or more, or the faces have turned more than about 25 degrees
@@ -273,13 +286,19 @@ def _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_are
             return
     share = twice_area / 6.0       # a third of the area per point
     for q in range(3):
-        if openings[q] >= 0.0:
-            continue
-        magnitude = share * openings[q] * penalty_over_h       # < 0: pushes A away from B
-        fx = magnitude * nx
-        fy = magnitude * ny
-        fz = magnitude * nz
+        compression = min(openings[q], 0.0) * penalty_over_h    # < 0: pushes A away from B
         sx, sy, sz = separations[q, 0], separations[q, 1], separations[q, 2]
+        gx = gy = gz = 0.0
+        if tan_phi > 0.0:
+            # the crack's faces keep the joint's friction while they are pressed together
+            gx, gy, gz = _friction(sx - openings[q] * nx, sy - openings[q] * ny,
+                                   sz - openings[q] * nz, compression, tan_phi, penalty_over_h,
+                                   e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram, anchors, j, q)
+        if compression == 0.0:
+            continue
+        fx = share * (compression * nx + gx)
+        fy = share * (compression * ny + gy)
+        fz = share * (compression * nz + gz)
         _spread_on_face(buffer, j, corners, 0, q, 0.5 * sx, 0.5 * sy, 0.5 * sz, fx, fy, fz)
         _spread_on_face(buffer, j, corners, 3, 3 + q, -0.5 * sx, -0.5 * sy, -0.5 * sz,
                         -fx, -fy, -fz)
@@ -337,12 +356,12 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     nx *= inverse
     ny *= inverse
     nz *= inverse
-    if broken[j]:
-        _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, released,
-                      buffer)
-        return 2
     # for the friction anchors: the Gram determinant of the edges is |e1 x e2|^2
     inverse_gram = inverse * inverse
+    if broken[j]:
+        _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, released,
+                      tan_phi, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram, anchors, buffer)
+        return 2
     # a third of the area per point, half of that to each of the point's two vertices
     share = twice_area / 12.0
     # point q sits midway between vertices q and q + 1
