@@ -3,8 +3,9 @@ curve, and bad joint input refused by name."""
 import numpy as np
 import pytest
 
-from riprap.deformable.joints import SOFTENING_AREA, FracturingBody, JointMaterial, explode_mesh
-from riprap.deformable.kernels.joints import softening
+from riprap.deformable.joints import (SOFTENING_AREA, FracturingBody, JointMaterial, explode_mesh,
+                                     joint_slot_table)
+from riprap.deformable.kernels.joints import gather_joint_forces, softening
 from riprap.deformable.material import ElasticMaterial
 from riprap.errors import CaseFileError
 from riprap.geometry.structured import box_mesh
@@ -59,6 +60,27 @@ def test_joints_only_in_a_region_keep_the_rest_of_the_mesh_whole():
     assert len(table["mass"]) == cracking.sum() - 8 + 1
     assert table["mass_fraction"][0] == pytest.approx((48 + 8) / 96)
     assert table["mass"].sum() == pytest.approx(body.mass)
+
+
+@pytest.mark.parametrize("cracking_half", [False, True])
+def test_the_slot_table_sums_every_joint_force_on_its_node(cracking_half):
+    """The nodes' table of joint slots (three a node, the rest in the overflow lists) sums each
+    joint corner's force on its own node: the same as adding them one by one. With a cracking
+    region, the nodes at its edge are shared by several glued tets and have more than three."""
+    nodes, tets = box_mesh((0.2, 0.05, 0.05), (4, 2, 2))
+    cracking = nodes[tets].mean(axis=1)[:, 0] > 0.1 if cracking_half else None
+    split = explode_mesh(nodes, tets, cracking)
+    table, overflow_offsets, overflow_slots = joint_slot_table(split.joints, len(split.nodes))
+    counts = np.bincount(split.joints.ravel(), minlength=len(split.nodes))
+    assert table.shape == (len(split.nodes), 3)
+    assert (counts.max() > 3) == cracking_half and len(overflow_slots) == np.maximum(counts - 3, 0).sum()
+    buffer = np.zeros((len(split.joints) + 1, 6, 3))
+    buffer[:-1] = np.random.default_rng(3).normal(size=(len(split.joints), 6, 3))
+    expected = np.zeros((len(split.nodes), 3))
+    np.add.at(expected, split.joints.ravel(), buffer[:-1].reshape(-1, 3))
+    summed = np.zeros_like(expected)
+    gather_joint_forces(buffer, table, overflow_offsets, overflow_slots, summed)
+    assert np.allclose(summed, expected, rtol=0, atol=1e-12)
 
 
 def test_the_softening_curve_falls_from_one_to_zero():

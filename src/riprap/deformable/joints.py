@@ -188,13 +188,25 @@ def check_crack_resolution(nodes, tets, name: str) -> None:
             f"finer (a shape's mesh_size of at most {thinnest / MIN_TETS_ACROSS:.3g} m)")
 
 
-def node_slots(joints, n_nodes):
-    """(offsets, slots): ``slots[offsets[i]:offsets[i + 1]]`` are the flat (joint * 6 + corner)
-    entries of a joint force buffer that act on node i."""
+def joint_slot_table(joints, n_nodes):
+    """Where each node finds the joints' forces on it, for ``kernels/slots.table_slot_sum``:
+    (table, overflow_offsets, overflow_slots). ``table[i]`` (three wide: every node of a mesh
+    split by joints everywhere has 2 or 3) holds the first flat (joint * 6 + corner) entries of
+    a joint force buffer that act on node i, padded with ``6 * len(joints)``: the buffer has one
+    joint more than ``joints``, whose forces stay zero. A node's further entries (nodes shared
+    by tets glued together at the edge of a cracking region) are
+    ``overflow_slots[overflow_offsets[i]:overflow_offsets[i + 1]]``."""
     flat = np.asarray(joints, dtype=np.int64).reshape(-1)
     order = np.argsort(flat, kind="stable")
     counts = np.bincount(flat, minlength=n_nodes)
-    return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), order.astype(np.int64)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    nodes = flat[order]
+    rank = np.arange(len(order)) - starts[nodes]
+    table = np.full((n_nodes, 3), len(flat), dtype=np.int64)
+    in_table = rank < 3
+    table[nodes[in_table], rank[in_table]] = order[in_table]
+    overflow_offsets = np.concatenate([[0], np.cumsum(np.maximum(counts - 3, 0))])
+    return table, overflow_offsets.astype(np.int64), order[~in_table].astype(np.int64)
 
 
 class FracturingBody(DeformableBody):
@@ -256,8 +268,9 @@ class FracturingBody(DeformableBody):
         self.joint_work = np.zeros(1)
         self._joint_properties = joint_material.kernel_row()[None, :]
         self._joint_material_index = np.zeros(len(joints), dtype=np.int64)
-        self._joint_buffer = np.zeros((len(joints), 6, 3))
-        self._joint_node_offsets, self._joint_node_slots = node_slots(joints, len(exploded))
+        # one joint more, whose forces stay zero: where the slot table is padded
+        self._joint_buffer = np.zeros((len(joints) + 1, 6, 3))
+        self._joint_slot_table = joint_slot_table(joints, len(exploded))
 
     # ------------------------------------------------------------------ steps
     def stable_time_step(self) -> float:
@@ -293,15 +306,14 @@ class FracturingBody(DeformableBody):
                                    self._joint_properties, self._joint_material_index,
                                    self.joint_damage, self.joint_broken, self.joint_released,
                                    self.joint_friction_anchor, self._joint_buffer)
-        joint_kernels.gather_joint_forces(self._joint_buffer, self._joint_node_offsets,
-                                           self._joint_node_slots, forces)
+        joint_kernels.gather_joint_forces(self._joint_buffer, *self._joint_slot_table, forces)
         return forces
 
     def _joint_arguments(self):
         return (self.joints, self.joint_sizes, self._joint_properties, self._joint_material_index,
                 self.joint_damage, self.joint_broken, self._joint_buffer,
-                self._joint_node_offsets, self._joint_node_slots, self.joint_released,
-                self.joint_work, self.joint_friction_anchor)
+                self._joint_slot_table[0], self._joint_slot_table[1], self.joint_released,
+                self.joint_work, self.joint_friction_anchor, self._joint_slot_table[2])
 
     # ------------------------------------------------------------------ results
     @property

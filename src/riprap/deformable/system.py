@@ -20,7 +20,7 @@ from riprap.deformable.body import (NO_TET4_GRADIENTS, PARALLEL_POINTS,
                                     TIME_STEP_SAFETY, DeformableBody, material_table,
                                     no_joints, stable_step_for)
 from riprap.deformable.elements import _OUTWARD_FACES
-from riprap.deformable.joints import FracturingBody, node_slots
+from riprap.deformable.joints import FracturingBody, joint_slot_table
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import finite_strain
 from riprap.errors import CaseFileError
@@ -227,12 +227,13 @@ class DeformableSystem:
             setattr(self, name, joined)
             for i, k in enumerate(fracturing):
                 setattr(self.bodies[k], name, joined[self.joint_offsets[i]:self.joint_offsets[i + 1]])
-        offsets, slots = node_slots(self.joints, n_nodes)
+        table, overflow_offsets, overflow_slots = joint_slot_table(self.joints, n_nodes)
         self.joint_work = np.zeros(1)
+        # (one joint more in the buffer: the zero forces where the slot table is padded)
         self.joint_data = (self.joints, sizes, properties, material, self.joint_damage,
-                           self.joint_broken, np.zeros((len(self.joints), 6, 3)),
-                           offsets, slots, self.joint_released, self.joint_work,
-                           self.joint_friction_anchor)
+                           self.joint_broken, np.zeros((len(self.joints) + 1, 6, 3)),
+                           table, overflow_offsets, self.joint_released, self.joint_work,
+                           self.joint_friction_anchor, overflow_slots)
 
     def _fracturing_surface(self, body) -> tuple:
         """A fracturing body's contact surface now: its outer faces and the faces of its parted

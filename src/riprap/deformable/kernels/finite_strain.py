@@ -21,7 +21,7 @@ import numpy as np
 from riprap._jit import inline_kernel, kernel, parallel_kernel, prange
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import joints as joint_kernels
-from riprap.deformable.kernels.slots import slot_sum
+from riprap.deformable.kernels.slots import slot_sum, table_slot_sum
 
 
 @inline_kernel
@@ -257,7 +257,8 @@ def general_element_forces(positions, velocities, elements, gradients, weights,
 @inline_kernel
 def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained, prescribed_velocities,
-                time_step, nodal_forces, joint_flat, joint_offsets, joint_slots, listed_positions):
+                time_step, nodal_forces, joint_flat, joint_table, joint_overflow_offsets,
+                joint_overflow_slots, listed_positions):
     """Central-difference update of node ``n`` (see :func:`central_difference_update`); returns
     the work of the joints' force on it over the step and its squared distance from
     ``listed_positions`` after it."""
@@ -265,7 +266,8 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
     # written out per axis: a helper per axis (inlined) made the one-thread loop 2 to 3 times
     # slower (numba 0.68, this machine), the threaded one not
     ex, ey, ez = slot_sum(n, flat_forces, node_offsets, node_slots)
-    jx, jy, jz = slot_sum(n, joint_flat, joint_offsets, joint_slots)
+    jx, jy, jz = table_slot_sum(n, joint_flat, joint_table, joint_overflow_offsets,
+                                joint_overflow_slots)
     # the trapezoidal rule for the joints' work, exact for a linear spring (the rectangle rule
     # gains k dx^2 / 2 a step: a steady drift while the joints vibrate): this step's force over
     # the intervals on both sides of it, each at its velocity
@@ -317,15 +319,17 @@ def central_difference_update(positions, velocities, element_forces, node_offset
     reactions and outputs)."""
     flat = element_forces.reshape((-1, 3))
     joint_flat = joint_data[6].reshape((-1, 3))
-    joint_offsets, joint_slots = joint_data[7], joint_data[8]
+    joint_table, joint_overflow_offsets, joint_overflow_slots = (joint_data[7], joint_data[8],
+                                                                 joint_data[12])
     work = 0.0
     largest = 0.0
     for n in prange(positions.shape[0]):
         node_work, moved = update_node(n, positions, velocities, flat, node_offsets, node_slots,
                                        masses, external_forces, contact_forces, gravity,
                                        mass_damping, constrained, prescribed_velocities,
-                                       time_step, nodal_forces, joint_flat, joint_offsets,
-                                       joint_slots, listed_positions)
+                                       time_step, nodal_forces, joint_flat, joint_table,
+                                       joint_overflow_offsets, joint_overflow_slots,
+                                       listed_positions)
         work += node_work
         largest = max(largest, moved)
     return work, largest
@@ -339,15 +343,17 @@ def central_difference_update_serial(positions, velocities, element_forces, node
     """:func:`central_difference_update` on one thread (small bodies: no thread start-up)."""
     flat = element_forces.reshape((-1, 3))
     joint_flat = joint_data[6].reshape((-1, 3))
-    joint_offsets, joint_slots = joint_data[7], joint_data[8]
+    joint_table, joint_overflow_offsets, joint_overflow_slots = (joint_data[7], joint_data[8],
+                                                                 joint_data[12])
     work = 0.0
     largest = 0.0
     for n in range(positions.shape[0]):
         node_work, moved = update_node(n, positions, velocities, flat, node_offsets, node_slots,
                                        masses, external_forces, contact_forces, gravity,
                                        mass_damping, constrained, prescribed_velocities,
-                                       time_step, nodal_forces, joint_flat, joint_offsets,
-                                       joint_slots, listed_positions)
+                                       time_step, nodal_forces, joint_flat, joint_table,
+                                       joint_overflow_offsets, joint_overflow_slots,
+                                       listed_positions)
         work += node_work
         largest = max(largest, moved)
     return work, largest
@@ -473,9 +479,11 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     wall tets, the normal damping ratio per triangle and per tet).
     ``joint_data`` = the joints between tets of fracturing bodies (``riprap/deformable/kernels/joints.py``):
     (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
-    a (n, 6, 3) buffer, the node-to-slot lists of the buffer, released (broken joints whose
-    faces slid apart: no force any more), their work done on the nodes so far (1,), by the
-    trapezoidal rule, and the friction anchors of their points (n, 3, 2)).
+    a (n + 1, 6, 3) buffer (its last joint's forces stay zero), the node's table of slots in
+    the buffer and the offsets of the rest (``joints.joint_slot_table``), released (broken
+    joints whose faces slid apart: no force any more), their work done on the nodes so far (1,),
+    by the trapezoidal rule, the friction anchors of their points (n, 3, 2), and the nodes'
+    slots beyond the table).
     Their forces are added in the node update (not to ``contact_forces``), which also sums
     their work.
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
@@ -486,8 +494,8 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
      tet_stiffness, pair_springs, wall_triangle_springs, wall_tet_springs, triangle_damping,
      tet_damping) = contact
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer, joint_node_offsets, joint_node_slots, joint_released,
-     joint_work, joint_anchors) = joint_data
+     joint_buffer, joint_slot_table, joint_overflow_offsets, joint_released,
+     joint_work, joint_anchors, joint_overflow_slots) = joint_data
     has_joints = joint_nodes.shape[0] > 0
     tet4 = elements.shape[1] == 4
     has_contact = triangles.shape[0] > 0

@@ -37,7 +37,7 @@ import math
 import numpy as np
 
 from riprap._jit import inline_kernel, kernel
-from riprap.deformable.kernels.slots import slot_sum
+from riprap.deformable.kernels.slots import table_slot_sum
 
 SOFTENING_A = 0.63
 SOFTENING_B = 1.8
@@ -418,10 +418,10 @@ def joint_forces(positions, joints, sizes, properties, joint_material, damage, b
 
 
 @kernel
-def gather_joint_forces(buffer, node_offsets, node_slots, out):
-    """out[node] = the joint forces on it: ``node_slots[node_offsets[i]:node_offsets[i+1]]``
-    are the flat (joint * 6 + corner) slots of node i. (The time step sums them in the node
-    update instead: ``finite_strain.update_node``.)"""
+def gather_joint_forces(buffer, table, overflow_offsets, overflow_slots, out):
+    """out[node] = the joint forces on it, from the slots of ``joints.joint_slot_table``. (The
+    time step sums them in the node update instead: ``finite_strain.update_node``.)"""
     flat = buffer.reshape((-1, 3))
     for node in range(out.shape[0]):
-        out[node, 0], out[node, 1], out[node, 2] = slot_sum(node, flat, node_offsets, node_slots)
+        out[node, 0], out[node, 1], out[node, 2] = table_slot_sum(
+            node, flat, table, overflow_offsets, overflow_slots)
