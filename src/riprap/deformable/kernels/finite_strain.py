@@ -225,10 +225,10 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
         for e in range(block * n_tets // FORCE_BLOCKS, (block + 1) * n_tets // FORCE_BLOCKS):
             tet4_element(e, positions, velocities, tets, gradients, volumes, materials,
                          element_material, element_forces, jacobians)
-        for j in range(block * n_joints // FORCE_BLOCKS, (block + 1) * n_joints // FORCE_BLOCKS):
-            joint_kernels.joint_step(j, positions, joint_nodes, joint_sizes, joint_properties,
-                                     joint_material, joint_damage, joint_broken, joint_released,
-                                     joint_anchors, joint_buffer)
+        joint_kernels.joint_range(block * n_joints // FORCE_BLOCKS,
+                                  (block + 1) * n_joints // FORCE_BLOCKS, positions, joint_nodes,
+                                  joint_sizes, joint_properties, joint_material, joint_damage,
+                                  joint_broken, joint_released, joint_anchors, joint_buffer)
 
 
 @kernel

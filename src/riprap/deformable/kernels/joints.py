@@ -115,15 +115,32 @@ def _friction(tx, ty, tz, compression, tan_phi, penalty_over_h, e1x, e1y, e1z, e
 
 
 @inline_kernel
-def _point_traction(sx, sy, sz, nx, ny, nz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h, two_h_over_p,
+def _point_friction(sx, sy, sz, nx, ny, nz, h, tan_phi, penalty_over_h, e1x, e1y, e1z, e2x, e2y,
+                    e2z, inverse_gram, anchors, j, q):
+    """Coulomb friction (``_friction``) at point ``q`` of intact joint ``j`` whose faces are
+    apart by (sx, sy, sz), pressed by the penalty of ``_point_traction``. Moves the point's
+    friction anchor (``anchors[j, q]``: the slip, as multiples of the edges e1 and e2, at which
+    its friction is nil) where the friction slides. Munjiza's f_s = c - tan(phi) sigma inside the
+    elastic-like law gave the energy back on a different path from the one it took: a unit
+    crushing on a rock gained 881 J from its joints (docs/fracture.md)."""
+    opening = sx * nx + sy * ny + sz * nz
+    tx = sx - opening * nx
+    ty = sy - opening * ny
+    tz = sz - opening * nz
+    pressed = opening < 0.0 and tx * tx + ty * ty + tz * tz < h * h
+    compression = opening * penalty_over_h if pressed else 0.0
+    return _friction(tx, ty, tz, compression, tan_phi, penalty_over_h, e1x, e1y, e1z, e2x, e2y,
+                     e2z, inverse_gram, anchors, j, q)
+
+
+@inline_kernel
+def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, penalty_over_h, two_h_over_p,
                     opening_peak, inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i,
-                    inverse_energy_ii, damage, anchors, j, q):
-    """Traction (pulling face A towards B) at point ``q`` of joint ``j`` whose faces are apart
-    by (sx, sy, sz), mid-surface normal n and edges e1, e2 (``inverse_gram`` = 1 / |e1 x e2|^2);
-    and the point's damage after it.
-    ``opening_peak`` = 2 h f_t / p; ``inverse_slip_peak`` = p / (2 h c). Moves the point's
-    friction anchor (``anchors[j, q]``: the slip, as multiples of e1 and e2, at which its
-    friction is nil) where the friction slides. (Divisions and square roots are most of a joint's
+                    inverse_energy_ii, damage, j, q):
+    """Cohesive traction and compressive penalty (pulling face A towards B) at point ``q`` of
+    joint ``j`` whose faces are apart by (sx, sy, sz), mid-surface normal n; and the point's
+    damage after it. ``opening_peak`` = 2 h f_t / p; ``inverse_slip_peak`` = p / (2 h c). (The
+    friction is added by ``_point_friction``. Divisions and square roots are most of a joint's
     cost: each is taken once per joint where it can be.)"""
     opening = sx * nx + sy * ny + sz * nz
     tx = sx - opening * nx
@@ -159,16 +176,6 @@ def _point_traction(sx, sy, sz, nx, ny, nz, e1x, e1y, e1z, e2x, e2y, e2z, invers
     fx = sigma * nx + shear_over_slip * tx
     fy = sigma * ny + shear_over_slip * ty
     fz = sigma * nz + shear_over_slip * tz
-    if tan_phi > 0.0:
-        # Coulomb friction on top of the cohesion (``_friction``). Munjiza's f_s = c - tan(phi)
-        # sigma inside the elastic-like law above gave the energy back on a different path from
-        # the one it took: a unit crushing on a rock gained 881 J from its joints
-        # (docs/fracture.md).
-        gx, gy, gz = _friction(tx, ty, tz, compression, tan_phi, penalty_over_h, e1x, e1y, e1z,
-                               e2x, e2y, e2z, inverse_gram, anchors, j, q)
-        fx += gx
-        fy += gy
-        fz += gz
     return fx, fy, fz, current
 
 
@@ -242,8 +249,8 @@ def _face_cosine(corners):
 
 
 @inline_kernel
-def _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, released,
-                  tan_phi, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram, anchors, buffer):
+def _broken_joint(j, positions, joints, sizes, properties, joint_material, released, anchors,
+                  buffer):
     """Forces of broken joint ``j``: the intact joint's compressive penalty and friction at each
     point (opening below zero), but acting on both faces at one place, midway between the point
     of A and the point of B, by each face's barycentric coordinates there. The two forces then lie
@@ -264,8 +271,28 @@ def _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_are
         for d in range(3):
             corners[k, d] = positions[joints[j, k], d]
             buffer[j, k, d] = 0.0
-    if released[j]:
+    # the mid-surface, as for an intact joint (``_joint``)
+    mid = np.empty((3, 3))
+    for k in range(3):
+        for d in range(3):
+            mid[k, d] = corners[k, d] + 0.5 * (corners[3 + k, d] - corners[k, d])
+    e1x, e1y, e1z = mid[1, 0] - mid[0, 0], mid[1, 1] - mid[0, 1], mid[1, 2] - mid[0, 2]
+    e2x, e2y, e2z = mid[2, 0] - mid[0, 0], mid[2, 1] - mid[0, 1], mid[2, 2] - mid[0, 2]
+    nx = e1y * e2z - e1z * e2y
+    ny = e1z * e2x - e1x * e2z
+    nz = e1x * e2y - e1y * e2x
+    twice_area = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if twice_area <= 0.0 or released[j]:
         return
+    inverse = 1.0 / twice_area
+    nx *= inverse
+    ny *= inverse
+    nz *= inverse
+    inverse_gram = inverse * inverse
+    row = joint_material[j]
+    tan_phi = properties[row, 2]
+    h = sizes[j]
+    penalty_over_h = properties[row, 3] / h
     if _face_cosine(corners) < RELEASE_FACE_COSINE:
         released[j] = True
         return
@@ -305,10 +332,9 @@ def _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_are
 
 
 @inline_kernel
-def _joint(j, positions, joints, sizes, properties, joint_material, damage, broken, released,
-           anchors, buffer):
-    """Forces of joint ``j`` on its six nodes into ``buffer[j]`` (6, 3); updates its damage and
-    friction anchors. Returns the number of its points at D >= 1."""
+def _joint(j, positions, joints, sizes, properties, joint_material, damage, anchors, buffer):
+    """Forces of intact joint ``j`` on its six nodes into ``buffer[j]`` (6, 3); updates its damage
+    and friction anchors. Returns the number of its points at D >= 1."""
     row = joint_material[j]
     tensile = properties[row, 0]
     cohesion = properties[row, 1]
@@ -358,31 +384,42 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
     nz *= inverse
     # for the friction anchors: the Gram determinant of the edges is |e1 x e2|^2
     inverse_gram = inverse * inverse
-    if broken[j]:
-        _broken_joint(j, positions, joints, h, penalty_over_h, nx, ny, nz, twice_area, released,
-                      tan_phi, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram, anchors, buffer)
-        return 2
     # a third of the area per point, half of that to each of the point's two vertices
     share = twice_area / 12.0
     # point q sits midway between vertices q and q + 1
     t0x, t0y, t0z, d0 = _point_traction(
-        0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, e1x, e1y, e1z,
-        e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h,
-        two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak,
-        tensile_over_energy_i, inverse_energy_ii,
-        damage, anchors, j, 0)
+        0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, h, tensile,
+        cohesion, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
+        inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii, damage, j, 0)
     t1x, t1y, t1z, d1 = _point_traction(
-        0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, e1x, e1y, e1z,
-        e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h,
-        two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak,
-        tensile_over_energy_i, inverse_energy_ii,
-        damage, anchors, j, 1)
+        0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, h, tensile,
+        cohesion, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
+        inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii, damage, j, 1)
     t2x, t2y, t2z, d2 = _point_traction(
-        0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, e1x, e1y, e1z,
-        e2x, e2y, e2z, inverse_gram, h, tensile, cohesion, tan_phi, penalty_over_h,
-        two_h_over_p, opening_peak, inverse_opening_peak, inverse_slip_peak,
-        tensile_over_energy_i, inverse_energy_ii,
-        damage, anchors, j, 2)
+        0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, h, tensile,
+        cohesion, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
+        inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii, damage, j, 2)
+    if tan_phi > 0.0:
+        # after the three points' laws, not inside them: the friction's code inside the point's
+        # law made every joint about 10 % slower, even with no friction (bench/joint_kernel.py)
+        g0x, g0y, g0z = _point_friction(0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z),
+                                        nx, ny, nz, h, tan_phi, penalty_over_h, e1x, e1y, e1z,
+                                        e2x, e2y, e2z, inverse_gram, anchors, j, 0)
+        g1x, g1y, g1z = _point_friction(0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z),
+                                        nx, ny, nz, h, tan_phi, penalty_over_h, e1x, e1y, e1z,
+                                        e2x, e2y, e2z, inverse_gram, anchors, j, 1)
+        g2x, g2y, g2z = _point_friction(0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z),
+                                        nx, ny, nz, h, tan_phi, penalty_over_h, e1x, e1y, e1z,
+                                        e2x, e2y, e2z, inverse_gram, anchors, j, 2)
+        t0x += g0x
+        t0y += g0y
+        t0z += g0z
+        t1x += g1x
+        t1y += g1y
+        t1z += g1z
+        t2x += g2x
+        t2y += g2y
+        t2z += g2z
     failed = int(d0 >= 1.0) + int(d1 >= 1.0) + int(d2 >= 1.0)
     # vertex k takes the points on its two edges: q = k and q = k - 1
     _put_vertex(buffer, j, 0, share * (t0x + t2x), share * (t0y + t2y), share * (t0z + t2z))
@@ -392,29 +429,35 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, brok
 
 
 @inline_kernel
-def joint_step(j, positions, joints, sizes, properties, joint_material, damage, broken, released,
-               anchors, buffer):
-    """``_joint``, then mark the joint broken once two of its points are at D >= 1; returns 1 if
-    it broke now."""
-    failed = _joint(j, positions, joints, sizes, properties, joint_material, damage, broken,
-                    released, anchors, buffer)
-    if failed >= 2 and not broken[j]:
-        broken[j] = True
-        return 1
-    return 0
+def joint_range(start, stop, positions, joints, sizes, properties, joint_material, damage, broken,
+                released, anchors, buffer):
+    """Forces of joints ``start`` .. ``stop - 1`` into ``buffer``: first the broken ones
+    (``_broken_joint``), then the intact ones (``_joint``), of which those with two or more
+    points at D >= 1 are marked ``broken`` (they act as broken joints from the next step on).
+    Returns the number broken now. (Two loops: the broken joints' code inside the intact joints'
+    loop made every joint about 15 % slower, though few joints ever break: bench/joint_kernel.py.)"""
+    for j in range(start, stop):
+        if broken[j]:
+            _broken_joint(j, positions, joints, sizes, properties, joint_material, released,
+                          anchors, buffer)
+    newly = 0
+    for j in range(start, stop):
+        if not broken[j]:
+            if _joint(j, positions, joints, sizes, properties, joint_material, damage, anchors,
+                      buffer) >= 2:
+                broken[j] = True
+                newly += 1
+    return newly
 
 
 @kernel
 def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, released,
                  anchors, buffer):
-    """Forces of every joint (``_joint``) into ``buffer`` (n_joints, 6, 3); a joint with two or
-    more points at D >= 1 is marked ``broken``. Returns the number broken now. (On threads, the
-    joints run in the loop of the tets' forces: ``finite_strain.tet4_and_joint_forces``.)"""
-    newly = 0
-    for j in range(joints.shape[0]):
-        newly += joint_step(j, positions, joints, sizes, properties, joint_material, damage,
-                             broken, released, anchors, buffer)
-    return newly
+    """Forces of every joint (``joint_range``) into ``buffer`` (n_joints, 6, 3); a joint with two
+    or more points at D >= 1 is marked ``broken``. Returns the number broken now. (On threads,
+    the joints run in the loop of the tets' forces: ``finite_strain.tet4_and_joint_forces``.)"""
+    return joint_range(0, joints.shape[0], positions, joints, sizes, properties, joint_material,
+                       damage, broken, released, anchors, buffer)
 
 
 @kernel
