@@ -66,6 +66,8 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=1000)
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
+    if args.steps < 1 or args.repeats < 1:
+        parser.error(f"--steps and --repeats must be at least 1 (got {args.steps}, {args.repeats})")
     print(f"{numba.config.NUMBA_NUM_THREADS} threads; {CASE.relative_to(CASE.parents[2])}")
     best, systems = step_times(args.steps, args.repeats)
     plain, jointed = best[False], best[True]
