@@ -264,7 +264,9 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
     ``listed_positions`` after it."""
     m = masses[n]
     # written out per axis: a helper per axis (inlined) made the one-thread loop 2 to 3 times
-    # slower (numba 0.68, this machine), the threaded one not
+    # slower (numba 0.68, this machine), the threaded one not. Both velocities are loaded before
+    # the choice: an array read inside the conditional expression made numba take references to
+    # four arrays per node in the one-thread loop (atomic counts; 3.4 times slower)
     ex, ey, ez = slot_sum(n, flat_forces, node_offsets, node_slots)
     jx, jy, jz = table_slot_sum(n, joint_flat, joint_table, joint_overflow_offsets,
                                 joint_overflow_slots)
@@ -275,7 +277,9 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
     total = (external_forces[n, 0] + contact_forces[n, 0] + m * gravity[0]
              - mass_damping * m * before + ex + jx)
     nodal_forces[n, 0] = total
-    velocity = prescribed_velocities[n, 0] if constrained[n, 0] else before + time_step * total / m
+    free = before + time_step * total / m
+    held = prescribed_velocities[n, 0]
+    velocity = held if constrained[n, 0] else free
     velocities[n, 0] = velocity
     positions[n, 0] += time_step * velocity
     wx = (before + velocity) * jx
@@ -283,7 +287,9 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
     total = (external_forces[n, 1] + contact_forces[n, 1] + m * gravity[1]
              - mass_damping * m * before + ey + jy)
     nodal_forces[n, 1] = total
-    velocity = prescribed_velocities[n, 1] if constrained[n, 1] else before + time_step * total / m
+    free = before + time_step * total / m
+    held = prescribed_velocities[n, 1]
+    velocity = held if constrained[n, 1] else free
     velocities[n, 1] = velocity
     positions[n, 1] += time_step * velocity
     wy = (before + velocity) * jy
@@ -291,7 +297,9 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
     total = (external_forces[n, 2] + contact_forces[n, 2] + m * gravity[2]
              - mass_damping * m * before + ez + jz)
     nodal_forces[n, 2] = total
-    velocity = prescribed_velocities[n, 2] if constrained[n, 2] else before + time_step * total / m
+    free = before + time_step * total / m
+    held = prescribed_velocities[n, 2]
+    velocity = held if constrained[n, 2] else free
     velocities[n, 2] = velocity
     positions[n, 2] += time_step * velocity
     wz = (before + velocity) * jz
