@@ -60,9 +60,11 @@ def clip(polygon, n_vertices, signed, n_columns, out):
 
 
 @kernel
-def product_integrals(polygon, n_vertices, a_column, b_first, n_b, out):
-    """out[j] += int polygon[:, a_column] * polygon[:, b_first + j] dA for j < n_b over a planar
-    convex polygon (exact: edge-midpoint rule on each fan triangle). Returns the area."""
+def product_integrals(polygon, n_vertices, a_column, b_first, n_b, out, out_first):
+    """out[out_first + j] += int polygon[:, a_column] * polygon[:, b_first + j] dA for j < n_b
+    over a planar convex polygon (exact: edge-midpoint rule on each fan triangle). Returns the
+    area. (An offset, not a slice of ``out``: a slice per call cost an atomic reference count
+    each way, most of a contact pair's time.)"""
     total_area = 0.0
     for i in range(1, n_vertices - 1):
         ax = polygon[i, 0] - polygon[0, 0]
@@ -86,28 +88,28 @@ def product_integrals(polygon, n_vertices, a_column, b_first, n_b, out):
             a_mid = 0.5 * (polygon[p, a_column] + polygon[q, a_column])
             for j in range(n_b):
                 b_mid = 0.5 * (polygon[p, b_first + j] + polygon[q, b_first + j])
-                out[j] += area / 3.0 * a_mid * b_mid
+                out[out_first + j] += area / 3.0 * a_mid * b_mid
     return total_area
 
 
 @kernel
-def barycentric_map(positions, tet, out):
-    """Rows k = (a_k, b_k) with lambda_k(x) = a_k . x + b_k for the tet's current corners, (4, 4).
-    Returns False for a flat tet."""
-    n0 = tet[0]
+def barycentric_map(positions, tets, t, out):
+    """Rows k = (a_k, b_k) with lambda_k(x) = a_k . x + b_k for the current corners of tet
+    ``tets[t]``, (4, 4). Returns False for a flat tet."""
+    n0 = tets[t, 0]
     x0 = positions[n0, 0]
     y0 = positions[n0, 1]
     z0 = positions[n0, 2]
     # columns: edges from corner 0 to corners 1, 2, 3
-    a00 = positions[tet[1], 0] - x0
-    a10 = positions[tet[1], 1] - y0
-    a20 = positions[tet[1], 2] - z0
-    a01 = positions[tet[2], 0] - x0
-    a11 = positions[tet[2], 1] - y0
-    a21 = positions[tet[2], 2] - z0
-    a02 = positions[tet[3], 0] - x0
-    a12 = positions[tet[3], 1] - y0
-    a22 = positions[tet[3], 2] - z0
+    a00 = positions[tets[t, 1], 0] - x0
+    a10 = positions[tets[t, 1], 1] - y0
+    a20 = positions[tets[t, 1], 2] - z0
+    a01 = positions[tets[t, 2], 0] - x0
+    a11 = positions[tets[t, 2], 1] - y0
+    a21 = positions[tets[t, 2], 2] - z0
+    a02 = positions[tets[t, 3], 0] - x0
+    a12 = positions[tets[t, 3], 1] - y0
+    a22 = positions[tets[t, 3], 2] - z0
     # cofactors c_ij of the edge matrix; its inverse is c^T / det
     c00 = a11 * a22 - a12 * a21
     c01 = a12 * a20 - a10 * a22
@@ -167,18 +169,20 @@ def polygon_normal(polygon):
 
 
 @kernel
-def triangle_in_tet(positions, triangle, tet, lam_map, penalty, forces, scratch, velocities,
-                    masses, friction_coefficient, damping_ratio, tangential_stiffness, time_step,
-                    spring):
-    """Forces of the potential of ``tet`` on the boundary ``triangle`` (outward, counter-clockwise)
-    of another body: added to ``forces`` at the triangle's and the tet's nodes. Returns
-    (force on the triangle's body along its... magnitude p int phi dS, contact area)."""
-    polygon, work, signed, integrals, piece, _ = scratch
+def triangle_in_tet(positions, triangles, tri, tets, t, lam_map, penalty, forces, polygon, work,
+                    signed, integrals, piece, node_force, velocities, masses, friction_coefficient,
+                    damping_ratio, tangential_stiffness, time_step, springs, q):
+    """Forces of the potential of tet ``tets[t]`` on the boundary triangle ``triangles[tri]``
+    (outward, counter-clockwise) of another body: added to ``forces`` at the triangle's and the
+    tet's nodes; the pair's tangential spring is ``springs[q]``. ``polygon`` .. ``node_force`` are
+    scratch arrays (``make_scratch``). Returns (force on the triangle's body along its...
+    magnitude p int phi dS, contact area). (Rows are passed by index, never as slices: each
+    slice cost an atomic reference count each way, most of a pair's time.)"""
     # quick rejection: all three corners outside the same face of the tet
     for k in range(4):
         outside = 0
         for v in range(3):
-            node = triangle[v]
+            node = triangles[tri, v]
             if (lam_map[k, 0] * positions[node, 0] + lam_map[k, 1] * positions[node, 1]
                     + lam_map[k, 2] * positions[node, 2] + lam_map[k, 3]) < 0.0:
                 outside += 1
@@ -186,7 +190,7 @@ def triangle_in_tet(positions, triangle, tet, lam_map, penalty, forces, scratch,
             return 0.0, 0.0
     # the triangle's plane normal (outward, unit) and its vertices with N_v and lambda_k
     for v in range(3):
-        node = triangle[v]
+        node = triangles[tri, v]
         for c in range(3):
             polygon[v, c] = positions[node, c]
         for w in range(3):
@@ -213,7 +217,6 @@ def triangle_in_tet(positions, triangle, tet, lam_map, penalty, forces, scratch,
                 polygon[v, c] = work[v, c]
     area = 0.0
     # node weights of the normal force: [0:3] the triangle's nodes, [3:7] the tet's
-    node_force = scratch[5]
     for i in range(7):
         node_force[i] = 0.0
     for j in range(4):
@@ -222,53 +225,53 @@ def triangle_in_tet(positions, triangle, tet, lam_map, penalty, forces, scratch,
             continue
         for i in range(7):
             integrals[i] = 0.0
-        area += product_integrals(piece, mj, _LAMBDA + j, _N, 3, integrals[0:3])
-        product_integrals(piece, mj, _LAMBDA + j, _LAMBDA, 4, integrals[3:7])
+        area += product_integrals(piece, mj, _LAMBDA + j, _N, 3, integrals, 0)
+        product_integrals(piece, mj, _LAMBDA + j, _LAMBDA, 4, integrals, 3)
         for i in range(7):
             node_force[i] += 4.0 * penalty * integrals[i]
     weight = node_force[0] + node_force[1] + node_force[2]
     if weight <= 0.0:
         return 0.0, area
     for v in range(3):
-        node = triangle[v]
+        node = triangles[tri, v]
         forces[node, 0] -= node_force[v] * nx
         forces[node, 1] -= node_force[v] * ny
         forces[node, 2] -= node_force[v] * nz
     for k in range(4):
-        node = tet[k]
+        node = tets[t, k]
         forces[node, 0] += node_force[3 + k] * nx
         forces[node, 1] += node_force[3 + k] * ny
         forces[node, 2] += node_force[3 + k] * nz
     if friction_coefficient > 0.0 or damping_ratio > 0.0:
         # tangential stiffness: a share of the normal one, p A / h with h the tet's potential depth
-        apply_friction(triangle, tet, node_force, weight, nx, ny, nz, velocities, masses,
-                       friction_coefficient, tangential_stiffness * area, damping_ratio, time_step,
-                       spring, forces)
+        apply_friction(triangles, tri, tets, t, node_force, weight, nx, ny, nz, velocities,
+                       masses, friction_coefficient, tangential_stiffness * area, damping_ratio,
+                       time_step, springs, q, forces)
     return weight, area
 
 
 @kernel
-def spring_friction(spring, tx, ty, tz, nx, ny, nz, stiffness, limit, time_step):
-    """Coulomb friction by an elastic tangential spring, as for rigid bodies: the spring (3,
-    updated in place) is turned into the present tangent plane, stretched by the relative
-    tangential velocity (tx, ty, tz) times the step, and cut back to ``limit`` / ``stiffness``
+def spring_friction(springs, q, tx, ty, tz, nx, ny, nz, stiffness, limit, time_step):
+    """Coulomb friction by an elastic tangential spring, as for rigid bodies: the spring
+    ``springs[q]`` (3, updated in place) is turned into the present tangent plane, stretched by the
+    relative tangential velocity (tx, ty, tz) times the step, and cut back to ``limit`` / ``stiffness``
     when it would pull harder than ``limit`` (sliding). Returns the force on the first side."""
-    length = np.sqrt(spring[0] ** 2 + spring[1] ** 2 + spring[2] ** 2)
-    along = spring[0] * nx + spring[1] * ny + spring[2] * nz
+    length = np.sqrt(springs[q, 0] ** 2 + springs[q, 1] ** 2 + springs[q, 2] ** 2)
+    along = springs[q, 0] * nx + springs[q, 1] * ny + springs[q, 2] * nz
     for c, n in ((0, nx), (1, ny), (2, nz)):
-        spring[c] -= along * n
-    turned = np.sqrt(spring[0] ** 2 + spring[1] ** 2 + spring[2] ** 2)
+        springs[q, c] -= along * n
+    turned = np.sqrt(springs[q, 0] ** 2 + springs[q, 1] ** 2 + springs[q, 2] ** 2)
     if turned > 0.0:
         for c in range(3):
-            spring[c] *= length / turned
-    spring[0] += tx * time_step
-    spring[1] += ty * time_step
-    spring[2] += tz * time_step
-    pull = stiffness * np.sqrt(spring[0] ** 2 + spring[1] ** 2 + spring[2] ** 2)
+            springs[q, c] *= length / turned
+    springs[q, 0] += tx * time_step
+    springs[q, 1] += ty * time_step
+    springs[q, 2] += tz * time_step
+    pull = stiffness * np.sqrt(springs[q, 0] ** 2 + springs[q, 1] ** 2 + springs[q, 2] ** 2)
     if pull > limit:
         for c in range(3):
-            spring[c] *= limit / pull
-    return -stiffness * spring[0], -stiffness * spring[1], -stiffness * spring[2]
+            springs[q, c] *= limit / pull
+    return -stiffness * springs[q, 0], -stiffness * springs[q, 1], -stiffness * springs[q, 2]
 
 
 @kernel
@@ -281,11 +284,11 @@ def reduced_mass(side_a, side_b):
 
 
 @kernel
-def apply_friction(triangle, tet, node_force, weight, nx, ny, nz, velocities, masses,
-                   friction_coefficient, stiffness, damping_ratio, time_step, spring, forces):
+def apply_friction(triangles, tri, tets, t, node_force, weight, nx, ny, nz, velocities, masses,
+                   friction_coefficient, stiffness, damping_ratio, time_step, springs, q, forces):
     """Friction and normal damping of one (triangle, tet) contact with normal force ``weight``
     spread over its nodes as ``node_force``: a tangential spring of ``stiffness`` (N/m) between the
-    two sides at the force's centre (:func:`spring_friction`), and a dashpot on their normal
+    two sides at the force's centre (``springs[q]``) (:func:`spring_friction`), and a dashpot on their normal
     relative speed with ``damping_ratio`` of the contact's normal stiffness (taken as the tangential
     one over 2/7) and their lumped masses, clipped so that the contact never pulls; spread with the
     same weights, equal and opposite."""
@@ -293,20 +296,20 @@ def apply_friction(triangle, tet, node_force, weight, nx, ny, nz, velocities, ma
     side_a = side_b = 0.0
     for v in range(3):
         share = node_force[v] / weight
-        node = triangle[v]
+        node = triangles[tri, v]
         rx += share * velocities[node, 0]
         ry += share * velocities[node, 1]
         rz += share * velocities[node, 2]
         side_a += share * masses[node]
     for k in range(4):
         share = node_force[3 + k] / weight
-        node = tet[k]
+        node = tets[t, k]
         rx -= share * velocities[node, 0]
         ry -= share * velocities[node, 1]
         rz -= share * velocities[node, 2]
         side_b += share * masses[node]
     normal = rx * nx + ry * ny + rz * nz
-    fx, fy, fz = spring_friction(spring, rx - normal * nx, ry - normal * ny, rz - normal * nz,
+    fx, fy, fz = spring_friction(springs, q, rx - normal * nx, ry - normal * ny, rz - normal * nz,
                                  nx, ny, nz, stiffness, friction_coefficient * weight, time_step)
     if damping_ratio > 0.0:
         # n points out of the triangle's body: approaching sides have normal > 0
@@ -319,13 +322,13 @@ def apply_friction(triangle, tet, node_force, weight, nx, ny, nz, velocities, ma
         fz += dashpot * nz
     for v in range(3):
         share = node_force[v] / weight
-        node = triangle[v]
+        node = triangles[tri, v]
         forces[node, 0] += share * fx
         forces[node, 1] += share * fy
         forces[node, 2] += share * fz
     for k in range(4):
         share = node_force[3 + k] / weight
-        node = tet[k]
+        node = tets[t, k]
         forces[node, 0] -= share * fx
         forces[node, 1] -= share * fy
         forces[node, 2] -= share * fz
@@ -347,7 +350,7 @@ def pair_forces(positions, triangles, tets, pairs, penalty, forces, velocities, 
     per m^2 of contact) times its
     contact area, its spring ``springs[pair]`` (zeroed while the pair does not touch). Returns
     (total p int phi dS, contact area)."""
-    scratch = make_scratch()
+    polygon, work, signed, integrals, piece, node_force = make_scratch()
     lam_map = np.empty((4, 4))
     weight = 0.0
     area = 0.0
@@ -356,16 +359,16 @@ def pair_forces(positions, triangles, tets, pairs, penalty, forces, velocities, 
     for q in range(pairs.shape[0]):
         t = pairs[q, 1]
         if t != last:
-            valid = barycentric_map(positions, tets[t], lam_map)
+            valid = barycentric_map(positions, tets, t, lam_map)
             last = t
         if not valid:
             continue
         tri = pairs[q, 0]
-        w, a = triangle_in_tet(positions, triangles[tri], tets[t], lam_map, penalty, forces,
-                               scratch, velocities, masses,
-                               min(triangle_friction[tri], tet_friction[t]),
+        w, a = triangle_in_tet(positions, triangles, tri, tets, t, lam_map, penalty, forces,
+                               polygon, work, signed, integrals, piece, node_force, velocities,
+                               masses, min(triangle_friction[tri], tet_friction[t]),
                                min(triangle_damping[tri], tet_damping[t]), tet_stiffness[t],
-                               time_step, springs[q])
+                               time_step, springs, q)
         if w == 0.0:
             springs[q, 0] = springs[q, 1] = springs[q, 2] = 0.0
         weight += w
@@ -445,7 +448,7 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
             continue
         for i in range(3):
             integrals[i] = 0.0
-        piece_area = product_integrals(work, m, 3, 4, 3, integrals[0:3])
+        piece_area = product_integrals(work, m, 3, 4, 3, integrals, 0)
         area += 0.5 * piece_area
         cosine = -(nx * wall_normal[0] + ny * wall_normal[1] + nz * wall_normal[2]) / norm
         pushed = 0.0
@@ -460,9 +463,9 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
         total += pushed
         mu = min(triangle_friction[tri], wall_friction)
         if (mu > 0.0 or triangle_damping[tri] > 0.0) and pushed > 0.0:
-            slide_on_wall(triangles[tri], 3, node_force, pushed, wall_normal, velocities, masses,
+            slide_on_wall(triangles, tri, 3, node_force, pushed, wall_normal, velocities, masses,
                           mu, tangential_ratio * penalty * piece_area / wall_depths[tri],
-                          triangle_damping[tri], time_step, triangle_springs[tri], forces)
+                          triangle_damping[tri], time_step, triangle_springs, tri, forces)
     # (ii) the wall plane inside the body's tets: p phi_t n, spread with lambda_k
     depths = np.empty(4)
     for t in range(tets.shape[0]):
@@ -492,7 +495,7 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
                 continue
             for i in range(4):
                 integrals[i] = 0.0
-            section_area += product_integrals(piece, mj, 3 + j, 3, 4, integrals[0:4])
+            section_area += product_integrals(piece, mj, 3 + j, 3, 4, integrals, 0)
             for k in range(4):
                 node_force[k] += 4.0 * penalty * integrals[k]
         pushed = 0.0
@@ -505,18 +508,18 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
         area += 0.5 * section_area
         mu = min(tet_friction[t], wall_friction)
         if (mu > 0.0 or tet_damping[t] > 0.0) and pushed > 0.0:
-            slide_on_wall(tets[t], 4, node_force, pushed, wall_normal, velocities, masses, mu,
+            slide_on_wall(tets, t, 4, node_force, pushed, wall_normal, velocities, masses, mu,
                           tet_stiffness[t] * section_area, tet_damping[t], time_step,
-                          tet_springs[t], forces)
+                          tet_springs, t, forces)
     return total, area
 
 
 @kernel
-def slide_on_wall(nodes, count, node_force, normal_force, wall_normal, velocities, masses,
-                  friction_coefficient, stiffness, damping_ratio, time_step, spring, forces):
-    """Friction and normal damping of ``count`` nodes pressed on a still wall with
-    ``normal_force`` spread as ``node_force``, as :func:`apply_friction` with a still, infinitely
-    heavy second side."""
+def slide_on_wall(nodes, row, count, node_force, normal_force, wall_normal, velocities, masses,
+                  friction_coefficient, stiffness, damping_ratio, time_step, springs, q, forces):
+    """Friction and normal damping of the ``count`` nodes ``nodes[row]`` pressed on a still wall
+    with ``normal_force`` spread as ``node_force``, as :func:`apply_friction` with a still,
+    infinitely heavy second side (tangential spring ``springs[q]``)."""
     total = 0.0
     for i in range(count):
         total += node_force[i]
@@ -526,13 +529,13 @@ def slide_on_wall(nodes, count, node_force, normal_force, wall_normal, velocitie
     mass = 0.0
     for i in range(count):
         share = node_force[i] / total
-        node = nodes[i]
+        node = nodes[row, i]
         vx += share * velocities[node, 0]
         vy += share * velocities[node, 1]
         vz += share * velocities[node, 2]
         mass += share * masses[node]
     normal = vx * wall_normal[0] + vy * wall_normal[1] + vz * wall_normal[2]
-    fx, fy, fz = spring_friction(spring, vx - normal * wall_normal[0], vy - normal * wall_normal[1],
+    fx, fy, fz = spring_friction(springs, q, vx - normal * wall_normal[0], vy - normal * wall_normal[1],
                                  vz - normal * wall_normal[2], wall_normal[0], wall_normal[1],
                                  wall_normal[2], stiffness, friction_coefficient * normal_force,
                                  time_step)
@@ -545,7 +548,7 @@ def slide_on_wall(nodes, count, node_force, normal_force, wall_normal, velocitie
         fz += dashpot * wall_normal[2]
     for i in range(count):
         share = node_force[i] / total
-        node = nodes[i]
+        node = nodes[row, i]
         forces[node, 0] += share * fx
         forces[node, 1] += share * fy
         forces[node, 2] += share * fz
