@@ -111,6 +111,10 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
 
     (_, _, _, _, _, vertices, lam, normal, centre, candidates, stamp,
      counter, tri_lo, tri_hi, i_lo, i_hi, _, _, _, _) = scratch
+    # the potential body's box, taken once: a slice per call in the loops below cost an atomic
+    # reference count each way, shared by the threads
+    shape_lo = local_box_min[sp]
+    shape_hi = local_box_max[sp]
     # stamp[t] == counter means tet t is already listed for the current triangle: O(1)
     # de-duplication; the counter keeps growing across calls so stale stamps never match.
 
@@ -119,7 +123,7 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
             centre[c] = (rotation[c, 0] * cluster_centres[cl, 0] + rotation[c, 1] * cluster_centres[cl, 1]
                          + rotation[c, 2] * cluster_centres[cl, 2] + translation[c])
         if _sphere_far(centre, cluster_radii[cl] + skin, box_lo, box_hi, origin, cell, nx, ny, nz,
-                       cell_clearance, coff, local_box_min[sp], local_box_max[sp]):
+                       cell_clearance, coff, shape_lo, shape_hi):
             continue
         for tri_local in range(cluster_begin[cl], cluster_end[cl]):
             tri = troff + tri_local
@@ -127,7 +131,7 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
                 centre[c] = (rotation[c, 0] * triangle_centres[tri, 0] + rotation[c, 1] * triangle_centres[tri, 1]
                              + rotation[c, 2] * triangle_centres[tri, 2] + translation[c])
             if _sphere_far(centre, triangle_radii[tri] + skin, box_lo, box_hi, origin, cell, nx, ny,
-                           nz, cell_clearance, coff, local_box_min[sp], local_box_max[sp]):
+                           nz, cell_clearance, coff, shape_lo, shape_hi):
                 continue
             _place_triangle(rotation, translation, nodes, noff_s, triangles, triangle_normals, tri,
                             vertices, normal)
@@ -267,8 +271,8 @@ def integrate_pieces(surface_shape, potential_shape, rotation, translation, pena
         for m in range(6):
             moments[m] = 0.0
         result[R_CLIPPED] += 1.0
-        integrate_tet_potential_on_triangle(lam, vertices, barycentric[t, :, 0:3], normal,
-                                            polygons, signed, moments)
+        integrate_tet_potential_on_triangle(lam, vertices, barycentric, t, normal, polygons,
+                                            signed, moments)
         if moments[0] <= 0.0:
             continue
         # Force on the surface body: -p phi n dS; moment about the potential body's centroid.

@@ -187,7 +187,7 @@ def integrate_tet_potential_on_polygon(polygon, n_vertices, gradients, normal, w
 
 
 @kernel
-def integrate_tet_potential_on_triangle(lam, vertices, gradients, normal, polygons, signed,
+def integrate_tet_potential_on_triangle(lam, vertices, barycentric, t, normal, polygons, signed,
                                         moments):
     """Integrate a tet's potential phi = 4 min_k lambda_k over the part of a triangle inside the
     tet, adding to ``moments`` the same quantities as :func:`integrate_tet_potential_on_polygon`
@@ -196,7 +196,8 @@ def integrate_tet_potential_on_triangle(lam, vertices, gradients, normal, polygo
     The clipping is done in the triangle's own affine coordinates (mu1, mu2), x = V0 + mu1 (V1 -
     V0) + mu2 (V2 - V0): every lambda_k is affine in them, so a polygon is two columns, a clipping
     line three numbers, and dA = 2 A dmu with A the triangle's area. ``lam`` (3, 4): barycentrics
-    of the three vertices; ``gradients`` (4, 3): grad lambda_k; ``polygons`` (3, MAX_POLYGON, 2)
+    of the three vertices; ``barycentric[t, k, 0:3]``: grad lambda_k (the tet's row, not a slice of
+    it: a slice per piece cost an atomic reference count each way); ``polygons`` (3, MAX_POLYGON, 2)
     and ``signed`` (MAX_POLYGON,): work arrays. The triangle is counter-clockwise about ``normal``.
     """
     ex = vertices[1, 0] - vertices[0, 0]
@@ -284,8 +285,8 @@ def integrate_tet_potential_on_triangle(lam, vertices, gradients, normal, polygo
         first_1 += piece_1
         first_2 += piece_2
         area_mu += piece_area
-        g = 4.0 * (gradients[k, 0] * normal[0] + gradients[k, 1] * normal[1]
-                   + gradients[k, 2] * normal[2])
+        g = 4.0 * (barycentric[t, k, 0] * normal[0] + barycentric[t, k, 1] * normal[1]
+                   + barycentric[t, k, 2] * normal[2])
         stiffness += piece_area * abs(g)
     # Back to x: dA = jacobian dmu, x = V0 + mu1 e + mu2 f.
     moments[0] += jacobian * integral
