@@ -26,7 +26,7 @@ import numpy as np
 
 from numba import prange
 
-from riprap._jit import inline_kernel, kernel, parallel_kernel
+from riprap._jit import inline_kernel, kernel, leaf_kernel, parallel_kernel
 from riprap.solid.kernels.contact import plane_section
 
 MAX_VERTICES = 16
@@ -36,7 +36,7 @@ _N = 3
 _LAMBDA = 6
 
 
-@kernel
+@leaf_kernel
 def clip(polygon, n_vertices, signed, n_columns, out):
     """Keep the part of a convex polygon where ``signed`` (per vertex) is >= 0 (Sutherland-Hodgman,
     all columns interpolated linearly). Returns the vertex count of ``out``."""
@@ -59,7 +59,7 @@ def clip(polygon, n_vertices, signed, n_columns, out):
     return m
 
 
-@kernel
+@leaf_kernel
 def product_integrals(polygon, n_vertices, a_column, b_first, n_b, out, out_first):
     """out[out_first + j] += int polygon[:, a_column] * polygon[:, b_first + j] dA for j < n_b
     over a planar convex polygon (exact: edge-midpoint rule on each fan triangle). Returns the
@@ -92,7 +92,7 @@ def product_integrals(polygon, n_vertices, a_column, b_first, n_b, out, out_firs
     return total_area
 
 
-@kernel
+@leaf_kernel
 def barycentric_map(positions, tets, t, out):
     """Rows k = (a_k, b_k) with lambda_k(x) = a_k . x + b_k for the current corners of tet
     ``tets[t]``, (4, 4). Returns False for a flat tet."""
@@ -135,7 +135,7 @@ def barycentric_map(positions, tets, t, out):
     return True
 
 
-@kernel
+@leaf_kernel
 def smallest_region(polygon, m, j, first_lambda, n_columns, piece, work, signed):
     """Copy into ``piece`` the part of ``polygon`` where barycentric coordinate j (column
     ``first_lambda + j``) is the smallest of the four, so the tet's potential is 4 lambda_j there.
@@ -156,7 +156,7 @@ def smallest_region(polygon, m, j, first_lambda, n_columns, piece, work, signed)
     return mj
 
 
-@kernel
+@leaf_kernel
 def polygon_normal(polygon):
     """Unnormalised normal (x1 - x0) x (x2 - x0) of the first three vertices and its length."""
     nx = ((polygon[1, 1] - polygon[0, 1]) * (polygon[2, 2] - polygon[0, 2])
@@ -168,7 +168,7 @@ def polygon_normal(polygon):
     return nx, ny, nz, np.sqrt(nx * nx + ny * ny + nz * nz)
 
 
-@kernel
+@leaf_kernel
 def triangle_in_tet(positions, triangles, tri, tets, t, lam_map, penalty, forces, polygon, work,
                     signed, integrals, piece, node_force, velocities, masses, friction_coefficient,
                     damping_ratio, tangential_stiffness, time_step, springs, q):
@@ -250,7 +250,7 @@ def triangle_in_tet(positions, triangles, tri, tets, t, lam_map, penalty, forces
     return weight, area
 
 
-@kernel
+@leaf_kernel
 def spring_friction(springs, q, tx, ty, tz, nx, ny, nz, stiffness, limit, time_step):
     """Coulomb friction by an elastic tangential spring, as for rigid bodies: the spring
     ``springs[q]`` (3, updated in place) is turned into the present tangent plane, stretched by the
@@ -274,7 +274,7 @@ def spring_friction(springs, q, tx, ty, tz, nx, ny, nz, stiffness, limit, time_s
     return -stiffness * springs[q, 0], -stiffness * springs[q, 1], -stiffness * springs[q, 2]
 
 
-@kernel
+@leaf_kernel
 def reduced_mass(side_a, side_b):
     if np.isinf(side_b):
         return side_a
@@ -283,7 +283,7 @@ def reduced_mass(side_a, side_b):
     return side_a * side_b / (side_a + side_b)
 
 
-@kernel
+@leaf_kernel
 def apply_friction(triangles, tri, tets, t, node_force, weight, nx, ny, nz, velocities, masses,
                    friction_coefficient, stiffness, damping_ratio, time_step, springs, q, forces):
     """Friction and normal damping of one (triangle, tet) contact with normal force ``weight``
@@ -514,7 +514,7 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
     return total, area
 
 
-@kernel
+@leaf_kernel
 def slide_on_wall(nodes, row, count, node_force, normal_force, wall_normal, velocities, masses,
                   friction_coefficient, stiffness, damping_ratio, time_step, springs, q, forces):
     """Friction and normal damping of the ``count`` nodes ``nodes[row]`` pressed on a still wall

@@ -26,7 +26,7 @@ barycentric maps, triangle clusters and the tet lookup grid are precomputed (``s
 """
 import numpy as np
 
-from riprap._jit import kernel
+from riprap._jit import kernel, leaf_kernel
 from riprap.solid.kernels.geometry_ops import (MAX_POLYGON, clip_polygon, integrate_linear_on_polygon,
                                                integrate_tet_potential_on_polygon,
                                                integrate_tet_potential_on_triangle, mat3_mul_transposed,
@@ -67,6 +67,13 @@ def make_scratch(max_tets):
             np.empty(3), np.empty(3), np.empty(3, dtype=np.int64), np.empty(3, dtype=np.int64),
             np.zeros(R_SIZE), np.empty(4), np.empty((MAX_PAIR_PIECES, 2), dtype=np.int64),
             np.empty((3, MAX_POLYGON, 2)))
+
+
+@kernel
+def pair_work_arrays(scratch):
+    """The work arrays of :func:`pair_force_from_pieces` out of ``make_scratch``'s tuple
+    (signed, moments, vertices, lam, normal, polygons, res): taken once per batch of pairs."""
+    return scratch[3], scratch[4], scratch[5], scratch[6], scratch[7], scratch[19], scratch[16]
 
 
 @kernel
@@ -194,7 +201,7 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
     return n_pieces
 
 
-@kernel
+@leaf_kernel
 def _place_triangle(rotation, translation, nodes, node_offset, triangles, triangle_normals, tri,
                     vertices, normal):
     """Vertices and unit normal of boundary triangle ``tri`` moved by (rotation, translation)."""
@@ -208,7 +215,7 @@ def _place_triangle(rotation, translation, nodes, node_offset, triangles, triang
                      + rotation[c, 2] * triangle_normals[tri, 2])
 
 
-@kernel
+@leaf_kernel
 def _separated(barycentric, t, vertices, normal, nodes, noff_p, tets, skin, lam):
     """True when triangle ``vertices`` stays more than ``skin`` away from tet ``t``: all three
     vertices beyond one face plane, or all four tet nodes on one side of the triangle's plane.
@@ -243,21 +250,22 @@ def _separated(barycentric, t, vertices, normal, nodes, noff_p, tets, skin, lam)
     return above == 4 or below == 4
 
 
-@kernel
+@leaf_kernel
 def integrate_pieces(surface_shape, potential_shape, rotation, translation, penalty, pieces, first,
                      last, node_offset, nodes, tet_offset, tets, barycentric, triangle_offset,
-                     triangles, triangle_normals, scratch, result):
+                     triangles, triangle_normals, signed, moments, vertices, lam, normal, polygons,
+                     result):
     """Integrate the potential of ``potential_shape`` over the listed (triangle, tet) pieces of
     ``surface_shape``'s boundary (rows ``first:last`` of ``pieces``), at the relative pose
-    ``rotation``, ``translation``. Adds to ``result`` (layout R_*) in the potential body's frame."""
+    ``rotation``, ``translation``. Adds to ``result`` (layout R_*) in the potential body's frame.
+    ``signed`` .. ``polygons``: work arrays (``make_scratch``'s 3, 4, 5, 6, 7 and 19), passed one
+    by one: a tuple unpacked per pair cost an atomic reference count per array each way."""
     sp = potential_shape
     ss = surface_shape
     noff_s = node_offset[ss]
     noff_p = node_offset[sp]
     toff_p = tet_offset[sp]
     troff = triangle_offset[ss]
-    (_, _, _, signed, moments, vertices, lam, normal, _, _, _,
-     _, _, _, _, _, _, _, _, polygons) = scratch
     current = -1
     for q in range(first, last):
         tri_local = pieces[q, 0]
@@ -294,7 +302,7 @@ def integrate_pieces(surface_shape, potential_shape, rotation, translation, pena
         _add_second_moment(result, R_SECOND, penalty, moments)
 
 
-@kernel
+@leaf_kernel
 def _add_second_moment(target, at, penalty, moments):
     """Add p M1 M1^T / M0 of one integrated piece (lumped at its centroid)."""
     if moments[0] <= 0.0:
@@ -344,7 +352,7 @@ def _store_spread(total, weight, point, out):
     out[21] = weight
 
 
-@kernel
+@leaf_kernel
 def _sphere_far(centre, radius, box_lo, box_hi, origin, cell, nx, ny, nz, clearance, coff,
                 shape_lo, shape_hi):
     """True when a sphere cannot touch the body (outside its box, or in a cell far from it)."""
@@ -391,7 +399,8 @@ def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, r
                                                 position_b, rotation_b, 0.0, shape_arrays,
                                                 scratch, pieces, 0)
     pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
-                           penalty, shape_arrays, scratch, pieces, 0, split, last, out)
+                           penalty, *shape_arrays[:8], *pair_work_arrays(scratch), pieces, 0, split,
+                           last, out)
     out[13] += overflow
 
 
@@ -437,12 +446,13 @@ def collect_pair_pieces(shape_a, shape_b, position_a, rotation_a, position_b, ro
 
 @kernel
 def pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
-                           penalty, shape_arrays, scratch, pieces, first, split, last, out):
+                           penalty, node_offset, nodes, tet_offset, tets, barycentric,
+                           triangle_offset, triangles, triangle_normals, signed, moments, vertices,
+                           lam, normal, polygons, res, pieces, first, split, last, out):
     """Potential contact of a pair from its listed pieces (rows ``first:split`` A's triangles in
     B's tets, ``split:last`` B's in A's); ``out`` (OUT_SIZE,) as for
-    :func:`body_pair_potential_force`."""
-    (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
-     triangle_normals) = shape_arrays[:8]
+    :func:`body_pair_potential_force`. ``node_offset`` .. ``triangle_normals``: the first eight
+    shape arrays; ``signed`` .. ``res``: work arrays (``pair_work_arrays``)."""
     for i in range(OUT_SIZE):
         out[i] = 0.0
     weight = 0.0
@@ -454,11 +464,10 @@ def pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b,
     rotation_1, translation_1, rotation_2, translation_2 = relative_pose(position_a, rotation_a,
                                                                           position_b, rotation_b)
     # Direction 1: A's surface in B's potential, evaluated in B's frame.
-    res = scratch[16]
     res[:] = 0.0
     integrate_pieces(shape_a, shape_b, rotation_1, translation_1, penalty, pieces, first, split,
                      node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
-                     triangle_normals, scratch, res)
+                     triangle_normals, signed, moments, vertices, lam, normal, polygons, res)
     force1 = mat3_vec(rotation_b, res[R_FORCE:R_FORCE + 3])          # on A
     moment1 = mat3_vec(rotation_b, res[R_MOMENT:R_MOMENT + 3])       # about B's centroid
     # torque on A about its centroid: moment about B's centroid + (x_B - x_A) x F
@@ -476,7 +485,7 @@ def pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b,
     res[:] = 0.0
     integrate_pieces(shape_b, shape_a, rotation_2, translation_2, penalty, pieces, split, last,
                      node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
-                     triangle_normals, scratch, res)
+                     triangle_normals, signed, moments, vertices, lam, normal, polygons, res)
     force2 = mat3_vec(rotation_a, res[R_FORCE:R_FORCE + 3])          # on B
     moment2 = mat3_vec(rotation_a, res[R_MOMENT:R_MOMENT + 3])       # about A's centroid
     force_a -= force2

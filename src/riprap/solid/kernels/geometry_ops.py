@@ -6,7 +6,7 @@ interpolates them exactly).
 """
 import numpy as np
 
-from riprap._jit import kernel
+from riprap._jit import kernel, leaf_kernel
 
 MAX_POLYGON = 16
 
@@ -37,7 +37,7 @@ def rotation_matrices(quaternions):
     return out
 
 
-@kernel
+@leaf_kernel
 def clip_polygon(polygon, n_vertices, signed, out):
     """Keep the part of a convex polygon where ``signed`` (one value per vertex) is >= 0.
 
@@ -63,7 +63,7 @@ def clip_polygon(polygon, n_vertices, signed, out):
     return m
 
 
-@kernel
+@leaf_kernel
 def integrate_linear_on_polygon(polygon, n_vertices, value_column, scale, normal, moments):
     """Integrate f = scale * polygon[:, value_column] over a planar convex polygon.
 
@@ -102,7 +102,7 @@ def integrate_linear_on_polygon(polygon, n_vertices, value_column, scale, normal
         moments[4] += area
 
 
-@kernel
+@leaf_kernel
 def integrate_tet_potential_on_polygon(polygon, n_vertices, gradients, normal, work_a, work_b,
                                        signed, moments):
     """Integrate a tet's potential phi = 4 min_k lambda_k over the part of a planar polygon inside
@@ -186,7 +186,7 @@ def integrate_tet_potential_on_polygon(polygon, n_vertices, gradients, normal, w
         moments[5] += sub_area * abs(g)
 
 
-@kernel
+@leaf_kernel
 def integrate_tet_potential_on_triangle(lam, vertices, barycentric, t, normal, polygons, signed,
                                         moments):
     """Integrate a tet's potential phi = 4 min_k lambda_k over the part of a triangle inside the
@@ -297,7 +297,7 @@ def integrate_tet_potential_on_triangle(lam, vertices, barycentric, t, normal, p
     moments[5] += jacobian * stiffness
 
 
-@kernel
+@leaf_kernel
 def _integrate_fan(polygons, current, count, c0, c1, c2):
     """Integrals of f = c0 + c1 mu1 + c2 mu2 over the convex polygon ``polygons[current]`` (mu
     coordinates): (int f, int mu1 f, int mu2 f, area), exactly, over its fan triangles."""
@@ -327,7 +327,7 @@ def _integrate_fan(polygons, current, count, c0, c1, c2):
     return integral, first_1, first_2, total_area
 
 
-@kernel
+@leaf_kernel
 def _clip_by_line(polygons, source, target, n_vertices, c0, c1, c2, signed):
     """Keep the part of convex polygon ``polygons[source]`` (mu coordinates) where c0 + c1 mu1 +
     c2 mu2 >= 0. Returns (vertex count, whether it was written to ``polygons[target]``); a polygon

@@ -26,7 +26,7 @@ import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
 from riprap.solid.kernels.contact import (OUT_SIZE, collect_pair_pieces, make_scratch,
-                                          pair_force_from_pieces, relative_pose,
+                                          pair_force_from_pieces, pair_work_arrays, relative_pose,
                                           wall_potential_force)
 from riprap.solid.kernels.geometry_ops import rotation_matrix
 
@@ -190,6 +190,11 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, positions, quate
                     piece_cache, skin, bounding_radius, shape_arrays, fresh, capacity, source,
                     bounds, poses, results):
     scratch = make_scratch(shape_arrays[3].shape[0])
+    # the arrays the pair loop needs, out of their tuples once: a tuple unpacked per pair cost an
+    # atomic reference count per array each way, shared with the other threads
+    (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
+     triangle_normals) = shape_arrays[:8]
+    signed, moments, vertices, lam, normal, polygons, res = pair_work_arrays(scratch)
     out = np.zeros(OUT_SIZE)
     n_body_pairs = body_pairs.shape[0]
     cache_keys, cache_poses, cache_bounds, cache_pieces = piece_cache
@@ -213,8 +218,10 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, positions, quate
                     and _within_skin(rotation_1, translation_1, cache_poses[idx],
                                      bounding_radius[shape_i], bounding_radius[shape_j], skin)):
                 pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, positions[j], r_j,
-                                       penalty, shape_arrays, scratch, cache_pieces,
-                                       cache_bounds[idx, 0], cache_bounds[idx, 1],
+                                       penalty, node_offset, nodes, tet_offset, tets,
+                                       barycentric, triangle_offset, triangles, triangle_normals,
+                                       signed, moments, vertices, lam, normal, polygons, res,
+                                       cache_pieces, cache_bounds[idx, 0], cache_bounds[idx, 1],
                                        cache_bounds[idx, 2], out)
                 source[k] = SOURCE_OLD
                 for c in range(3):
@@ -227,7 +234,10 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, positions, quate
                                                            positions[j], r_j, skin, shape_arrays,
                                                            scratch, pieces, 0)
                 pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, positions[j], r_j,
-                                       penalty, shape_arrays, scratch, pieces, 0, split, end, out)
+                                       penalty, node_offset, nodes, tet_offset, tets,
+                                       barycentric, triangle_offset, triangles, triangle_normals,
+                                       signed, moments, vertices, lam, normal, polygons, res,
+                                       pieces, 0, split, end, out)
                 if skin > 0.0 and overflow == 0.0 and used + end <= capacity:
                     row = buffer_start + used
                     for r in range(end):
