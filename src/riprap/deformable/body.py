@@ -95,7 +95,6 @@ class DeformableBody:
         self.prescribed_velocities = np.zeros((n_nodes, 3))
         self.gravity = np.asarray(gravity, dtype=np.float64).reshape(3).copy()
         self.mass_damping = float(mass_damping)
-        self.nodal_forces = np.zeros((n_nodes, 3))
         self.time = 0.0
         self.step_count = 0
         self._element_forces = np.zeros((n_el, n_local, 3))
@@ -205,8 +204,8 @@ class DeformableBody:
             tet4_gradients, elements.gradients, elements.weights, self.materials,
             self.element_material, self._element_forces, self.jacobians, self._offsets,
             self._slots, self.masses, self.external_forces, self.contact_forces, self.gravity,
-            self.mass_damping, self.constrained, self.prescribed_velocities, dt, self.nodal_forces,
-            NO_CONTACT, self._joint_arguments())
+            self.mass_damping, self.constrained, self.prescribed_velocities, dt, NO_CONTACT,
+            self._joint_arguments())
         self.step_count += int(done)
         self.time += int(done) * dt
         if status == finite_strain.INVERTED:

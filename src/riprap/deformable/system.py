@@ -121,7 +121,7 @@ class DeformableSystem:
         self.element_offsets = np.r_[0, np.cumsum(element_counts)].astype(np.int64)
         n_proxy = sum(len(p[0]) for p in proxies)
         for name in ("positions", "velocities", "external_forces", "contact_forces",
-                     "prescribed_velocities", "nodal_forces", "constrained"):
+                     "prescribed_velocities", "constrained"):
             parts = [getattr(b, name) for b in bodies]
             # rigid surface nodes: held (constrained) at their body's motion, set every step
             parts.append(np.full((n_proxy, 3), name == "constrained", dtype=parts[0].dtype))
@@ -512,8 +512,8 @@ class DeformableSystem:
                 self.tet4_gradients, self.gradients, self.weights, self.materials,
                 self.element_material, self._element_forces, self.jacobians, self._offsets,
                 self._slots, self.masses, self.external_forces, self.contact_forces, self.gravity,
-                self.mass_damping, self.constrained, self.prescribed_velocities, dt,
-                self.nodal_forces, contact, self.joint_data)
+                self.mass_damping, self.constrained, self.prescribed_velocities, dt, contact,
+                self.joint_data)
             self.step_count += int(done)
             self.time += int(done) * dt
             for body in self.bodies:

@@ -257,7 +257,7 @@ def general_element_forces(positions, velocities, elements, gradients, weights,
 @inline_kernel
 def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained, prescribed_velocities,
-                time_step, nodal_forces, joint_flat, joint_table, joint_overflow_offsets,
+                time_step, joint_flat, joint_table, joint_overflow_offsets,
                 joint_overflow_slots, listed_positions):
     """Central-difference update of node ``n`` (see :func:`central_difference_update`); returns
     the work of the joints' force on it over the step and its squared distance from
@@ -276,7 +276,6 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
     before = velocities[n, 0]
     total = (external_forces[n, 0] + contact_forces[n, 0] + m * gravity[0]
              - mass_damping * m * before + ex + jx)
-    nodal_forces[n, 0] = total
     free = before + time_step * total / m
     held = prescribed_velocities[n, 0]
     velocity = held if constrained[n, 0] else free
@@ -286,7 +285,6 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
     before = velocities[n, 1]
     total = (external_forces[n, 1] + contact_forces[n, 1] + m * gravity[1]
              - mass_damping * m * before + ey + jy)
-    nodal_forces[n, 1] = total
     free = before + time_step * total / m
     held = prescribed_velocities[n, 1]
     velocity = held if constrained[n, 1] else free
@@ -296,7 +294,6 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
     before = velocities[n, 2]
     total = (external_forces[n, 2] + contact_forces[n, 2] + m * gravity[2]
              - mass_damping * m * before + ez + jz)
-    nodal_forces[n, 2] = total
     free = before + time_step * total / m
     held = prescribed_velocities[n, 2]
     velocity = held if constrained[n, 2] else free
@@ -313,8 +310,8 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
 @parallel_kernel
 def central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
                               masses, external_forces, contact_forces, gravity, mass_damping,
-                              constrained, prescribed_velocities, time_step, nodal_forces,
-                              joint_data, listed_positions):
+                              constrained, prescribed_velocities, time_step, joint_data,
+                              listed_positions):
     """Sum the element forces at every node, add loads, gravity, mass-proportional damping and the
     joints' forces, and advance the half-step velocity and the position (central difference /
     leapfrog). Returns the joints' work over the step and the largest squared distance of a node
@@ -323,8 +320,7 @@ def central_difference_update(positions, velocities, element_forces, node_offset
     ``node_slots[node_offsets[n]:node_offsets[n + 1]]`` lists the flat (element, local node)
     entries of ``element_forces`` that act on node n; ``joint_data`` (see :func:`advance_steps`)
     likewise the slots of the joints' buffer. Components flagged in ``constrained`` take
-    ``prescribed_velocities`` instead. ``nodal_forces`` receives the total force at every node (for
-    reactions and outputs)."""
+    ``prescribed_velocities`` instead."""
     flat = element_forces.reshape((-1, 3))
     joint_flat = joint_data[6].reshape((-1, 3))
     joint_table, joint_overflow_offsets, joint_overflow_slots = (joint_data[7], joint_data[8],
@@ -335,7 +331,7 @@ def central_difference_update(positions, velocities, element_forces, node_offset
         node_work, moved = update_node(n, positions, velocities, flat, node_offsets, node_slots,
                                        masses, external_forces, contact_forces, gravity,
                                        mass_damping, constrained, prescribed_velocities,
-                                       time_step, nodal_forces, joint_flat, joint_table,
+                                       time_step, joint_flat, joint_table,
                                        joint_overflow_offsets, joint_overflow_slots,
                                        listed_positions)
         work += node_work
@@ -347,7 +343,7 @@ def central_difference_update(positions, velocities, element_forces, node_offset
 def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
                                      node_slots, masses, external_forces, contact_forces, gravity,
                                      mass_damping, constrained, prescribed_velocities, time_step,
-                                     nodal_forces, joint_data, listed_positions):
+                                     joint_data, listed_positions):
     """:func:`central_difference_update` on one thread (small bodies: no thread start-up)."""
     flat = element_forces.reshape((-1, 3))
     joint_flat = joint_data[6].reshape((-1, 3))
@@ -359,7 +355,7 @@ def central_difference_update_serial(positions, velocities, element_forces, node
         node_work, moved = update_node(n, positions, velocities, flat, node_offsets, node_slots,
                                        masses, external_forces, contact_forces, gravity,
                                        mass_damping, constrained, prescribed_velocities,
-                                       time_step, nodal_forces, joint_flat, joint_table,
+                                       time_step, joint_flat, joint_table,
                                        joint_overflow_offsets, joint_overflow_slots,
                                        listed_positions)
         work += node_work
@@ -475,7 +471,7 @@ PARALLEL_PAIRS = 2000
 def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradients, gradients,
                   weights, materials, element_material, element_forces, jacobians, node_offsets,
                   node_slots, masses, external_forces, contact_forces, gravity, mass_damping,
-                  constrained, prescribed_velocities, time_step, nodal_forces, contact, joint_data):
+                  constrained, prescribed_velocities, time_step, contact, joint_data):
     """Up to ``n_steps`` central-difference steps without returning to Python.
 
     ``contact`` = (the triangles and tets walls act on, all contact triangles and tets, wall depth
@@ -572,11 +568,11 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
             work, largest_move = central_difference_update(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, nodal_forces, joint_data, moves_from)
+                prescribed_velocities, time_step, joint_data, moves_from)
         else:
             work, largest_move = central_difference_update_serial(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, nodal_forces, joint_data, moves_from)
+                prescribed_velocities, time_step, joint_data, moves_from)
         joint_work[0] += work
     return n_steps, DONE, -1, 1.0
