@@ -31,15 +31,12 @@ NO_CONTACT = (np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int64)
 NO_TET4_GRADIENTS = np.zeros((0, 4, 3))
 
 
-def no_joints(n_nodes: int) -> tuple:
-    """The joint arguments of a run without joints (see finite_strain.advance_steps): every
-    node's table of joint slots points at the zero forces of the buffer's one joint, and its
-    overflow list is empty (the node update runs over them without a branch)."""
+def no_joints() -> tuple:
+    """The joint arguments of a run without joints (see finite_strain.advance_steps)."""
     return (np.zeros((0, 6), dtype=np.int64), np.zeros(0), np.zeros((1, 9)),
             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0, dtype=np.bool_),
-            np.zeros((1, 6, 3)), np.zeros((n_nodes, 3), dtype=np.int64),
-            np.zeros(n_nodes + 1, dtype=np.int64), np.zeros(0, dtype=np.bool_), np.zeros(1),
-            np.zeros((0, 3, 2)), np.zeros(0, dtype=np.int64))
+            np.zeros((0, 3)), np.zeros((0, 6), dtype=np.int64), np.zeros(0, dtype=np.bool_),
+            np.zeros(1), np.zeros((0, 3, 2)))
 
 # Bodies with fewer integration points than this step on one thread: starting the threads of a
 # parallel loop (twice a step) cost more than the work for the 480-tet cantilever of the tests
@@ -214,7 +211,7 @@ class DeformableBody:
     def _joint_arguments(self):
         """The joint arguments of ``finite_strain.advance_steps`` (none: a body without joints)."""
         if self._no_joints is None:
-            self._no_joints = no_joints(len(self.positions))
+            self._no_joints = no_joints()
         return self._no_joints
 
     def _raise_inverted(self, worst: int, value: float, time_step: float | None = None,

@@ -211,25 +211,22 @@ def check_crack_resolution(nodes, tets, name: str) -> None:
             f"finer (a shape's mesh_size of at most {thinnest / MIN_TETS_ACROSS:.3g} m)")
 
 
-def joint_slot_table(joints, n_nodes):
-    """Where each node finds the joints' forces on it, for ``kernels/slots.table_slot_sum``:
-    (table, overflow_offsets, overflow_slots). ``table[i]`` (three wide: every node of a mesh
-    split by joints everywhere has 2 or 3) holds the first flat (joint * 6 + corner) entries of
-    a joint force buffer that act on node i, padded with ``6 * len(joints)``: the buffer has one
-    joint more than ``joints``, whose forces stay zero. A node's further entries (nodes shared
-    by tets glued together at the edge of a cracking region) are
-    ``overflow_slots[overflow_offsets[i]:overflow_offsets[i + 1]]``."""
-    flat = np.asarray(joints, dtype=np.int64).reshape(-1)
-    order = np.argsort(flat, kind="stable")
-    counts = np.bincount(flat, minlength=n_nodes)
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-    nodes = flat[order]
-    rank = np.arange(len(order)) - starts[nodes]
-    table = np.full((n_nodes, 3), len(flat), dtype=np.int64)
-    in_table = rank < 3
-    table[nodes[in_table], rank[in_table]] = order[in_table]
-    overflow_offsets = np.concatenate([[0], np.cumsum(np.maximum(counts - 3, 0))])
-    return table, overflow_offsets.astype(np.int64), order[~in_table].astype(np.int64)
+def joint_force_rows(tets, joints, joint_tets, face_joint) -> np.ndarray:
+    """(n, 6): the row of a (12 m, 3) joint force buffer that each joint's force on each of its
+    six vertices goes to (``kernels/joints.joint_forces``): row 12 t + 3 f + i for the vertex at
+    the i-th corner of face f of tet t, the face the joint holds."""
+    tets = np.asarray(tets, dtype=np.int64)
+    joints = np.asarray(joints, dtype=np.int64)
+    n = len(joints)
+    rows = np.zeros((n, 6), dtype=np.int64)
+    for side in (0, 1):
+        tet = joint_tets[:, side]
+        face = np.argmax(face_joint[tet] == np.arange(n)[:, None], axis=1)
+        face_nodes = np.take_along_axis(tets[tet], _TET_FACES[face], axis=1)      # (n, 3)
+        position = np.argmax(face_nodes[:, None, :] == joints[:, 3 * side:3 * side + 3, None],
+                             axis=2)
+        rows[:, 3 * side:3 * side + 3] = 12 * tet[:, None] + 3 * face[:, None] + position
+    return rows
 
 
 class FracturingBody(DeformableBody):
@@ -296,9 +293,9 @@ class FracturingBody(DeformableBody):
         self.joint_work = np.zeros(1)
         self._joint_properties = joint_material.kernel_row()[None, :]
         self._joint_material_index = np.zeros(len(joints), dtype=np.int64)
-        # one joint more, whose forces stay zero: where the slot table is padded
-        self._joint_buffer = np.zeros((len(joints) + 1, 6, 3))
-        self._joint_slot_table = joint_slot_table(joints, len(exploded))
+        self._joint_rows = joint_force_rows(split.tets, joints, split.joint_tets,
+                                            split.face_joint)
+        self._joint_buffer = np.zeros((3 * split.tets.size, 3))
 
     # ------------------------------------------------------------------ steps
     def stable_time_step(self) -> float:
@@ -333,15 +330,15 @@ class FracturingBody(DeformableBody):
         joint_kernels.joint_forces(self.positions, self.joints, self.joint_sizes,
                                    self._joint_properties, self._joint_material_index,
                                    self.joint_damage, self.joint_broken, self.joint_released,
-                                   self.joint_friction_anchor, self._joint_buffer)
-        joint_kernels.gather_joint_forces(self._joint_buffer, *self._joint_slot_table, forces)
+                                   self.joint_friction_anchor, self._joint_buffer,
+                                   self._joint_rows)
+        joint_kernels.gather_joint_forces(self._joint_buffer, self._offsets, self._slots, forces)
         return forces
 
     def _joint_arguments(self):
         return (self.joints, self.joint_sizes, self._joint_properties, self._joint_material_index,
-                self.joint_damage, self.joint_broken, self._joint_buffer,
-                self._joint_slot_table[0], self._joint_slot_table[1], self.joint_released,
-                self.joint_work, self.joint_friction_anchor, self._joint_slot_table[2])
+                self.joint_damage, self.joint_broken, self._joint_buffer, self._joint_rows,
+                self.joint_released, self.joint_work, self.joint_friction_anchor)
 
     # ------------------------------------------------------------------ results
     @property

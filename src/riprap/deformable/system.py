@@ -20,7 +20,7 @@ from riprap.deformable.body import (NO_TET4_GRADIENTS, PARALLEL_POINTS,
                                     TIME_STEP_SAFETY, DeformableBody, material_table,
                                     no_joints, stable_step_for)
 from riprap.deformable.elements import _OUTWARD_FACES
-from riprap.deformable.joints import FracturingBody, joint_slot_table
+from riprap.deformable.joints import FracturingBody
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import finite_strain
 from riprap.errors import CaseFileError
@@ -210,10 +210,9 @@ class DeformableSystem:
         self.fracturing_bodies = fracturing
         counts = [len(self.bodies[k].joints) for k in fracturing]
         self.joint_offsets = np.r_[0, np.cumsum(counts)].astype(np.int64)
-        n_nodes = len(self.positions)
         if not fracturing:
             self.joints = np.zeros((0, 6), dtype=np.int64)
-            self.joint_data = no_joints(n_nodes)
+            self.joint_data = no_joints()
             self.joint_work = np.zeros(1)
             return
         self.joints = np.concatenate([self.bodies[k].joints + self.node_offsets[k]
@@ -227,13 +226,12 @@ class DeformableSystem:
             setattr(self, name, joined)
             for i, k in enumerate(fracturing):
                 setattr(self.bodies[k], name, joined[self.joint_offsets[i]:self.joint_offsets[i + 1]])
-        table, overflow_offsets, overflow_slots = joint_slot_table(self.joints, n_nodes)
+        rows = np.concatenate([self.bodies[k]._joint_rows + 12 * self.element_offsets[k]
+                               for k in fracturing])
         self.joint_work = np.zeros(1)
-        # (one joint more in the buffer: the zero forces where the slot table is padded)
         self.joint_data = (self.joints, sizes, properties, material, self.joint_damage,
-                           self.joint_broken, np.zeros((len(self.joints) + 1, 6, 3)),
-                           table, overflow_offsets, self.joint_released, self.joint_work,
-                           self.joint_friction_anchor, overflow_slots)
+                           self.joint_broken, np.zeros((3 * self.elements.size, 3)), rows,
+                           self.joint_released, self.joint_work, self.joint_friction_anchor)
 
     def _fracturing_surface(self, body) -> tuple:
         """A fracturing body's contact surface now: its outer faces and the faces of its parted

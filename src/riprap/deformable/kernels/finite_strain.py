@@ -21,7 +21,7 @@ import numpy as np
 from riprap._jit import inline_kernel, kernel, parallel_kernel, prange
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import joints as joint_kernels
-from riprap.deformable.kernels.slots import slot_sum, table_slot_sum
+from riprap.deformable.kernels.slots import joint_slot_sum, slot_sum
 
 
 @inline_kernel
@@ -216,9 +216,9 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
     :func:`advance_steps`) in one parallel loop: both only read the positions, so one region
     instead of two (each region costs the threads a wake-up)."""
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer, joint_released, joint_anchors) = (
+     joint_buffer, joint_rows, joint_released, joint_anchors) = (
         joint_data[0], joint_data[1], joint_data[2], joint_data[3], joint_data[4], joint_data[5],
-        joint_data[6], joint_data[9], joint_data[11])
+        joint_data[6], joint_data[7], joint_data[8], joint_data[10])
     n_tets = tets.shape[0]
     n_joints = joint_nodes.shape[0]
     for block in prange(FORCE_BLOCKS):
@@ -228,7 +228,8 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
         joint_kernels.joint_range(block * n_joints // FORCE_BLOCKS,
                                   (block + 1) * n_joints // FORCE_BLOCKS, positions, joint_nodes,
                                   joint_sizes, joint_properties, joint_material, joint_damage,
-                                  joint_broken, joint_released, joint_anchors, joint_buffer)
+                                  joint_broken, joint_released, joint_anchors, joint_buffer,
+                                  joint_rows)
 
 
 @kernel
@@ -255,21 +256,18 @@ def general_element_forces(positions, velocities, elements, gradients, weights,
 
 
 @inline_kernel
-def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots, masses,
-                external_forces, contact_forces, gravity, mass_damping, constrained, prescribed_velocities,
-                time_step, joint_flat, joint_table, joint_overflow_offsets,
-                joint_overflow_slots, listed_positions):
-    """Central-difference update of node ``n`` (see :func:`central_difference_update`); returns
-    the work of the joints' force on it over the step and its squared distance from
-    ``listed_positions`` after it."""
+def update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses, external_forces,
+                contact_forces, gravity, mass_damping, constrained, prescribed_velocities,
+                time_step, listed_positions):
+    """Central-difference update of node ``n`` (see :func:`central_difference_update`) under the
+    elements' force (ex, ey, ez) and the joints' (jx, jy, jz) on it; returns the work of the
+    joints' force over the step and the node's squared distance from ``listed_positions`` after
+    it."""
     m = masses[n]
     # written out per axis: a helper per axis (inlined) made the one-thread loop 2 to 3 times
     # slower (numba 0.68, this machine), the threaded one not. Both velocities are loaded before
     # the choice: an array read inside the conditional expression made numba take references to
     # four arrays per node in the one-thread loop (atomic counts; 3.4 times slower)
-    ex, ey, ez = slot_sum(n, flat_forces, node_offsets, node_slots)
-    jx, jy, jz = table_slot_sum(n, joint_flat, joint_table, joint_overflow_offsets,
-                                joint_overflow_slots)
     # the trapezoidal rule for the joints' work, exact for a linear spring (the rectangle rule
     # gains k dx^2 / 2 a step: a steady drift while the joints vibrate): this step's force over
     # the intervals on both sides of it, each at its velocity
@@ -310,29 +308,58 @@ def update_node(n, positions, velocities, flat_forces, node_offsets, node_slots,
 @parallel_kernel
 def central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
                               masses, external_forces, contact_forces, gravity, mass_damping,
-                              constrained, prescribed_velocities, time_step, joint_data,
-                              listed_positions):
-    """Sum the element forces at every node, add loads, gravity, mass-proportional damping and the
-    joints' forces, and advance the half-step velocity and the position (central difference /
-    leapfrog). Returns the joints' work over the step and the largest squared distance of a node
-    from ``listed_positions`` after it (pass ``positions`` itself where none is wanted).
+                              constrained, prescribed_velocities, time_step, listed_positions):
+    """Sum the element forces at every node, add loads, gravity and mass-proportional damping,
+    and advance the half-step velocity and the position (central difference / leapfrog).
+    Returns the largest squared distance of a node from ``listed_positions`` after it (pass
+    ``positions`` itself where none is wanted).
 
     ``node_slots[node_offsets[n]:node_offsets[n + 1]]`` lists the flat (element, local node)
-    entries of ``element_forces`` that act on node n; ``joint_data`` (see :func:`advance_steps`)
-    likewise the slots of the joints' buffer. Components flagged in ``constrained`` take
+    entries of ``element_forces`` that act on node n. Components flagged in ``constrained`` take
     ``prescribed_velocities`` instead."""
     flat = element_forces.reshape((-1, 3))
-    joint_flat = joint_data[6].reshape((-1, 3))
-    joint_table, joint_overflow_offsets, joint_overflow_slots = (joint_data[7], joint_data[8],
-                                                                 joint_data[12])
+    largest = 0.0
+    for n in prange(positions.shape[0]):
+        ex, ey, ez = slot_sum(n, flat, node_offsets, node_slots)
+        _, moved = update_node(n, ex, ey, ez, 0.0, 0.0, 0.0, positions, velocities, masses,
+                               external_forces, contact_forces, gravity, mass_damping,
+                               constrained, prescribed_velocities, time_step, listed_positions)
+        largest = max(largest, moved)
+    return largest
+
+
+@kernel
+def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
+                                     node_slots, masses, external_forces, contact_forces, gravity,
+                                     mass_damping, constrained, prescribed_velocities, time_step,
+                                     listed_positions):
+    """:func:`central_difference_update` on one thread (small bodies: no thread start-up)."""
+    flat = element_forces.reshape((-1, 3))
+    largest = 0.0
+    for n in range(positions.shape[0]):
+        ex, ey, ez = slot_sum(n, flat, node_offsets, node_slots)
+        _, moved = update_node(n, ex, ey, ez, 0.0, 0.0, 0.0, positions, velocities, masses,
+                               external_forces, contact_forces, gravity, mass_damping,
+                               constrained, prescribed_velocities, time_step, listed_positions)
+        largest = max(largest, moved)
+    return largest
+
+
+@parallel_kernel
+def jointed_update(positions, velocities, element_forces, node_offsets, node_slots, masses,
+                   external_forces, contact_forces, gravity, mass_damping, constrained,
+                   prescribed_velocities, time_step, joint_forces, listed_positions):
+    """:func:`central_difference_update` with the joints' forces added (``joint_forces``: three
+    rows per element slot, ``kernels/joints.joint_forces``); returns also the joints' work over
+    the step. (A loop of its own: the bodies without joints read no joint rows.)"""
+    flat = element_forces.reshape((-1, 3))
     work = 0.0
     largest = 0.0
     for n in prange(positions.shape[0]):
-        node_work, moved = update_node(n, positions, velocities, flat, node_offsets, node_slots,
-                                       masses, external_forces, contact_forces, gravity,
-                                       mass_damping, constrained, prescribed_velocities,
-                                       time_step, joint_flat, joint_table,
-                                       joint_overflow_offsets, joint_overflow_slots,
+        ex, ey, ez, jx, jy, jz = joint_slot_sum(n, flat, joint_forces, node_offsets, node_slots)
+        node_work, moved = update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses,
+                                       external_forces, contact_forces, gravity, mass_damping,
+                                       constrained, prescribed_velocities, time_step,
                                        listed_positions)
         work += node_work
         largest = max(largest, moved)
@@ -340,23 +367,19 @@ def central_difference_update(positions, velocities, element_forces, node_offset
 
 
 @kernel
-def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
-                                     node_slots, masses, external_forces, contact_forces, gravity,
-                                     mass_damping, constrained, prescribed_velocities, time_step,
-                                     joint_data, listed_positions):
-    """:func:`central_difference_update` on one thread (small bodies: no thread start-up)."""
+def jointed_update_serial(positions, velocities, element_forces, node_offsets, node_slots,
+                          masses, external_forces, contact_forces, gravity, mass_damping,
+                          constrained, prescribed_velocities, time_step, joint_forces,
+                          listed_positions):
+    """:func:`jointed_update` on one thread."""
     flat = element_forces.reshape((-1, 3))
-    joint_flat = joint_data[6].reshape((-1, 3))
-    joint_table, joint_overflow_offsets, joint_overflow_slots = (joint_data[7], joint_data[8],
-                                                                 joint_data[12])
     work = 0.0
     largest = 0.0
     for n in range(positions.shape[0]):
-        node_work, moved = update_node(n, positions, velocities, flat, node_offsets, node_slots,
-                                       masses, external_forces, contact_forces, gravity,
-                                       mass_damping, constrained, prescribed_velocities,
-                                       time_step, joint_flat, joint_table,
-                                       joint_overflow_offsets, joint_overflow_slots,
+        ex, ey, ez, jx, jy, jz = joint_slot_sum(n, flat, joint_forces, node_offsets, node_slots)
+        node_work, moved = update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses,
+                                       external_forces, contact_forces, gravity, mass_damping,
+                                       constrained, prescribed_velocities, time_step,
                                        listed_positions)
         work += node_work
         largest = max(largest, moved)
@@ -483,11 +506,10 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     wall tets, the normal damping ratio per triangle and per tet).
     ``joint_data`` = the joints between tets of fracturing bodies (``riprap/deformable/kernels/joints.py``):
     (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
-    a (n + 1, 6, 3) buffer (its last joint's forces stay zero), the node's table of slots in
-    the buffer and the offsets of the rest (``joints.joint_slot_table``), released (broken
-    joints whose faces slid apart: no force any more), their work done on the nodes so far (1,),
-    by the trapezoidal rule, the friction anchors of their points (n, 3, 2), and the nodes'
-    slots beyond the table).
+    the buffer of their forces (three rows per element slot) and each joint's six rows in it
+    (``kernels/joints.joint_forces``), released (broken joints whose faces slid apart: no force
+    any more), their work done on the nodes so far (1,), by the trapezoidal rule, and the
+    friction anchors of their points (n, 3, 2)); no joints: none, and a buffer of no rows.
     Their forces are added in the node update (not to ``contact_forces``), which also sums
     their work.
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
@@ -498,8 +520,7 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
      tet_stiffness, pair_springs, wall_triangle_springs, wall_tet_springs, triangle_damping,
      tet_damping) = contact
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer, joint_slot_table, joint_overflow_offsets, joint_released,
-     joint_work, joint_anchors, joint_overflow_slots) = joint_data
+     joint_buffer, joint_rows, joint_released, joint_work, joint_anchors) = joint_data
     has_joints = joint_nodes.shape[0] > 0
     tet4 = elements.shape[1] == 4
     has_contact = triangles.shape[0] > 0
@@ -552,7 +573,8 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
             if has_joints:
                 joint_kernels.joint_forces(
                     positions, joint_nodes, joint_sizes, joint_properties, joint_material,
-                    joint_damage, joint_broken, joint_released, joint_anchors, joint_buffer)
+                    joint_damage, joint_broken, joint_released, joint_anchors, joint_buffer,
+                    joint_rows)
             element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
                                   weights, materials, element_material, element_forces, jacobians)
         elif tet4:
@@ -564,15 +586,26 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
         worst, value = smallest_jacobian(jacobians)
         if not value > 0.0:
             return step, INVERTED, worst, value
-        if parallel:
-            work, largest_move = central_difference_update(
+        if has_joints and parallel:
+            work, largest_move = jointed_update(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, joint_data, moves_from)
+                prescribed_velocities, time_step, joint_buffer, moves_from)
+            joint_work[0] += work
+        elif has_joints:
+            work, largest_move = jointed_update_serial(
+                positions, velocities, element_forces, node_offsets, node_slots, masses,
+                external_forces, contact_forces, gravity, mass_damping, constrained,
+                prescribed_velocities, time_step, joint_buffer, moves_from)
+            joint_work[0] += work
+        elif parallel:
+            largest_move = central_difference_update(
+                positions, velocities, element_forces, node_offsets, node_slots, masses,
+                external_forces, contact_forces, gravity, mass_damping, constrained,
+                prescribed_velocities, time_step, moves_from)
         else:
-            work, largest_move = central_difference_update_serial(
+            largest_move = central_difference_update_serial(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, joint_data, moves_from)
-        joint_work[0] += work
+                prescribed_velocities, time_step, moves_from)
     return n_steps, DONE, -1, 1.0

@@ -37,7 +37,7 @@ import math
 import numpy as np
 
 from riprap._jit import inline_kernel, kernel
-from riprap.deformable.kernels.slots import table_slot_sum
+from riprap.deformable.kernels.slots import joint_slot_sum
 
 SOFTENING_A = 0.63
 SOFTENING_B = 1.8
@@ -182,18 +182,21 @@ def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, penalty_over_h
 
 
 @inline_kernel
-def _put_vertex(buffer, j, k, fx, fy, fz):
-    """Force on face A's vertex k, and its opposite on B's vertex k."""
-    buffer[j, k, 0] = fx
-    buffer[j, k, 1] = fy
-    buffer[j, k, 2] = fz
-    buffer[j, 3 + k, 0] = -fx
-    buffer[j, 3 + k, 1] = -fy
-    buffer[j, 3 + k, 2] = -fz
+def _put_vertex(buffer, rows, j, k, fx, fy, fz):
+    """Force on face A's vertex k, and its opposite on B's vertex k (into their rows of
+    ``buffer``: ``rows[j]``)."""
+    a = rows[j, k]
+    b = rows[j, 3 + k]
+    buffer[a, 0] = fx
+    buffer[a, 1] = fy
+    buffer[a, 2] = fz
+    buffer[b, 0] = -fx
+    buffer[b, 1] = -fy
+    buffer[b, 2] = -fz
 
 
 @inline_kernel
-def _spread_on_face(buffer, j, corners, face, point_row, wx, wy, wz, fx, fy, fz):
+def _spread_on_face(buffer, rows, j, corners, face, point_row, wx, wy, wz, fx, fy, fz):
     """Force (fx, fy, fz) on the face whose corners are rows ``face``..``face + 2`` of
     ``corners``, at the point ``w`` away (in the face's plane) from the midpoint of the edge from
     row ``point_row`` to the next: shared by the corners' barycentric coordinates there."""
@@ -218,9 +221,10 @@ def _spread_on_face(buffer, j, corners, face, point_row, wx, wy, wz, fx, fy, fz)
         weights[1] += shift_1
         weights[2] += shift_2
     for k in range(3):
-        buffer[j, face + k, 0] += weights[k] * fx
-        buffer[j, face + k, 1] += weights[k] * fy
-        buffer[j, face + k, 2] += weights[k] * fz
+        row = rows[j, face + k]
+        buffer[row, 0] += weights[k] * fx
+        buffer[row, 1] += weights[k] * fy
+        buffer[row, 2] += weights[k] * fz
 
 
 #: A broken joint whose faces have turned from each other beyond this cosine (about 25 degrees)
@@ -252,7 +256,7 @@ def _face_cosine(corners):
 
 @inline_kernel
 def _broken_joint(j, positions, joints, sizes, properties, joint_material, released, anchors,
-                  buffer):
+                  buffer, rows):
     """Forces of broken joint ``j``: the intact joint's compressive penalty and friction at each
     point (opening below zero), but acting on both faces at one place, midway between the point
     of A and the point of B, by each face's barycentric coordinates there. The two forces then lie
@@ -272,7 +276,7 @@ def _broken_joint(j, positions, joints, sizes, properties, joint_material, relea
     for k in range(6):
         for d in range(3):
             corners[k, d] = positions[joints[j, k], d]
-            buffer[j, k, d] = 0.0
+            buffer[rows[j, k], d] = 0.0
     # the mid-surface, as for an intact joint (``_joint``)
     mid = np.empty((3, 3))
     for k in range(3):
@@ -328,15 +332,18 @@ def _broken_joint(j, positions, joints, sizes, properties, joint_material, relea
         fx = share * (compression * nx + gx)
         fy = share * (compression * ny + gy)
         fz = share * (compression * nz + gz)
-        _spread_on_face(buffer, j, corners, 0, q, 0.5 * sx, 0.5 * sy, 0.5 * sz, fx, fy, fz)
-        _spread_on_face(buffer, j, corners, 3, 3 + q, -0.5 * sx, -0.5 * sy, -0.5 * sz,
+        _spread_on_face(buffer, rows, j, corners, 0, q, 0.5 * sx, 0.5 * sy, 0.5 * sz, fx, fy,
+                        fz)
+        _spread_on_face(buffer, rows, j, corners, 3, 3 + q, -0.5 * sx, -0.5 * sy, -0.5 * sz,
                         -fx, -fy, -fz)
 
 
 @inline_kernel
-def _joint(j, positions, joints, sizes, properties, joint_material, damage, anchors, buffer):
-    """Forces of intact joint ``j`` on its six nodes into ``buffer[j]`` (6, 3); updates its damage
-    and friction anchors. Returns the number of its points at D >= 1."""
+def _joint(j, positions, joints, sizes, properties, joint_material, damage, anchors, buffer,
+           rows):
+    """Forces of intact joint ``j`` on its six nodes into their rows of ``buffer``
+    (``rows[j]``); updates its damage and friction anchors. Returns the number of its points at
+    D >= 1."""
     row = joint_material[j]
     tensile = properties[row, 0]
     cohesion = properties[row, 1]
@@ -378,7 +385,7 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, anch
     if twice_area <= 0.0:
         for k in range(6):
             for d in range(3):
-                buffer[j, k, d] = 0.0
+                buffer[rows[j, k], d] = 0.0
         return 0
     inverse = 1.0 / twice_area
     nx *= inverse
@@ -424,16 +431,17 @@ def _joint(j, positions, joints, sizes, properties, joint_material, damage, anch
         t2z += g2z
     failed = int(d0 >= 1.0) + int(d1 >= 1.0) + int(d2 >= 1.0)
     # vertex k takes the points on its two edges: q = k and q = k - 1
-    _put_vertex(buffer, j, 0, share * (t0x + t2x), share * (t0y + t2y), share * (t0z + t2z))
-    _put_vertex(buffer, j, 1, share * (t0x + t1x), share * (t0y + t1y), share * (t0z + t1z))
-    _put_vertex(buffer, j, 2, share * (t1x + t2x), share * (t1y + t2y), share * (t1z + t2z))
+    _put_vertex(buffer, rows, j, 0, share * (t0x + t2x), share * (t0y + t2y), share * (t0z + t2z))
+    _put_vertex(buffer, rows, j, 1, share * (t0x + t1x), share * (t0y + t1y), share * (t0z + t1z))
+    _put_vertex(buffer, rows, j, 2, share * (t1x + t2x), share * (t1y + t2y), share * (t1z + t2z))
     return failed
 
 
 @inline_kernel
 def joint_range(start, stop, positions, joints, sizes, properties, joint_material, damage, broken,
-                released, anchors, buffer):
-    """Forces of joints ``start`` .. ``stop - 1`` into ``buffer``: first the broken ones
+                released, anchors, buffer, rows):
+    """Forces of joints ``start`` .. ``stop - 1`` into their rows of ``buffer`` (``rows``, as in
+    :func:`joint_forces`): first the broken ones
     (``_broken_joint``), then the intact ones (``_joint``), of which those with two or more
     points at D >= 1 are marked ``broken`` (they act as broken joints from the next step on).
     Returns the number broken now. (Two loops: the broken joints' code inside the intact joints'
@@ -441,12 +449,12 @@ def joint_range(start, stop, positions, joints, sizes, properties, joint_materia
     for j in range(start, stop):
         if broken[j]:
             _broken_joint(j, positions, joints, sizes, properties, joint_material, released,
-                          anchors, buffer)
+                          anchors, buffer, rows)
     newly = 0
     for j in range(start, stop):
         if not broken[j]:
             if _joint(j, positions, joints, sizes, properties, joint_material, damage, anchors,
-                      buffer) >= 2:
+                      buffer, rows) >= 2:
                 broken[j] = True
                 newly += 1
     return newly
@@ -454,19 +462,26 @@ def joint_range(start, stop, positions, joints, sizes, properties, joint_materia
 
 @kernel
 def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, released,
-                 anchors, buffer):
-    """Forces of every joint (``joint_range``) into ``buffer`` (n_joints, 6, 3); a joint with two
-    or more points at D >= 1 is marked ``broken``. Returns the number broken now. (On threads,
-    the joints run in the loop of the tets' forces: ``finite_strain.tet4_and_joint_forces``.)"""
+                 anchors, buffer, rows):
+    """Forces of every joint (``joint_range``) into ``buffer``; a joint with two or more points
+    at D >= 1 is marked ``broken``. Returns the number broken now. (On threads, the joints run in
+    the loop of the tets' forces: ``finite_strain.tet4_and_joint_forces``.)
+
+    ``buffer`` (12 n_tets, 3) holds one row per vertex of every face of every tet: row
+    12 t + 3 f + i for the i-th corner of face f of tet t (``slots.CORNER_FACE_ROWS``). Joint j's
+    force on its vertex k (0-2 face A, 3-5 face B) goes to row ``rows[j, k]``: a side's three
+    rows together. Rows of faces without a joint stay zero. A node's joint forces are the rows
+    of the faces at its (tet, corner) slots (``slots.joint_slot_sum``): read in the node update
+    in the order of the nodes, with no table."""
     return joint_range(0, joints.shape[0], positions, joints, sizes, properties, joint_material,
-                       damage, broken, released, anchors, buffer)
+                       damage, broken, released, anchors, buffer, rows)
 
 
 @kernel
-def gather_joint_forces(buffer, table, overflow_offsets, overflow_slots, out):
-    """out[node] = the joint forces on it, from the slots of ``joints.joint_slot_table``. (The
+def gather_joint_forces(buffer, node_offsets, node_slots, out):
+    """out[node] = the joint forces on it: the buffer's rows of its (tet, corner) slots
+    (``node_slots[node_offsets[node]:node_offsets[node + 1]]``, see :func:`joint_forces`). (The
     time step sums them in the node update instead: ``finite_strain.update_node``.)"""
-    flat = buffer.reshape((-1, 3))
     for node in range(out.shape[0]):
-        out[node, 0], out[node, 1], out[node, 2] = table_slot_sum(
-            node, flat, table, overflow_offsets, overflow_slots)
+        _, _, _, out[node, 0], out[node, 1], out[node, 2] = joint_slot_sum(
+            node, buffer, buffer, node_offsets, node_slots)     # (the first sum unused)
