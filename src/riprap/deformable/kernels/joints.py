@@ -34,9 +34,7 @@ the friction, applied to both faces at one place, until its faces have slid h ap
 """
 import math
 
-import numpy as np
-
-from riprap._jit import inline_kernel, kernel
+from riprap._jit import inline_kernel, kernel, leaf_kernel
 from riprap.deformable.kernels.slots import joint_slot_sum
 
 SOFTENING_A = 0.63
@@ -196,35 +194,65 @@ def _put_vertex(buffer, rows, j, k, fx, fy, fz):
 
 
 @inline_kernel
-def _spread_on_face(buffer, rows, j, corners, face, point_row, wx, wy, wz, fx, fy, fz):
-    """Force (fx, fy, fz) on the face whose corners are rows ``face``..``face + 2`` of
-    ``corners``, at the point ``w`` away (in the face's plane) from the midpoint of the edge from
-    row ``point_row`` to the next: shared by the corners' barycentric coordinates there."""
-    ux = corners[face + 1, 0] - corners[face, 0]
-    uy = corners[face + 1, 1] - corners[face, 1]
-    uz = corners[face + 1, 2] - corners[face, 2]
-    vx = corners[face + 2, 0] - corners[face, 0]
-    vy = corners[face + 2, 1] - corners[face, 1]
-    vz = corners[face + 2, 2] - corners[face, 2]
+def _corner(positions, joints, j, k, d):
+    """Coordinate ``d`` of joint ``j``'s vertex ``k`` (0-2 face A, 3-5 face B)."""
+    return positions[joints[j, k], d]
+
+
+@inline_kernel
+def _mid_corner(positions, joints, j, k, d):
+    """Coordinate ``d`` of the mid-surface's corner ``k``: midway from A's vertex k to B's."""
+    return _corner(positions, joints, j, k, d) + 0.5 * (_corner(positions, joints, j, 3 + k, d)
+                                                        - _corner(positions, joints, j, k, d))
+
+
+@inline_kernel
+def _face_edges(positions, joints, j, face):
+    """x1 - x0 and x2 - x0 of joint ``j``'s face (vertices ``face``..``face + 2``)."""
+    x0 = _corner(positions, joints, j, face, 0)
+    y0 = _corner(positions, joints, j, face, 1)
+    z0 = _corner(positions, joints, j, face, 2)
+    return (_corner(positions, joints, j, face + 1, 0) - x0,
+            _corner(positions, joints, j, face + 1, 1) - y0,
+            _corner(positions, joints, j, face + 1, 2) - z0,
+            _corner(positions, joints, j, face + 2, 0) - x0,
+            _corner(positions, joints, j, face + 2, 1) - y0,
+            _corner(positions, joints, j, face + 2, 2) - z0)
+
+
+@inline_kernel
+def _add_weighted(buffer, rows, j, k, weight, fx, fy, fz):
+    row = rows[j, k]
+    buffer[row, 0] += weight * fx
+    buffer[row, 1] += weight * fy
+    buffer[row, 2] += weight * fz
+
+
+@inline_kernel
+def _spread_on_face(buffer, rows, j, positions, joints, face, q, wx, wy, wz, fx, fy, fz):
+    """Force (fx, fy, fz) on the face of joint ``j`` whose vertices are ``face``..``face + 2``
+    (0: face A, 3: face B), at the point ``w`` away (in the face's plane) from the midpoint of
+    its edge from vertex ``q`` to the next: shared by the vertices' barycentric coordinates
+    there. (Scalars, no arrays: the joints' one-thread loop allocates nothing, so that it runs
+    without reference counts, ``joint_forces``.)"""
+    ux, uy, uz, vx, vy, vz = _face_edges(positions, joints, j, face)
     cx = uy * vz - uz * vy
     cy = uz * vx - ux * vz
     cz = ux * vy - uy * vx
     c2 = cx * cx + cy * cy + cz * cz
-    weights = np.zeros(3)
-    q = point_row - face
-    weights[q] = 0.5
-    weights[(q + 1) % 3] = 0.5
+    # the edge's two vertices take half each: q and the next
+    w0 = 0.5 if q == 0 or q == 2 else 0.0
+    w1 = 0.5 if q == 0 or q == 1 else 0.0
+    w2 = 0.5 if q == 1 or q == 2 else 0.0
     if c2 > 0.0:
         shift_1 = ((wy * vz - wz * vy) * cx + (wz * vx - wx * vz) * cy + (wx * vy - wy * vx) * cz) / c2
         shift_2 = ((uy * wz - uz * wy) * cx + (uz * wx - ux * wz) * cy + (ux * wy - uy * wx) * cz) / c2
-        weights[0] -= shift_1 + shift_2
-        weights[1] += shift_1
-        weights[2] += shift_2
-    for k in range(3):
-        row = rows[j, face + k]
-        buffer[row, 0] += weights[k] * fx
-        buffer[row, 1] += weights[k] * fy
-        buffer[row, 2] += weights[k] * fz
+        w0 -= shift_1 + shift_2
+        w1 += shift_1
+        w2 += shift_2
+    _add_weighted(buffer, rows, j, face, w0, fx, fy, fz)
+    _add_weighted(buffer, rows, j, face + 1, w1, fx, fy, fz)
+    _add_weighted(buffer, rows, j, face + 2, w2, fx, fy, fz)
 
 
 #: A broken joint whose faces have turned from each other beyond this cosine (about 25 degrees)
@@ -234,24 +262,34 @@ RELEASE_PENETRATION = 0.01
 
 
 @inline_kernel
-def _face_cosine(corners):
-    """Cosine of the angle between the normals of the faces (rows 0-2 and 3-5 of ``corners``)."""
-    ax = (corners[1, 1] - corners[0, 1]) * (corners[2, 2] - corners[0, 2]) - (
-        corners[1, 2] - corners[0, 2]) * (corners[2, 1] - corners[0, 1])
-    ay = (corners[1, 2] - corners[0, 2]) * (corners[2, 0] - corners[0, 0]) - (
-        corners[1, 0] - corners[0, 0]) * (corners[2, 2] - corners[0, 2])
-    az = (corners[1, 0] - corners[0, 0]) * (corners[2, 1] - corners[0, 1]) - (
-        corners[1, 1] - corners[0, 1]) * (corners[2, 0] - corners[0, 0])
-    bx = (corners[4, 1] - corners[3, 1]) * (corners[5, 2] - corners[3, 2]) - (
-        corners[4, 2] - corners[3, 2]) * (corners[5, 1] - corners[3, 1])
-    by = (corners[4, 2] - corners[3, 2]) * (corners[5, 0] - corners[3, 0]) - (
-        corners[4, 0] - corners[3, 0]) * (corners[5, 2] - corners[3, 2])
-    bz = (corners[4, 0] - corners[3, 0]) * (corners[5, 1] - corners[3, 1]) - (
-        corners[4, 1] - corners[3, 1]) * (corners[5, 0] - corners[3, 0])
+def _face_normal(positions, joints, j, face):
+    """(x1 - x0) x (x2 - x0) of joint ``j``'s face (vertices ``face``..``face + 2``)."""
+    ax, ay, az, bx, by, bz = _face_edges(positions, joints, j, face)
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+
+
+@inline_kernel
+def _face_cosine(positions, joints, j):
+    """Cosine of the angle between the normals of joint ``j``'s faces A and B."""
+    ax, ay, az = _face_normal(positions, joints, j, 0)
+    bx, by, bz = _face_normal(positions, joints, j, 3)
     lengths = math.sqrt((ax * ax + ay * ay + az * az) * (bx * bx + by * by + bz * bz))
     if lengths <= 0.0:
         return -1.0
     return (ax * bx + ay * by + az * bz) / lengths
+
+
+@inline_kernel
+def _point_separation(positions, joints, j, q):
+    """x_B - x_A at point ``q`` of joint ``j`` (the midpoint of the edge from vertex q to the
+    next, on both faces)."""
+    r = (q + 1) % 3
+    return (0.5 * (_corner(positions, joints, j, 3 + q, 0) + _corner(positions, joints, j, 3 + r, 0)
+                   - _corner(positions, joints, j, q, 0) - _corner(positions, joints, j, r, 0)),
+            0.5 * (_corner(positions, joints, j, 3 + q, 1) + _corner(positions, joints, j, 3 + r, 1)
+                   - _corner(positions, joints, j, q, 1) - _corner(positions, joints, j, r, 1)),
+            0.5 * (_corner(positions, joints, j, 3 + q, 2) + _corner(positions, joints, j, 3 + r, 2)
+                   - _corner(positions, joints, j, q, 2) - _corner(positions, joints, j, r, 2)))
 
 
 @inline_kernel
@@ -272,18 +310,19 @@ def _broken_joint(j, positions, joints, sizes, properties, joint_material, relea
     beyond any concrete's strength: the faces got there without it, by sliding or turning, and
     switching it on would throw them apart). Unreleased, joints whose slip came back under h, or
     whose faces had turned, put up to 25 kJ into a unit dropped from 1 m in a single step."""
-    corners = np.empty((6, 3))
     for k in range(6):
         for d in range(3):
-            corners[k, d] = positions[joints[j, k], d]
             buffer[rows[j, k], d] = 0.0
     # the mid-surface, as for an intact joint (``_joint``)
-    mid = np.empty((3, 3))
-    for k in range(3):
-        for d in range(3):
-            mid[k, d] = corners[k, d] + 0.5 * (corners[3 + k, d] - corners[k, d])
-    e1x, e1y, e1z = mid[1, 0] - mid[0, 0], mid[1, 1] - mid[0, 1], mid[1, 2] - mid[0, 2]
-    e2x, e2y, e2z = mid[2, 0] - mid[0, 0], mid[2, 1] - mid[0, 1], mid[2, 2] - mid[0, 2]
+    m0x = _mid_corner(positions, joints, j, 0, 0)
+    m0y = _mid_corner(positions, joints, j, 0, 1)
+    m0z = _mid_corner(positions, joints, j, 0, 2)
+    e1x = _mid_corner(positions, joints, j, 1, 0) - m0x
+    e1y = _mid_corner(positions, joints, j, 1, 1) - m0y
+    e1z = _mid_corner(positions, joints, j, 1, 2) - m0z
+    e2x = _mid_corner(positions, joints, j, 2, 0) - m0x
+    e2y = _mid_corner(positions, joints, j, 2, 1) - m0y
+    e2z = _mid_corner(positions, joints, j, 2, 2) - m0z
     nx = e1y * e2z - e1z * e2y
     ny = e1z * e2x - e1x * e2z
     nz = e1x * e2y - e1y * e2x
@@ -299,43 +338,38 @@ def _broken_joint(j, positions, joints, sizes, properties, joint_material, relea
     tan_phi = properties[row, 2]
     h = sizes[j]
     penalty_over_h = properties[row, 3] / h
-    if _face_cosine(corners) < RELEASE_FACE_COSINE:
+    if _face_cosine(positions, joints, j) < RELEASE_FACE_COSINE:
         released[j] = True
         return
-    separations = np.empty((3, 3))
-    openings = np.empty(3)
     for q in range(3):
-        r = (q + 1) % 3
-        for d in range(3):
-            separations[q, d] = 0.5 * (corners[3 + q, d] + corners[3 + r, d]
-                                       - corners[q, d] - corners[r, d])
-        opening = separations[q, 0] * nx + separations[q, 1] * ny + separations[q, 2] * nz
-        openings[q] = opening
-        tx = separations[q, 0] - opening * nx
-        ty = separations[q, 1] - opening * ny
-        tz = separations[q, 2] - opening * nz
+        sx, sy, sz = _point_separation(positions, joints, j, q)
+        opening = sx * nx + sy * ny + sz * nz
+        tx = sx - opening * nx
+        ty = sy - opening * ny
+        tz = sz - opening * nz
         if tx * tx + ty * ty + tz * tz >= h * h or opening < -RELEASE_PENETRATION * h:
             released[j] = True
             return
     share = twice_area / 6.0       # a third of the area per point
     for q in range(3):
-        compression = min(openings[q], 0.0) * penalty_over_h    # < 0: pushes A away from B
-        sx, sy, sz = separations[q, 0], separations[q, 1], separations[q, 2]
+        sx, sy, sz = _point_separation(positions, joints, j, q)
+        opening = sx * nx + sy * ny + sz * nz
+        compression = min(opening, 0.0) * penalty_over_h    # < 0: pushes A away from B
         gx = gy = gz = 0.0
         if tan_phi > 0.0:
             # the crack's faces keep the joint's friction while they are pressed together
-            gx, gy, gz = _friction(sx - openings[q] * nx, sy - openings[q] * ny,
-                                   sz - openings[q] * nz, compression, tan_phi, penalty_over_h,
-                                   e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram, anchors, j, q)
+            gx, gy, gz = _friction(sx - opening * nx, sy - opening * ny, sz - opening * nz,
+                                   compression, tan_phi, penalty_over_h, e1x, e1y, e1z, e2x, e2y,
+                                   e2z, inverse_gram, anchors, j, q)
         if compression == 0.0:
             continue
         fx = share * (compression * nx + gx)
         fy = share * (compression * ny + gy)
         fz = share * (compression * nz + gz)
-        _spread_on_face(buffer, rows, j, corners, 0, q, 0.5 * sx, 0.5 * sy, 0.5 * sz, fx, fy,
-                        fz)
-        _spread_on_face(buffer, rows, j, corners, 3, 3 + q, -0.5 * sx, -0.5 * sy, -0.5 * sz,
-                        -fx, -fy, -fz)
+        _spread_on_face(buffer, rows, j, positions, joints, 0, q, 0.5 * sx, 0.5 * sy, 0.5 * sz,
+                        fx, fy, fz)
+        _spread_on_face(buffer, rows, j, positions, joints, 3, q, -0.5 * sx, -0.5 * sy,
+                        -0.5 * sz, -fx, -fy, -fz)
 
 
 @inline_kernel
@@ -460,7 +494,7 @@ def joint_range(start, stop, positions, joints, sizes, properties, joint_materia
     return newly
 
 
-@kernel
+@leaf_kernel
 def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, released,
                  anchors, buffer, rows):
     """Forces of every joint (``joint_range``) into ``buffer``; a joint with two or more points
@@ -472,7 +506,11 @@ def joint_forces(positions, joints, sizes, properties, joint_material, damage, b
     force on its vertex k (0-2 face A, 3-5 face B) goes to row ``rows[j, k]``: a side's three
     rows together. Rows of faces without a joint stay zero. A node's joint forces are the rows
     of the faces at its (tet, corner) slots (``slots.joint_slot_sum``): read in the node update
-    in the order of the nodes, with no table."""
+    in the order of the nodes, with no table.
+
+    Compiled without numba's reference counts (``leaf_kernel``: nothing in the joints' code
+    allocates): with them, six atomic increments and decrements per joint took 65 % of this
+    loop's time (``perf``)."""
     return joint_range(0, joints.shape[0], positions, joints, sizes, properties, joint_material,
                        damage, broken, released, anchors, buffer, rows)
 
