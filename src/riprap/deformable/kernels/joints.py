@@ -35,7 +35,7 @@ the friction, applied to both faces at one place, until its faces have slid h ap
 import math
 
 from riprap._jit import inline_kernel, kernel, leaf_kernel
-from riprap.deformable.kernels.slots import joint_slot_sum
+from riprap.deformable.kernels.slots import corner_joint_force
 
 SOFTENING_A = 0.63
 SOFTENING_B = 1.8
@@ -521,5 +521,10 @@ def gather_joint_forces(buffer, node_offsets, node_slots, out):
     (``node_slots[node_offsets[node]:node_offsets[node + 1]]``, see :func:`joint_forces`). (The
     time step sums them in the node update instead: ``finite_strain.update_node``.)"""
     for node in range(out.shape[0]):
-        _, _, _, out[node, 0], out[node, 1], out[node, 2] = joint_slot_sum(
-            node, buffer, buffer, node_offsets, node_slots)     # (the first sum unused)
+        fx = fy = fz = 0.0
+        for s in range(node_offsets[node], node_offsets[node + 1]):
+            jx, jy, jz = corner_joint_force(node_slots[s], buffer)
+            fx += jx
+            fy += jy
+            fz += jz
+        out[node, 0], out[node, 1], out[node, 2] = fx, fy, fz
