@@ -5,7 +5,8 @@ import pytest
 
 from riprap.deformable.joints import (SOFTENING_AREA, FracturingBody, JointMaterial, explode_mesh,
                                      joint_force_rows, locality_order)
-from riprap.deformable.kernels.joints import gather_joint_forces, softening
+from riprap.deformable.kernels.joints import (SOFTENING_A, SOFTENING_B, SOFTENING_C,
+                                               gather_joint_forces, softening)
 from riprap.deformable.material import ElasticMaterial
 from riprap.errors import CaseFileError
 from riprap.geometry.structured import box_mesh
@@ -118,6 +119,12 @@ def test_the_softening_curve_falls_from_one_to_zero():
     z = np.array([softening(d) for d in damage])
     assert z[0] == 1.0 and z[-1] == 0.0
     assert np.all(np.diff(z) <= 0.0)
+    # the kernel's exponential is a polynomial (so that the joints' law runs on vector
+    # registers): Hordijk's curve with numpy's exp, to rounding
+    a, b, c = SOFTENING_A, SOFTENING_B, SOFTENING_C
+    closed_form = ((1.0 - (a + b - 1.0) / (a + b) * np.exp(damage * (a + c * b) / ((a + b) * (1.0 - a - b))))
+                   * (a * (1.0 - damage) + b * (1.0 - damage) ** c))
+    assert np.max(np.abs(z - closed_form)) < 1e-14
     assert SOFTENING_AREA == pytest.approx(0.3863, abs=1e-4)
 
 

@@ -331,7 +331,7 @@ class FracturingBody(DeformableBody):
                                    self._joint_properties, self._joint_material_index,
                                    self.joint_damage, self.joint_broken, self.joint_released,
                                    self.joint_friction_anchor, self._joint_buffer,
-                                   self._joint_rows)
+                                   self._joint_rows, np.empty(joint_kernels.JOINT_SCRATCH_SIZE))
         joint_kernels.gather_joint_forces(self._joint_buffer, self._offsets, self._slots, forces)
         return forces
 

@@ -222,6 +222,8 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
     n_tets = tets.shape[0]
     n_joints = joint_nodes.shape[0]
     for block in prange(FORCE_BLOCKS):
+        # each block its own (numba allocates it once per thread: allocation hoisting)
+        scratch = np.empty(joint_kernels.JOINT_SCRATCH_SIZE)
         for e in range(block * n_tets // FORCE_BLOCKS, (block + 1) * n_tets // FORCE_BLOCKS):
             tet4_element(e, positions, velocities, tets, gradients, volumes, materials,
                          element_material, element_forces, jacobians)
@@ -229,7 +231,7 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
                                   (block + 1) * n_joints // FORCE_BLOCKS, positions, joint_nodes,
                                   joint_sizes, joint_properties, joint_material, joint_damage,
                                   joint_broken, joint_released, joint_anchors, joint_buffer,
-                                  joint_rows)
+                                  joint_rows, scratch)
 
 
 @kernel
@@ -522,6 +524,8 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
      joint_buffer, joint_rows, joint_released, joint_work, joint_anchors) = joint_data
     has_joints = joint_nodes.shape[0] > 0
+    # the one-thread joints' scratch (``joint_forces``; on threads, each block has its own)
+    joint_scratch = np.empty(joint_kernels.JOINT_SCRATCH_SIZE if has_joints else 0)
     tet4 = elements.shape[1] == 4
     has_contact = triangles.shape[0] > 0
     half_skin_squared = 0.25 * skin * skin
@@ -574,7 +578,7 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
                 joint_kernels.joint_forces(
                     positions, joint_nodes, joint_sizes, joint_properties, joint_material,
                     joint_damage, joint_broken, joint_released, joint_anchors, joint_buffer,
-                    joint_rows)
+                    joint_rows, joint_scratch)
             element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
                                   weights, materials, element_material, element_forces, jacobians)
         elif tet4:

@@ -42,17 +42,44 @@ SOFTENING_B = 1.8
 SOFTENING_C = 6.0
 
 
+#: exp(D (a + c b) / ((a + b)(1 - a - b))) is taken as exp(x)^8 with x an eighth of the exponent
+#: (in [-0.41, 0]), exp(x) by its Taylor series to x^14 (the first term left out: 2e-18 of it).
+_EXPONENT_EIGHTH = ((SOFTENING_A + SOFTENING_C * SOFTENING_B)
+                    / ((SOFTENING_A + SOFTENING_B) * (1.0 - SOFTENING_A - SOFTENING_B)) / 8.0)
+_DROP = (SOFTENING_A + SOFTENING_B - 1.0) / (SOFTENING_A + SOFTENING_B)
+
+
 @inline_kernel
 def softening(damage):
-    """z(D) of the module docstring: 1 at D = 0, 0 at D = 1."""
-    if damage >= 1.0:
-        return 0.0
-    if damage <= 0.0:
-        return 1.0
-    a, b, c = SOFTENING_A, SOFTENING_B, SOFTENING_C
-    first = 1.0 - (a + b - 1.0) / (a + b) * math.exp(damage * (a + c * b) / ((a + b) * (1.0 - a - b)))
+    """z(D) of the module docstring: 1 at D = 0, 0 at D = 1 (c = 6: (1 - D)^c as products).
+
+    Written without calls or branches (the exponential as a polynomial, within 2e-15 of
+    ``math.exp``'s curve), so that the joints' law runs on vector registers (``_law_block``):
+    numba has no vector ``exp``, and its scalar ``exp`` in the loop kept the whole loop scalar."""
+    x = damage * _EXPONENT_EIGHTH
+    e = 1.0 / 87178291200.0
+    e = e * x + 1.0 / 6227020800.0
+    e = e * x + 1.0 / 479001600.0
+    e = e * x + 1.0 / 39916800.0
+    e = e * x + 1.0 / 3628800.0
+    e = e * x + 1.0 / 362880.0
+    e = e * x + 1.0 / 40320.0
+    e = e * x + 1.0 / 5040.0
+    e = e * x + 1.0 / 720.0
+    e = e * x + 1.0 / 120.0
+    e = e * x + 1.0 / 24.0
+    e = e * x + 1.0 / 6.0
+    e = e * x + 0.5
+    e = e * x + 1.0
+    e = e * x + 1.0
+    e = e * e
+    e = e * e
+    e = e * e
     rest = 1.0 - damage
-    return first * (a * rest + b * rest ** c)
+    rest_2 = rest * rest
+    z = (1.0 - _DROP * e) * (SOFTENING_A * rest + SOFTENING_B * (rest_2 * rest_2 * rest_2))
+    z = 0.0 if damage >= 1.0 else z
+    return 1.0 if damage <= 0.0 else z
 
 
 @inline_kernel
@@ -110,73 +137,6 @@ def _friction(tx, ty, tz, compression, tan_phi, penalty_over_h, e1x, e1y, e1z, e
         anchors[j, q, 0], anchors[j, q, 1] = _edge_coordinates(
             tx - ux, ty - uy, tz - uz, e1x, e1y, e1z, e2x, e2y, e2z, inverse_gram)
     return penalty_over_h * ux, penalty_over_h * uy, penalty_over_h * uz
-
-
-@inline_kernel
-def _point_friction(sx, sy, sz, nx, ny, nz, h, tan_phi, penalty_over_h, e1x, e1y, e1z, e2x, e2y,
-                    e2z, inverse_gram, anchors, j, q):
-    """Coulomb friction (``_friction``) at point ``q`` of intact joint ``j`` whose faces are
-    apart by (sx, sy, sz), pressed by the penalty of ``_point_traction``. Moves the point's
-    friction anchor (``anchors[j, q]``: the slip, as multiples of the edges e1 and e2, at which
-    its friction is nil) where the friction slides. Munjiza's f_s = c - tan(phi) sigma inside the
-    elastic-like law gave the energy back on a different path from the one it took: a unit
-    crushing on a rock gained 881 J from its joints (docs/fracture.md)."""
-    opening = sx * nx + sy * ny + sz * nz
-    tx = sx - opening * nx
-    ty = sy - opening * ny
-    tz = sz - opening * nz
-    pressed = opening < 0.0 and tx * tx + ty * ty + tz * tz < h * h
-    compression = opening * penalty_over_h if pressed else 0.0
-    return _friction(tx, ty, tz, compression, tan_phi, penalty_over_h, e1x, e1y, e1z, e2x, e2y,
-                     e2z, inverse_gram, anchors, j, q)
-
-
-@inline_kernel
-def _point_traction(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, penalty_over_h, two_h_over_p,
-                    opening_peak, inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i,
-                    inverse_energy_ii, damage, j, q):
-    """Cohesive traction and compressive penalty (pulling face A towards B) at point ``q`` of
-    joint ``j`` whose faces are apart by (sx, sy, sz), mid-surface normal n; and the point's
-    damage after it. ``opening_peak`` = 2 h f_t / p; ``inverse_slip_peak`` = p / (2 h c). (The
-    friction is added by ``_point_friction``. Divisions and square roots are most of a joint's
-    cost: each is taken once per joint where it can be.)"""
-    opening = sx * nx + sy * ny + sz * nz
-    tx = sx - opening * nx
-    ty = sy - opening * ny
-    tz = sz - opening * nz
-    slip = math.sqrt(tx * tx + ty * ty + tz * tz)
-    # the faces may not pass through each other (sigma = p o / h) while they face each other
-    compression = opening * penalty_over_h if opening < 0.0 and slip < h else 0.0
-    # tau / slip: the cohesive shear traction along the slip vector
-    shear_over_slip = 0.0
-    slip_peak = two_h_over_p * cohesion
-    excess_o = max(opening - opening_peak, 0.0) * tensile_over_energy_i
-    excess_s = max(slip - slip_peak, 0.0) * cohesion * inverse_energy_ii
-    current = damage[j, q]
-    if excess_o > 0.0 or excess_s > 0.0:
-        grown = min(math.sqrt(excess_o * excess_o + excess_s * excess_s), 1.0)
-        if grown > current:
-            current = grown
-    # stored every time, not only where it grew: an array written inside the branch made numba
-    # take references to it and to two more arrays per point in the one-thread loop (atomic
-    # counts: joint_forces 104 -> 77 ns a joint; the threaded loop has none either way)
-    damage[j, q] = current
-    z = softening(current)
-    if opening < 0.0:
-        sigma = compression
-    elif opening < opening_peak:
-        sigma = _rising(opening * inverse_opening_peak) * z * tensile
-    else:
-        sigma = z * tensile
-    if slip < slip_peak:
-        # (2 - r) r z c / slip with r = slip / slip_peak and c / slip_peak = p / (2 h)
-        shear_over_slip = (2.0 - slip * inverse_slip_peak) * z * 0.5 * penalty_over_h
-    elif slip > 0.0:
-        shear_over_slip = z * cohesion / slip
-    fx = sigma * nx + shear_over_slip * tx
-    fy = sigma * ny + shear_over_slip * ty
-    fz = sigma * nz + shear_over_slip * tz
-    return fx, fy, fz, current
 
 
 @inline_kernel
@@ -372,134 +332,272 @@ def _broken_joint(j, positions, joints, sizes, properties, joint_material, relea
                         -0.5 * sz, -fx, -fy, -fz)
 
 
+#: Joints whose law is evaluated together (``_law_block``), and the rows of their scratch: one
+#: row of ``JOINT_BLOCK`` numbers per quantity, so that each quantity lies contiguous and at a
+#: distance known when compiling from the others (with rows a run-time stride apart, LLVM would
+#: need more overlap checks than it makes, and kept the loop scalar).
+JOINT_BLOCK = 64
+_SEPARATIONS = 0        # 9 rows: x_B - x_A at vertices 0, 1, 2 (x, y, z each)
+_EDGES = 9              # 6 rows: the mid-surface's edges e1, e2 from its corner 0
+_SIZE = 15              # h
+_DAMAGE_BEFORE = 16     # 3 rows, one per point
+_TRACTIONS = 19         # 9 rows: each point's cohesive traction with the compressive penalty
+_SHARE = 28             # a sixth of the area (0 for a joint of no area)
+_DAMAGE = 29            # 3 rows: each point's damage after the step
+_SLIPS = 32             # 12 rows: per point, slip vector (3) and compression (1)
+_INVERSE_GRAM = 44      # 1 / |e1 x e2|^2
+SCRATCH_ROWS = 45
+#: Numbers of scratch one thread needs for the joints (``joint_forces``, ``joint_range``).
+JOINT_SCRATCH_SIZE = SCRATCH_ROWS * JOINT_BLOCK
+
+
 @inline_kernel
-def _joint(j, positions, joints, sizes, properties, joint_material, damage, anchors, buffer,
-           rows):
-    """Forces of intact joint ``j`` on its six nodes into their rows of ``buffer``
-    (``rows[j]``); updates its damage and friction anchors. Returns the number of its points at
-    D >= 1."""
-    row = joint_material[j]
-    tensile = properties[row, 0]
-    cohesion = properties[row, 1]
-    tan_phi = properties[row, 2]
-    h = sizes[j]
-    # one division per joint: the rest are the material's, taken once (JointMaterial.kernel_row)
-    penalty_over_h = properties[row, 3] / h
-    two_h_over_p = h * properties[row, 6]
-    opening_peak = two_h_over_p * tensile
-    inverse_opening_peak = penalty_over_h * properties[row, 7]
-    inverse_slip_peak = penalty_over_h * properties[row, 8]
-    tensile_over_energy_i = properties[row, 4]
-    inverse_energy_ii = properties[row, 5]
-    a0, a1, a2 = joints[j, 0], joints[j, 1], joints[j, 2]
-    b0, b1, b2 = joints[j, 3], joints[j, 4], joints[j, 5]
-    # separations at the vertices and the mid-surface's corners
-    d0x = positions[b0, 0] - positions[a0, 0]
-    d0y = positions[b0, 1] - positions[a0, 1]
-    d0z = positions[b0, 2] - positions[a0, 2]
-    d1x = positions[b1, 0] - positions[a1, 0]
-    d1y = positions[b1, 1] - positions[a1, 1]
-    d1z = positions[b1, 2] - positions[a1, 2]
-    d2x = positions[b2, 0] - positions[a2, 0]
-    d2y = positions[b2, 1] - positions[a2, 1]
-    d2z = positions[b2, 2] - positions[a2, 2]
-    m0x = positions[a0, 0] + 0.5 * d0x
-    m0y = positions[a0, 1] + 0.5 * d0y
-    m0z = positions[a0, 2] + 0.5 * d0z
-    e1x = positions[a1, 0] + 0.5 * d1x - m0x
-    e1y = positions[a1, 1] + 0.5 * d1y - m0y
-    e1z = positions[a1, 2] + 0.5 * d1z - m0z
-    e2x = positions[a2, 0] + 0.5 * d2x - m0x
-    e2y = positions[a2, 1] + 0.5 * d2y - m0y
-    e2z = positions[a2, 2] + 0.5 * d2z - m0z
-    nx = e1y * e2z - e1z * e2y
-    ny = e1z * e2x - e1x * e2z
-    nz = e1x * e2y - e1y * e2x
-    twice_area = math.sqrt(nx * nx + ny * ny + nz * nz)
-    if twice_area <= 0.0:
-        for k in range(6):
-            for d in range(3):
-                buffer[rows[j, k], d] = 0.0
-        return 0
-    inverse = 1.0 / twice_area
-    nx *= inverse
-    ny *= inverse
-    nz *= inverse
-    # for the friction anchors: the Gram determinant of the edges is |e1 x e2|^2
-    inverse_gram = inverse * inverse
-    # a third of the area per point, half of that to each of the point's two vertices
-    share = twice_area / 12.0
-    # point q sits midway between vertices q and q + 1
-    t0x, t0y, t0z, d0 = _point_traction(
-        0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, h, tensile,
-        cohesion, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii, damage, j, 0)
-    t1x, t1y, t1z, d1 = _point_traction(
-        0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, h, tensile,
-        cohesion, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii, damage, j, 1)
-    t2x, t2y, t2z, d2 = _point_traction(
-        0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, h, tensile,
-        cohesion, penalty_over_h, two_h_over_p, opening_peak, inverse_opening_peak,
-        inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii, damage, j, 2)
-    if tan_phi > 0.0:
-        # after the three points' laws, not inside them: the friction's code inside the point's
-        # law made every joint about 10 % slower, even with no friction (bench/joint_kernel.py)
-        g0x, g0y, g0z = _point_friction(0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z),
-                                        nx, ny, nz, h, tan_phi, penalty_over_h, e1x, e1y, e1z,
-                                        e2x, e2y, e2z, inverse_gram, anchors, j, 0)
-        g1x, g1y, g1z = _point_friction(0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z),
-                                        nx, ny, nz, h, tan_phi, penalty_over_h, e1x, e1y, e1z,
-                                        e2x, e2y, e2z, inverse_gram, anchors, j, 1)
-        g2x, g2y, g2z = _point_friction(0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z),
-                                        nx, ny, nz, h, tan_phi, penalty_over_h, e1x, e1y, e1z,
-                                        e2x, e2y, e2z, inverse_gram, anchors, j, 2)
-        t0x += g0x
-        t0y += g0y
-        t0z += g0z
-        t1x += g1x
-        t1y += g1y
-        t1z += g1z
-        t2x += g2x
-        t2y += g2y
-        t2z += g2z
-    failed = int(d0 >= 1.0) + int(d1 >= 1.0) + int(d2 >= 1.0)
-    # vertex k takes the points on its two edges: q = k and q = k - 1
-    _put_vertex(buffer, rows, j, 0, share * (t0x + t2x), share * (t0y + t2y), share * (t0z + t2z))
-    _put_vertex(buffer, rows, j, 1, share * (t0x + t1x), share * (t0y + t1y), share * (t0z + t1z))
-    _put_vertex(buffer, rows, j, 2, share * (t1x + t2x), share * (t1y + t2y), share * (t1z + t2z))
-    return failed
+def _at(row, i):
+    """Index of joint ``i`` of a block in its ``row`` of the scratch."""
+    return row * JOINT_BLOCK + i
+
+
+@inline_kernel
+def _read3(scratch, row, i):
+    """Joint ``i``'s three numbers in rows ``row`` .. ``row + 2`` of the scratch."""
+    return scratch[_at(row, i)], scratch[_at(row + 1, i)], scratch[_at(row + 2, i)]
+
+
+@inline_kernel
+def _write3(scratch, row, i, x, y, z):
+    scratch[_at(row, i)] = x
+    scratch[_at(row + 1, i)] = y
+    scratch[_at(row + 2, i)] = z
+
+
+@inline_kernel
+def _point_law(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, penalty_over_h, slip_peak,
+               opening_peak, inverse_opening_peak, inverse_slip_peak, tensile_over_energy_i,
+               inverse_energy_ii, before):
+    """Cohesive traction with the compressive penalty (pulling face A towards B) at a point of an
+    intact joint whose faces are apart by (sx, sy, sz), mid-surface normal n, damage ``before``
+    the step. Returns the traction, the damage after it, the slip vector and the compression (for
+    the friction, ``_friction``). Every case is computed and one chosen (no branches), so that the
+    loop of ``_law_block`` runs on vector registers."""
+    opening = sx * nx + sy * ny + sz * nz
+    tx = sx - opening * nx
+    ty = sy - opening * ny
+    tz = sz - opening * nz
+    slip = math.sqrt(tx * tx + ty * ty + tz * tz)
+    # the faces may not pass through each other (sigma = p o / h) while they face each other
+    compression = opening * penalty_over_h if (opening < 0.0) & (slip < h) else 0.0
+    excess_o = max(opening - opening_peak, 0.0) * tensile_over_energy_i
+    excess_s = max(slip - slip_peak, 0.0) * cohesion * inverse_energy_ii
+    damage = max(before, min(math.sqrt(excess_o * excess_o + excess_s * excess_s), 1.0))
+    z = softening(damage)
+    sigma = z * tensile
+    ratio = opening * inverse_opening_peak
+    sigma = _rising(ratio) * z * tensile if opening < opening_peak else sigma
+    sigma = compression if opening < 0.0 else sigma
+    # tau / slip: the cohesive shear traction along the slip vector; below the peak
+    # (2 - r) r z c / slip with r = slip / slip_peak and c / slip_peak = p / (2 h)
+    shear_over_slip = z * cohesion / slip if slip > 0.0 else 0.0
+    shear_over_slip = ((2.0 - slip * inverse_slip_peak) * z * 0.5 * penalty_over_h
+                       if slip < slip_peak else shear_over_slip)
+    return (sigma * nx + shear_over_slip * tx, sigma * ny + shear_over_slip * ty,
+            sigma * nz + shear_over_slip * tz, damage, tx, ty, tz, compression)
+
+
+@inline_kernel
+def _law_block(scratch, count, tensile, cohesion, penalty, two_over_penalty,
+               half_over_tensile, half_over_cohesion, tensile_over_energy_i, inverse_energy_ii):
+    """The law of ``count`` intact joints of one material, from their separations, edges, sizes
+    and damage in ``scratch`` (rows ``_SEPARATIONS`` .. ``_DAMAGE_BEFORE``) to their points'
+    tractions, damage, slips and compressions (rows ``_TRACTIONS`` .. ``_INVERSE_GRAM``). Reads
+    and writes the scratch only, at distances known when compiling, and has no branches or
+    calls: LLVM runs it on vector registers (eight joints at once with AVX-512)."""
+    for i in range(count):
+        d0x, d0y, d0z = _read3(scratch, _SEPARATIONS, i)
+        d1x, d1y, d1z = _read3(scratch, _SEPARATIONS + 3, i)
+        d2x, d2y, d2z = _read3(scratch, _SEPARATIONS + 6, i)
+        e1x, e1y, e1z = _read3(scratch, _EDGES, i)
+        e2x, e2y, e2z = _read3(scratch, _EDGES + 3, i)
+        h = scratch[_at(_SIZE, i)]
+        nx = e1y * e2z - e1z * e2y
+        ny = e1z * e2x - e1x * e2z
+        nz = e1x * e2y - e1y * e2x
+        twice_area = math.sqrt(nx * nx + ny * ny + nz * nz)
+        has_area = twice_area > 0.0
+        inverse = 1.0 / twice_area if has_area else 0.0
+        nx *= inverse
+        ny *= inverse
+        nz *= inverse
+        penalty_over_h = penalty / h
+        two_h_over_p = h * two_over_penalty
+        opening_peak = two_h_over_p * tensile
+        slip_peak = two_h_over_p * cohesion
+        inverse_opening_peak = penalty_over_h * half_over_tensile
+        inverse_slip_peak = penalty_over_h * half_over_cohesion
+        # point q sits midway between vertices q and q + 1
+        f0x, f0y, f0z, damage_0, t0x, t0y, t0z, c0 = _point_law(
+            0.5 * (d0x + d1x), 0.5 * (d0y + d1y), 0.5 * (d0z + d1z), nx, ny, nz, h, tensile,
+            cohesion, penalty_over_h, slip_peak, opening_peak, inverse_opening_peak,
+            inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii,
+            scratch[_at(_DAMAGE_BEFORE, i)])
+        f1x, f1y, f1z, damage_1, t1x, t1y, t1z, c1 = _point_law(
+            0.5 * (d1x + d2x), 0.5 * (d1y + d2y), 0.5 * (d1z + d2z), nx, ny, nz, h, tensile,
+            cohesion, penalty_over_h, slip_peak, opening_peak, inverse_opening_peak,
+            inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii,
+            scratch[_at(_DAMAGE_BEFORE + 1, i)])
+        f2x, f2y, f2z, damage_2, t2x, t2y, t2z, c2 = _point_law(
+            0.5 * (d2x + d0x), 0.5 * (d2y + d0y), 0.5 * (d2z + d0z), nx, ny, nz, h, tensile,
+            cohesion, penalty_over_h, slip_peak, opening_peak, inverse_opening_peak,
+            inverse_slip_peak, tensile_over_energy_i, inverse_energy_ii,
+            scratch[_at(_DAMAGE_BEFORE + 2, i)])
+        _write3(scratch, _TRACTIONS, i, f0x, f0y, f0z)
+        _write3(scratch, _TRACTIONS + 3, i, f1x, f1y, f1z)
+        _write3(scratch, _TRACTIONS + 6, i, f2x, f2y, f2z)
+        # a third of the area per point, half of that to each of the point's two vertices
+        scratch[_at(_SHARE, i)] = twice_area / 12.0
+        # a joint of no area keeps its damage (and gets no force: its share is 0)
+        scratch[_at(_DAMAGE, i)] = damage_0 if has_area else scratch[_at(_DAMAGE_BEFORE, i)]
+        scratch[_at(_DAMAGE + 1, i)] = damage_1 if has_area else scratch[_at(_DAMAGE_BEFORE + 1, i)]
+        scratch[_at(_DAMAGE + 2, i)] = damage_2 if has_area else scratch[_at(_DAMAGE_BEFORE + 2, i)]
+        _write3(scratch, _SLIPS, i, t0x, t0y, t0z)
+        scratch[_at(_SLIPS + 3, i)] = c0
+        _write3(scratch, _SLIPS + 4, i, t1x, t1y, t1z)
+        scratch[_at(_SLIPS + 7, i)] = c1
+        _write3(scratch, _SLIPS + 8, i, t2x, t2y, t2z)
+        scratch[_at(_SLIPS + 11, i)] = c2
+        # for the friction anchors: the Gram determinant of the edges is |e1 x e2|^2
+        scratch[_at(_INVERSE_GRAM, i)] = inverse * inverse
+
+
+@inline_kernel
+def _gather_block(first, count, positions, joints, sizes, damage, scratch):
+    """Separations, mid-surface edges, sizes and damage of joints ``first`` .. ``first + count -
+    1`` into their rows of ``scratch`` (for ``_law_block``)."""
+    for i in range(count):
+        j = first + i
+        a0, a1, a2 = joints[j, 0], joints[j, 1], joints[j, 2]
+        b0, b1, b2 = joints[j, 3], joints[j, 4], joints[j, 5]
+        for d in range(3):
+            d0 = positions[b0, d] - positions[a0, d]
+            d1 = positions[b1, d] - positions[a1, d]
+            d2 = positions[b2, d] - positions[a2, d]
+            m0 = positions[a0, d] + 0.5 * d0
+            scratch[_at(_SEPARATIONS + d, i)] = d0
+            scratch[_at(_SEPARATIONS + 3 + d, i)] = d1
+            scratch[_at(_SEPARATIONS + 6 + d, i)] = d2
+            scratch[_at(_EDGES + d, i)] = positions[a1, d] + 0.5 * d1 - m0
+            scratch[_at(_EDGES + 3 + d, i)] = positions[a2, d] + 0.5 * d2 - m0
+        scratch[_at(_SIZE, i)] = sizes[j]
+        for q in range(3):
+            scratch[_at(_DAMAGE_BEFORE + q, i)] = damage[j, q]
+
+
+@inline_kernel
+def _point_friction(scratch, i, q, tan_phi, penalty_over_h, inverse_gram, anchors, j):
+    """``_friction`` at point ``q`` of joint ``i`` of the block (joint ``j``), from its slip and
+    compression in the scratch."""
+    return _friction(scratch[_at(_SLIPS + 4 * q, i)], scratch[_at(_SLIPS + 4 * q + 1, i)],
+                     scratch[_at(_SLIPS + 4 * q + 2, i)], scratch[_at(_SLIPS + 4 * q + 3, i)],
+                     tan_phi, penalty_over_h, scratch[_at(_EDGES, i)], scratch[_at(_EDGES + 1, i)],
+                     scratch[_at(_EDGES + 2, i)], scratch[_at(_EDGES + 3, i)],
+                     scratch[_at(_EDGES + 4, i)], scratch[_at(_EDGES + 5, i)], inverse_gram,
+                     anchors, j, q)
+
+
+@inline_kernel
+def _scatter_block(first, count, tan_phi, penalty, damage, broken, anchors, buffer, rows,
+                   scratch):
+    """Joints ``first`` .. ``first + count - 1`` after ``_law_block``: for each intact one its
+    damage, its friction (Coulomb's, from its anchors: ``_friction``) and its forces on its six
+    nodes into their rows of ``buffer``; those with two or more points at D >= 1 are marked
+    ``broken``. Returns the number broken now."""
+    newly = 0
+    for i in range(count):
+        j = first + i
+        if broken[j]:
+            continue
+        failed = 0
+        for q in range(3):
+            damage[j, q] = scratch[_at(_DAMAGE + q, i)]
+            failed += scratch[_at(_DAMAGE + q, i)] >= 1.0
+        share = scratch[_at(_SHARE, i)]
+        t0x, t0y, t0z = _read3(scratch, _TRACTIONS, i)
+        t1x, t1y, t1z = _read3(scratch, _TRACTIONS + 3, i)
+        t2x, t2y, t2z = _read3(scratch, _TRACTIONS + 6, i)
+        if share > 0.0:
+            if failed >= 2:
+                broken[j] = True
+                newly += 1
+            if tan_phi > 0.0:
+                penalty_over_h = penalty / scratch[_at(_SIZE, i)]
+                inverse_gram = scratch[_at(_INVERSE_GRAM, i)]
+                g0x, g0y, g0z = _point_friction(scratch, i, 0, tan_phi, penalty_over_h,
+                                                inverse_gram, anchors, j)
+                g1x, g1y, g1z = _point_friction(scratch, i, 1, tan_phi, penalty_over_h,
+                                                inverse_gram, anchors, j)
+                g2x, g2y, g2z = _point_friction(scratch, i, 2, tan_phi, penalty_over_h,
+                                                inverse_gram, anchors, j)
+                t0x += g0x
+                t0y += g0y
+                t0z += g0z
+                t1x += g1x
+                t1y += g1y
+                t1z += g1z
+                t2x += g2x
+                t2y += g2y
+                t2z += g2z
+        # vertex k takes the points on its two edges: q = k and q = k - 1
+        _put_vertex(buffer, rows, j, 0, share * (t0x + t2x), share * (t0y + t2y),
+                    share * (t0z + t2z))
+        _put_vertex(buffer, rows, j, 1, share * (t0x + t1x), share * (t0y + t1y),
+                    share * (t0z + t1z))
+        _put_vertex(buffer, rows, j, 2, share * (t1x + t2x), share * (t1y + t2y),
+                    share * (t1z + t2z))
+    return newly
 
 
 @inline_kernel
 def joint_range(start, stop, positions, joints, sizes, properties, joint_material, damage, broken,
-                released, anchors, buffer, rows):
+                released, anchors, buffer, rows, scratch):
     """Forces of joints ``start`` .. ``stop - 1`` into their rows of ``buffer`` (``rows``, as in
-    :func:`joint_forces`): first the broken ones
-    (``_broken_joint``), then the intact ones (``_joint``), of which those with two or more
-    points at D >= 1 are marked ``broken`` (they act as broken joints from the next step on).
-    Returns the number broken now. (Two loops: the broken joints' code inside the intact joints'
-    loop made every joint about 15 % slower, though few joints ever break: bench/joint_kernel.py.)"""
+    :func:`joint_forces`): first the broken ones (``_broken_joint``), then the intact ones, in
+    blocks of up to ``JOINT_BLOCK`` joints of one material: their positions gathered into
+    ``scratch`` (``JOINT_SCRATCH_SIZE`` numbers), their law evaluated there eight at a time
+    (``_law_block``), their friction and forces scattered back (``_scatter_block``). Intact
+    joints with two or more points at D >= 1 are marked ``broken`` (they act as broken joints
+    from the next step on). Returns the number broken now. (Two loops: the broken joints' code
+    inside the intact joints' loop made every joint about 15 % slower, though few joints ever
+    break: bench/joint_kernel.py.)"""
     for j in range(start, stop):
         if broken[j]:
             _broken_joint(j, positions, joints, sizes, properties, joint_material, released,
                           anchors, buffer, rows)
     newly = 0
-    for j in range(start, stop):
-        if not broken[j]:
-            if _joint(j, positions, joints, sizes, properties, joint_material, damage, anchors,
-                      buffer, rows) >= 2:
-                broken[j] = True
-                newly += 1
+    first = start
+    while first < stop:
+        row = joint_material[first]
+        last = first + 1
+        while last < stop and last - first < JOINT_BLOCK and joint_material[last] == row:
+            last += 1
+        count = last - first
+        _gather_block(first, count, positions, joints, sizes, damage, scratch)
+        # properties (JointMaterial.kernel_row): f_t, c, tan phi, p, f_t A / G_I, A / G_II,
+        # 2 / p, 1 / (2 f_t), 1 / (2 c)
+        _law_block(scratch, count, properties[row, 0], properties[row, 1], properties[row, 3],
+                   properties[row, 6], properties[row, 7], properties[row, 8],
+                   properties[row, 4], properties[row, 5])
+        newly += _scatter_block(first, count, properties[row, 2], properties[row, 3], damage,
+                                broken, anchors, buffer, rows, scratch)
+        first = last
     return newly
 
 
 @leaf_kernel
 def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, released,
-                 anchors, buffer, rows):
+                 anchors, buffer, rows, scratch):
     """Forces of every joint (``joint_range``) into ``buffer``; a joint with two or more points
-    at D >= 1 is marked ``broken``. Returns the number broken now. (On threads, the joints run in
-    the loop of the tets' forces: ``finite_strain.tet4_and_joint_forces``.)
+    at D >= 1 is marked ``broken``. Returns the number broken now. ``scratch``: at least
+    ``JOINT_SCRATCH_SIZE`` numbers (``np.empty``). (On threads, the joints run in the loop of the
+    tets' forces: ``finite_strain.tet4_and_joint_forces``.)
 
     ``buffer`` (12 n_tets, 3) holds one row per vertex of every face of every tet: row
     12 t + 3 f + i for the i-th corner of face f of tet t (``slots.CORNER_FACE_ROWS``). Joint j's
@@ -512,7 +610,7 @@ def joint_forces(positions, joints, sizes, properties, joint_material, damage, b
     allocates): with them, six atomic increments and decrements per joint took 65 % of this
     loop's time (``perf``)."""
     return joint_range(0, joints.shape[0], positions, joints, sizes, properties, joint_material,
-                       damage, broken, released, anchors, buffer, rows)
+                       damage, broken, released, anchors, buffer, rows, scratch)
 
 
 @kernel
