@@ -34,7 +34,7 @@ def nanoseconds_per_joint(unit, friction_angle: float, jiggle: float, calls: int
     arguments = (body.positions, body.joints, body.joint_sizes, body._joint_properties,
                  body._joint_material_index, body.joint_damage, body.joint_broken,
                  body.joint_released, body.joint_friction_anchor, body._joint_buffer,
-                 body._joint_rows, np.empty(joint_kernels.JOINT_SCRATCH_SIZE))
+                 np.empty(joint_kernels.JOINT_SCRATCH_SIZE))
     joint_kernels.joint_forces(*arguments)            # compile
     best = float("inf")
     for _ in range(repeats):

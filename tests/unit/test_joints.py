@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from riprap.deformable.joints import (SOFTENING_AREA, FracturingBody, JointMaterial, explode_mesh,
-                                     joint_force_rows, locality_order)
+                                     locality_order, slot_joint_rows)
 from riprap.deformable.kernels.joints import (SOFTENING_A, SOFTENING_B, SOFTENING_C,
                                                gather_joint_forces, softening)
 from riprap.deformable.material import ElasticMaterial
@@ -65,31 +65,35 @@ def test_joints_only_in_a_region_keep_the_rest_of_the_mesh_whole():
 
 @pytest.mark.parametrize("cracking_half", [False, True])
 def test_every_joint_force_reaches_its_own_node(cracking_half):
-    """Each joint corner's force, put into its row of the buffer (``joint_force_rows``) and
-    summed per node over the faces at the node's (tet, corner) slots, is the same as adding the
-    forces one by one: every row is the joint vertex's own corner of the joint's face, no two
-    joints share a row. With a cracking region, the nodes at its edge are shared by several glued tets."""
+    """Each joint vertex's force, in its row 6 j + k of the buffer and summed per node over the
+    rows that the table (``slot_joint_rows``) gives for the faces at the node's (tet, corner)
+    slots, is the same as adding the forces one by one: every joint vertex is named once, at the
+    slot of its own tet's corner, on its own face's column. With a cracking region, the nodes at
+    its edge are shared by several glued tets."""
     nodes, tets = box_mesh((0.2, 0.05, 0.05), (4, 2, 2))
     cracking = nodes[tets].mean(axis=1)[:, 0] > 0.1 if cracking_half else None
     split = explode_mesh(nodes, tets, cracking)
-    rows = joint_force_rows(split.tets, split.joints, split.joint_tets, split.face_joint)
-    assert len(np.unique(rows)) == rows.size
-    tet, face, corner = rows // 12, rows % 12 // 3, rows % 3     # row 12 t + 3 f + i
-    assert np.array_equal(tet, np.repeat(split.joint_tets, 3, axis=1))
-    assert np.array_equal(split.face_joint[tet, face],
-                          np.repeat(np.arange(len(split.joints))[:, None], 6, axis=1))
-    face_corners = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])[face, corner]
-    assert np.array_equal(split.tets[tet, face_corners], split.joints)
-    assert np.all(np.diff(rows[:, :3], axis=1) == 1)      # a side's rows together
+    n = len(split.joints)
+    table = slot_joint_rows(split.tets, split.joints, split.joint_tets, split.face_joint)
+    named = table[table < 6 * n]
+    assert np.array_equal(np.sort(named), np.arange(6 * n))        # each joint vertex once
+    slot, column = np.nonzero(table < 6 * n)
+    joint, vertex = table[slot, column] // 6, table[slot, column] % 6
+    tet, corner = slot // 4, slot % 4
+    assert np.array_equal(tet, split.joint_tets[joint, vertex // 3])     # its own side's tet
+    assert np.array_equal(split.tets[tet, corner], split.joints[joint, vertex])
+    face = column + (column >= corner)                # the faces at corner c: f != c, in order
+    assert np.array_equal(split.face_joint[tet, face], joint)
     forces = np.random.default_rng(3).normal(size=(len(split.joints), 6, 3))
-    buffer = np.zeros((3 * split.tets.size, 3))
-    buffer[rows.reshape(-1)] = forces.reshape(-1, 3)
+    buffer = np.zeros((6 * n + 1, 3))
+    buffer[:-1] = forces.reshape(-1, 3)
     expected = np.zeros((len(split.nodes), 3))
     np.add.at(expected, split.joints.ravel(), forces.reshape(-1, 3))
     offsets = np.r_[0, np.cumsum(np.bincount(split.tets.ravel(), minlength=len(split.nodes)))]
     node_slots = np.argsort(split.tets.ravel(), kind="stable")
     summed = np.zeros_like(expected)
-    gather_joint_forces(buffer, offsets.astype(np.int64), node_slots.astype(np.int64), summed)
+    gather_joint_forces(buffer, offsets.astype(np.int64), node_slots.astype(np.int64), table,
+                        summed)
     assert (np.bincount(split.tets.ravel()).max() > 1) == cracking_half
     assert np.allclose(summed, expected, rtol=0, atol=1e-12)
 

@@ -211,22 +211,26 @@ def check_crack_resolution(nodes, tets, name: str) -> None:
             f"finer (a shape's mesh_size of at most {thinnest / MIN_TETS_ACROSS:.3g} m)")
 
 
-def joint_force_rows(tets, joints, joint_tets, face_joint) -> np.ndarray:
-    """(n, 6): the row of a (12 m, 3) joint force buffer that each joint's force on each of its
-    six vertices goes to (``kernels/joints.joint_forces``): row 12 t + 3 f + i for the vertex at
-    the i-th corner of face f of tet t, the face the joint holds."""
+def slot_joint_rows(tets, joints, joint_tets, face_joint) -> np.ndarray:
+    """(4 m, 3): for each (tet, corner) slot 4 t + c, the rows of a (6 n + 1, 3) joint force
+    buffer (``kernels/joints.joint_forces``: row 6 j + k for joint j's vertex k, 0-2 on face A,
+    3-5 on face B) that hold the forces on that corner from the joints on the tet's three faces
+    there (column f - (f > c) for face f, the face opposite corner f); row 6 n, kept zero, where
+    a face has no joint."""
     tets = np.asarray(tets, dtype=np.int64)
     joints = np.asarray(joints, dtype=np.int64)
     n = len(joints)
-    rows = np.zeros((n, 6), dtype=np.int64)
+    table = np.full((4 * len(tets), 3), 6 * n, dtype=np.int64)
     for side in (0, 1):
         tet = joint_tets[:, side]
         face = np.argmax(face_joint[tet] == np.arange(n)[:, None], axis=1)
-        face_nodes = np.take_along_axis(tets[tet], _TET_FACES[face], axis=1)      # (n, 3)
-        position = np.argmax(face_nodes[:, None, :] == joints[:, 3 * side:3 * side + 3, None],
-                             axis=2)
-        rows[:, 3 * side:3 * side + 3] = 12 * tet[:, None] + 3 * face[:, None] + position
-    return rows
+        # the tet's corner at each of the side's three vertices
+        corner = np.argmax(tets[tet][:, None, :] == joints[:, 3 * side:3 * side + 3, None],
+                           axis=2)
+        for k in range(3):
+            column = face - (face > corner[:, k])
+            table[4 * tet + corner[:, k], column] = 6 * np.arange(n) + 3 * side + k
+    return table
 
 
 class FracturingBody(DeformableBody):
@@ -293,9 +297,9 @@ class FracturingBody(DeformableBody):
         self.joint_work = np.zeros(1)
         self._joint_properties = joint_material.kernel_row()[None, :]
         self._joint_material_index = np.zeros(len(joints), dtype=np.int64)
-        self._joint_rows = joint_force_rows(split.tets, joints, split.joint_tets,
-                                            split.face_joint)
-        self._joint_buffer = np.zeros((3 * split.tets.size, 3))
+        self._slot_joint_rows = slot_joint_rows(split.tets, joints, split.joint_tets,
+                                                split.face_joint)
+        self._joint_buffer = np.zeros((6 * len(joints) + 1, 3))
 
     # ------------------------------------------------------------------ steps
     def stable_time_step(self) -> float:
@@ -331,13 +335,14 @@ class FracturingBody(DeformableBody):
                                    self._joint_properties, self._joint_material_index,
                                    self.joint_damage, self.joint_broken, self.joint_released,
                                    self.joint_friction_anchor, self._joint_buffer,
-                                   self._joint_rows, np.empty(joint_kernels.JOINT_SCRATCH_SIZE))
-        joint_kernels.gather_joint_forces(self._joint_buffer, self._offsets, self._slots, forces)
+                                   np.empty(joint_kernels.JOINT_SCRATCH_SIZE))
+        joint_kernels.gather_joint_forces(self._joint_buffer, self._offsets, self._slots,
+                                          self._slot_joint_rows, forces)
         return forces
 
     def _joint_arguments(self):
         return (self.joints, self.joint_sizes, self._joint_properties, self._joint_material_index,
-                self.joint_damage, self.joint_broken, self._joint_buffer, self._joint_rows,
+                self.joint_damage, self.joint_broken, self._joint_buffer, self._slot_joint_rows,
                 self.joint_released, self.joint_work, self.joint_friction_anchor)
 
     # ------------------------------------------------------------------ results

@@ -226,11 +226,19 @@ class DeformableSystem:
             setattr(self, name, joined)
             for i, k in enumerate(fracturing):
                 setattr(self.bodies[k], name, joined[self.joint_offsets[i]:self.joint_offsets[i + 1]])
-        rows = np.concatenate([self.bodies[k]._joint_rows + 12 * self.element_offsets[k]
-                               for k in fracturing])
+        # each element slot's rows of the joints' force buffer (``slot_joint_rows``), in the
+        # system's numbering: a row per vertex of every joint, and a last one kept zero
+        n_joints = int(self.joint_offsets[-1])
+        slot_rows = np.full((self.elements.size, 3), 6 * n_joints, dtype=np.int64)
+        for i, k in enumerate(fracturing):
+            body = self.bodies[k]
+            local = body._slot_joint_rows
+            first_slot = self.elements.shape[1] * self.element_offsets[k]
+            slot_rows[first_slot:first_slot + len(local)] = np.where(
+                local < 6 * len(body.joints), local + 6 * self.joint_offsets[i], 6 * n_joints)
         self.joint_work = np.zeros(1)
         self.joint_data = (self.joints, sizes, properties, material, self.joint_damage,
-                           self.joint_broken, np.zeros((3 * self.elements.size, 3)), rows,
+                           self.joint_broken, np.zeros((6 * n_joints + 1, 3)), slot_rows,
                            self.joint_released, self.joint_work, self.joint_friction_anchor)
 
     def _fracturing_surface(self, body) -> tuple:

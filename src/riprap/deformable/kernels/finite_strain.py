@@ -216,9 +216,9 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
     :func:`advance_steps`) in one parallel loop: both only read the positions, so one region
     instead of two (each region costs the threads a wake-up)."""
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer, joint_rows, joint_released, joint_anchors) = (
+     joint_buffer, joint_released, joint_anchors) = (
         joint_data[0], joint_data[1], joint_data[2], joint_data[3], joint_data[4], joint_data[5],
-        joint_data[6], joint_data[7], joint_data[8], joint_data[10])
+        joint_data[6], joint_data[8], joint_data[10])
     n_tets = tets.shape[0]
     n_joints = joint_nodes.shape[0]
     for block in prange(FORCE_BLOCKS):
@@ -231,7 +231,7 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
                                   (block + 1) * n_joints // FORCE_BLOCKS, positions, joint_nodes,
                                   joint_sizes, joint_properties, joint_material, joint_damage,
                                   joint_broken, joint_released, joint_anchors, joint_buffer,
-                                  joint_rows, scratch)
+                                  scratch)
 
 
 @kernel
@@ -350,15 +350,17 @@ def central_difference_update_serial(positions, velocities, element_forces, node
 @parallel_kernel
 def jointed_update(positions, velocities, element_forces, node_offsets, node_slots, masses,
                    external_forces, contact_forces, gravity, mass_damping, constrained,
-                   prescribed_velocities, time_step, joint_forces, listed_positions):
-    """:func:`central_difference_update` with the joints' forces added (``joint_forces``: three
-    rows per element slot, ``kernels/joints.joint_forces``); returns also the joints' work over
-    the step. (A loop of its own: the bodies without joints read no joint rows.)"""
+                   prescribed_velocities, time_step, joint_forces, joint_slot_rows,
+                   listed_positions):
+    """:func:`central_difference_update` with the joints' forces added (``joint_forces``: a row
+    per joint vertex, ``kernels/joints.joint_forces``; ``joint_slot_rows``: the rows of each
+    element slot's three faces); returns also the joints' work over the step. (A loop of its own: the bodies without joints read no joint rows.)"""
     flat = element_forces.reshape((-1, 3))
     work = 0.0
     largest = 0.0
     for n in prange(positions.shape[0]):
-        ex, ey, ez, jx, jy, jz = joint_slot_sum(n, flat, joint_forces, node_offsets, node_slots)
+        ex, ey, ez, jx, jy, jz = joint_slot_sum(n, flat, joint_forces, joint_slot_rows,
+                                                node_offsets, node_slots)
         node_work, moved = update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses,
                                        external_forces, contact_forces, gravity, mass_damping,
                                        constrained, prescribed_velocities, time_step,
@@ -372,13 +374,14 @@ def jointed_update(positions, velocities, element_forces, node_offsets, node_slo
 def jointed_update_serial(positions, velocities, element_forces, node_offsets, node_slots,
                           masses, external_forces, contact_forces, gravity, mass_damping,
                           constrained, prescribed_velocities, time_step, joint_forces,
-                          listed_positions):
+                          joint_slot_rows, listed_positions):
     """:func:`jointed_update` on one thread."""
     flat = element_forces.reshape((-1, 3))
     work = 0.0
     largest = 0.0
     for n in range(positions.shape[0]):
-        ex, ey, ez, jx, jy, jz = joint_slot_sum(n, flat, joint_forces, node_offsets, node_slots)
+        ex, ey, ez, jx, jy, jz = joint_slot_sum(n, flat, joint_forces, joint_slot_rows,
+                                                node_offsets, node_slots)
         node_work, moved = update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses,
                                        external_forces, contact_forces, gravity, mass_damping,
                                        constrained, prescribed_velocities, time_step,
@@ -508,8 +511,9 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     wall tets, the normal damping ratio per triangle and per tet).
     ``joint_data`` = the joints between tets of fracturing bodies (``riprap/deformable/kernels/joints.py``):
     (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
-    the buffer of their forces (three rows per element slot) and each joint's six rows in it
-    (``kernels/joints.joint_forces``), released (broken joints whose faces slid apart: no force
+    the buffer of their forces (a row per joint vertex, and a last row kept zero:
+    ``kernels/joints.joint_forces``) and each element slot's rows in it (elements.size, 3: one
+    per face at the slot's corner), released (broken joints whose faces slid apart: no force
     any more), their work done on the nodes so far (1,), by the trapezoidal rule, and the
     friction anchors of their points (n, 3, 2)); no joints: none, and a buffer of no rows.
     Their forces are added in the node update (not to ``contact_forces``), which also sums
@@ -522,7 +526,7 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
      tet_stiffness, pair_springs, wall_triangle_springs, wall_tet_springs, triangle_damping,
      tet_damping) = contact
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer, joint_rows, joint_released, joint_work, joint_anchors) = joint_data
+     joint_buffer, joint_slot_rows, joint_released, joint_work, joint_anchors) = joint_data
     has_joints = joint_nodes.shape[0] > 0
     # the one-thread joints' scratch (``joint_forces``; on threads, each block has its own)
     joint_scratch = np.empty(joint_kernels.JOINT_SCRATCH_SIZE if has_joints else 0)
@@ -578,7 +582,7 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
                 joint_kernels.joint_forces(
                     positions, joint_nodes, joint_sizes, joint_properties, joint_material,
                     joint_damage, joint_broken, joint_released, joint_anchors, joint_buffer,
-                    joint_rows, joint_scratch)
+                    joint_scratch)
             element_forces_serial(positions, velocities, elements, tet4_gradients, gradients,
                                   weights, materials, element_material, element_forces, jacobians)
         elif tet4:
@@ -594,13 +598,13 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
             work, largest_move = jointed_update(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, joint_buffer, moves_from)
+                prescribed_velocities, time_step, joint_buffer, joint_slot_rows, moves_from)
             joint_work[0] += work
         elif has_joints:
             work, largest_move = jointed_update_serial(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, joint_buffer, moves_from)
+                prescribed_velocities, time_step, joint_buffer, joint_slot_rows, moves_from)
             joint_work[0] += work
         elif parallel:
             largest_move = central_difference_update(

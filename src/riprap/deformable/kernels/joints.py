@@ -140,11 +140,11 @@ def _friction(tx, ty, tz, compression, tan_phi, penalty_over_h, e1x, e1y, e1z, e
 
 
 @inline_kernel
-def _put_vertex(buffer, rows, j, k, fx, fy, fz):
+def _put_vertex(buffer, j, k, fx, fy, fz):
     """Force on face A's vertex k, and its opposite on B's vertex k (into their rows of
-    ``buffer``: ``rows[j]``)."""
-    a = rows[j, k]
-    b = rows[j, 3 + k]
+    ``buffer``: 6 j + k and 6 j + 3 + k)."""
+    a = 6 * j + k
+    b = a + 3
     buffer[a, 0] = fx
     buffer[a, 1] = fy
     buffer[a, 2] = fz
@@ -181,15 +181,15 @@ def _face_edges(positions, joints, j, face):
 
 
 @inline_kernel
-def _add_weighted(buffer, rows, j, k, weight, fx, fy, fz):
-    row = rows[j, k]
+def _add_weighted(buffer, j, k, weight, fx, fy, fz):
+    row = 6 * j + k
     buffer[row, 0] += weight * fx
     buffer[row, 1] += weight * fy
     buffer[row, 2] += weight * fz
 
 
 @inline_kernel
-def _spread_on_face(buffer, rows, j, positions, joints, face, q, wx, wy, wz, fx, fy, fz):
+def _spread_on_face(buffer, j, positions, joints, face, q, wx, wy, wz, fx, fy, fz):
     """Force (fx, fy, fz) on the face of joint ``j`` whose vertices are ``face``..``face + 2``
     (0: face A, 3: face B), at the point ``w`` away (in the face's plane) from the midpoint of
     its edge from vertex ``q`` to the next: shared by the vertices' barycentric coordinates
@@ -210,9 +210,9 @@ def _spread_on_face(buffer, rows, j, positions, joints, face, q, wx, wy, wz, fx,
         w0 -= shift_1 + shift_2
         w1 += shift_1
         w2 += shift_2
-    _add_weighted(buffer, rows, j, face, w0, fx, fy, fz)
-    _add_weighted(buffer, rows, j, face + 1, w1, fx, fy, fz)
-    _add_weighted(buffer, rows, j, face + 2, w2, fx, fy, fz)
+    _add_weighted(buffer, j, face, w0, fx, fy, fz)
+    _add_weighted(buffer, j, face + 1, w1, fx, fy, fz)
+    _add_weighted(buffer, j, face + 2, w2, fx, fy, fz)
 
 
 #: A broken joint whose faces have turned from each other beyond this cosine (about 25 degrees)
@@ -254,7 +254,7 @@ def _point_separation(positions, joints, j, q):
 
 @inline_kernel
 def _broken_joint(j, positions, joints, sizes, properties, joint_material, released, anchors,
-                  buffer, rows):
+                  buffer):
     """Forces of broken joint ``j``: the intact joint's compressive penalty and friction at each
     point (opening below zero), but acting on both faces at one place, midway between the point
     of A and the point of B, by each face's barycentric coordinates there. The two forces then lie
@@ -272,7 +272,7 @@ def _broken_joint(j, positions, joints, sizes, properties, joint_material, relea
     whose faces had turned, put up to 25 kJ into a unit dropped from 1 m in a single step."""
     for k in range(6):
         for d in range(3):
-            buffer[rows[j, k], d] = 0.0
+            buffer[6 * j + k, d] = 0.0
     # the mid-surface, as for an intact joint (``_joint``)
     m0x = _mid_corner(positions, joints, j, 0, 0)
     m0y = _mid_corner(positions, joints, j, 0, 1)
@@ -326,9 +326,9 @@ def _broken_joint(j, positions, joints, sizes, properties, joint_material, relea
         fx = share * (compression * nx + gx)
         fy = share * (compression * ny + gy)
         fz = share * (compression * nz + gz)
-        _spread_on_face(buffer, rows, j, positions, joints, 0, q, 0.5 * sx, 0.5 * sy, 0.5 * sz,
+        _spread_on_face(buffer, j, positions, joints, 0, q, 0.5 * sx, 0.5 * sy, 0.5 * sz,
                         fx, fy, fz)
-        _spread_on_face(buffer, rows, j, positions, joints, 3, q, -0.5 * sx, -0.5 * sy,
+        _spread_on_face(buffer, j, positions, joints, 3, q, -0.5 * sx, -0.5 * sy,
                         -0.5 * sz, -fx, -fy, -fz)
 
 
@@ -504,8 +504,7 @@ def _point_friction(scratch, i, q, tan_phi, penalty_over_h, inverse_gram, anchor
 
 
 @inline_kernel
-def _scatter_block(first, count, tan_phi, penalty, damage, broken, anchors, buffer, rows,
-                   scratch):
+def _scatter_block(first, count, tan_phi, penalty, damage, broken, anchors, buffer, scratch):
     """Joints ``first`` .. ``first + count - 1`` after ``_law_block``: for each intact one its
     damage, its friction (Coulomb's, from its anchors: ``_friction``) and its forces on its six
     nodes into their rows of ``buffer``; those with two or more points at D >= 1 are marked
@@ -546,19 +545,19 @@ def _scatter_block(first, count, tan_phi, penalty, damage, broken, anchors, buff
                 t2y += g2y
                 t2z += g2z
         # vertex k takes the points on its two edges: q = k and q = k - 1
-        _put_vertex(buffer, rows, j, 0, share * (t0x + t2x), share * (t0y + t2y),
+        _put_vertex(buffer, j, 0, share * (t0x + t2x), share * (t0y + t2y),
                     share * (t0z + t2z))
-        _put_vertex(buffer, rows, j, 1, share * (t0x + t1x), share * (t0y + t1y),
+        _put_vertex(buffer, j, 1, share * (t0x + t1x), share * (t0y + t1y),
                     share * (t0z + t1z))
-        _put_vertex(buffer, rows, j, 2, share * (t1x + t2x), share * (t1y + t2y),
+        _put_vertex(buffer, j, 2, share * (t1x + t2x), share * (t1y + t2y),
                     share * (t1z + t2z))
     return newly
 
 
 @inline_kernel
 def joint_range(start, stop, positions, joints, sizes, properties, joint_material, damage, broken,
-                released, anchors, buffer, rows, scratch):
-    """Forces of joints ``start`` .. ``stop - 1`` into their rows of ``buffer`` (``rows``, as in
+                released, anchors, buffer, scratch):
+    """Forces of joints ``start`` .. ``stop - 1`` into their rows of ``buffer`` (as in
     :func:`joint_forces`): first the broken ones (``_broken_joint``), then the intact ones, in
     blocks of up to ``JOINT_BLOCK`` joints of one material: their positions gathered into
     ``scratch`` (``JOINT_SCRATCH_SIZE`` numbers), their law evaluated there eight at a time
@@ -570,7 +569,7 @@ def joint_range(start, stop, positions, joints, sizes, properties, joint_materia
     for j in range(start, stop):
         if broken[j]:
             _broken_joint(j, positions, joints, sizes, properties, joint_material, released,
-                          anchors, buffer, rows)
+                          anchors, buffer)
     newly = 0
     first = start
     while first < stop:
@@ -586,42 +585,41 @@ def joint_range(start, stop, positions, joints, sizes, properties, joint_materia
                    properties[row, 6], properties[row, 7], properties[row, 8],
                    properties[row, 4], properties[row, 5])
         newly += _scatter_block(first, count, properties[row, 2], properties[row, 3], damage,
-                                broken, anchors, buffer, rows, scratch)
+                                broken, anchors, buffer, scratch)
         first = last
     return newly
 
 
 @leaf_kernel
 def joint_forces(positions, joints, sizes, properties, joint_material, damage, broken, released,
-                 anchors, buffer, rows, scratch):
+                 anchors, buffer, scratch):
     """Forces of every joint (``joint_range``) into ``buffer``; a joint with two or more points
     at D >= 1 is marked ``broken``. Returns the number broken now. ``scratch``: at least
     ``JOINT_SCRATCH_SIZE`` numbers (``np.empty``). (On threads, the joints run in the loop of the
     tets' forces: ``finite_strain.tet4_and_joint_forces``.)
 
-    ``buffer`` (12 n_tets, 3) holds one row per vertex of every face of every tet: row
-    12 t + 3 f + i for the i-th corner of face f of tet t (``slots.CORNER_FACE_ROWS``). Joint j's
-    force on its vertex k (0-2 face A, 3-5 face B) goes to row ``rows[j, k]``: a side's three
-    rows together. Rows of faces without a joint stay zero. A node's joint forces are the rows
-    of the faces at its (tet, corner) slots (``slots.joint_slot_sum``): read in the node update
-    in the order of the nodes, with no table.
+    ``buffer`` (6 n_joints + 1, 3) holds joint j's force on its vertex k (0-2 face A, 3-5 face B)
+    in row 6 j + k: each joint's six rows together, the joints in order (the rows are written
+    one after the other, not scattered over the tets). The last row stays zero. The node update
+    reads the rows at each node's (tet, corner) slots from a table (``slots.joint_slot_sum``,
+    ``joints.slot_joint_rows``).
 
     Compiled without numba's reference counts (``leaf_kernel``: nothing in the joints' code
     allocates): with them, six atomic increments and decrements per joint took 65 % of this
     loop's time (``perf``)."""
     return joint_range(0, joints.shape[0], positions, joints, sizes, properties, joint_material,
-                       damage, broken, released, anchors, buffer, rows, scratch)
+                       damage, broken, released, anchors, buffer, scratch)
 
 
 @kernel
-def gather_joint_forces(buffer, node_offsets, node_slots, out):
-    """out[node] = the joint forces on it: the buffer's rows of its (tet, corner) slots
-    (``node_slots[node_offsets[node]:node_offsets[node + 1]]``, see :func:`joint_forces`). (The
-    time step sums them in the node update instead: ``finite_strain.update_node``.)"""
+def gather_joint_forces(buffer, node_offsets, node_slots, slot_rows, out):
+    """out[node] = the joint forces on it: the buffer's rows (``slot_rows``) of its (tet, corner)
+    slots (``node_slots[node_offsets[node]:node_offsets[node + 1]]``, see :func:`joint_forces`).
+    (The time step sums them in the node update instead: ``finite_strain.update_node``.)"""
     for node in range(out.shape[0]):
         fx = fy = fz = 0.0
         for s in range(node_offsets[node], node_offsets[node + 1]):
-            jx, jy, jz = corner_joint_force(node_slots[s], buffer)
+            jx, jy, jz = corner_joint_force(node_slots[s], slot_rows, buffer)
             fx += jx
             fy += jy
             fz += jz
