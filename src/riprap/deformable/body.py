@@ -33,9 +33,9 @@ NO_TET4_GRADIENTS = np.zeros((0, 4, 3))
 
 def no_joints() -> tuple:
     """The joint arguments of a run without joints (see finite_strain.advance_steps)."""
-    return (np.zeros((0, 6), dtype=np.int64), np.zeros(0), np.zeros((1, 9)),
+    return (np.zeros((0, 6), dtype=np.int32), np.zeros(0), np.zeros((1, 9)),
             np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0, dtype=np.bool_),
-            np.zeros((1, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros(0, dtype=np.bool_),
+            np.zeros((1, 3)), np.zeros((0, 3), dtype=np.int32), np.zeros(0, dtype=np.bool_),
             np.zeros(1), np.zeros((0, 3, 2)))
 
 # Bodies with fewer integration points than this step on one thread: starting the threads of a

@@ -212,7 +212,7 @@ def check_crack_resolution(nodes, tets, name: str) -> None:
 
 
 def slot_joint_rows(tets, joints, joint_tets, face_joint) -> np.ndarray:
-    """(4 m, 3): for each (tet, corner) slot 4 t + c, the rows of a (6 n + 1, 3) joint force
+    """(4 m, 3) int32 (half the bytes the node update reads for it): for each (tet, corner) slot 4 t + c, the rows of a (6 n + 1, 3) joint force
     buffer (``kernels/joints.joint_forces``: row 6 j + k for joint j's vertex k, 0-2 on face A,
     3-5 on face B) that hold the forces on that corner from the joints on the tet's three faces
     there (column f - (f > c) for face f, the face opposite corner f); row 6 n, kept zero, where
@@ -220,7 +220,7 @@ def slot_joint_rows(tets, joints, joint_tets, face_joint) -> np.ndarray:
     tets = np.asarray(tets, dtype=np.int64)
     joints = np.asarray(joints, dtype=np.int64)
     n = len(joints)
-    table = np.full((4 * len(tets), 3), 6 * n, dtype=np.int64)
+    table = np.full((4 * len(tets), 3), 6 * n, dtype=np.int32)
     for side in (0, 1):
         tet = joint_tets[:, side]
         face = np.argmax(face_joint[tet] == np.arange(n)[:, None], axis=1)
@@ -264,7 +264,8 @@ class FracturingBody(DeformableBody):
         #: The mesh before it was exploded (reference nodes and tets).
         self.original_nodes = np.asarray(nodes, dtype=np.float64).copy()
         self.original_tets = np.asarray(tets, dtype=np.int64).copy()
-        self.joints = joints
+        # 32-bit node numbers: the joints' step reads them every time (bench/fracture.py)
+        self.joints = joints.astype(np.int32)
         self.joint_tets = split.joint_tets
         self.original_node = split.original_node
         #: The joint on tet t's face k, -1 on the surface, -2 glued (``ExplodedMesh.face_joint``).

@@ -211,12 +211,12 @@ class DeformableSystem:
         counts = [len(self.bodies[k].joints) for k in fracturing]
         self.joint_offsets = np.r_[0, np.cumsum(counts)].astype(np.int64)
         if not fracturing:
-            self.joints = np.zeros((0, 6), dtype=np.int64)
+            self.joints = np.zeros((0, 6), dtype=np.int32)
             self.joint_data = no_joints()
             self.joint_work = np.zeros(1)
             return
         self.joints = np.concatenate([self.bodies[k].joints + self.node_offsets[k]
-                                      for k in fracturing])
+                                      for k in fracturing]).astype(np.int32)
         sizes = np.concatenate([self.bodies[k].joint_sizes for k in fracturing])
         properties = np.concatenate([self.bodies[k]._joint_properties for k in fracturing])
         material = np.repeat(np.arange(len(fracturing), dtype=np.int64), counts)
@@ -229,7 +229,7 @@ class DeformableSystem:
         # each element slot's rows of the joints' force buffer (``slot_joint_rows``), in the
         # system's numbering: a row per vertex of every joint, and a last one kept zero
         n_joints = int(self.joint_offsets[-1])
-        slot_rows = np.full((self.elements.size, 3), 6 * n_joints, dtype=np.int64)
+        slot_rows = np.full((self.elements.size, 3), 6 * n_joints, dtype=np.int32)
         for i, k in enumerate(fracturing):
             body = self.bodies[k]
             local = body._slot_joint_rows

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from riprap._jit import inline_kernel, kernel, parallel_kernel, prange
+from riprap._jit import inline_kernel, kernel, leaf_kernel, parallel_kernel, prange
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import joints as joint_kernels
 from riprap.deformable.kernels.slots import joint_slot_sum, slot_sum
@@ -260,46 +260,50 @@ def general_element_forces(positions, velocities, elements, gradients, weights,
 @inline_kernel
 def update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses, external_forces,
                 contact_forces, gravity, mass_damping, constrained, prescribed_velocities,
-                time_step, listed_positions):
+                first_loaded, first_held, time_step, listed_positions):
     """Central-difference update of node ``n`` (see :func:`central_difference_update`) under the
     elements' force (ex, ey, ez) and the joints' (jx, jy, jz) on it; returns the work of the
     joints' force over the step and the node's squared distance from ``listed_positions`` after
     it."""
     m = masses[n]
+    # nodes before ``first_loaded`` (``first_held``) have no load (no held component): they skip
+    # those reads and choices (a split body's node update 80 -> 68 microseconds; with the
+    # reads branch-free from a row of zeros it stayed at 80: the cost is the instructions)
+    load_x = load_y = load_z = 0.0
+    if n >= first_loaded:
+        load_x = external_forces[n, 0]
+        load_y = external_forces[n, 1]
+        load_z = external_forces[n, 2]
     # written out per axis: a helper per axis (inlined) made the one-thread loop 2 to 3 times
-    # slower (numba 0.68, this machine), the threaded one not. Both velocities are loaded before
-    # the choice: an array read inside the conditional expression made numba take references to
-    # four arrays per node in the one-thread loop (atomic counts; 3.4 times slower)
+    # slower (numba 0.68, this machine), the threaded one not
+    before_x = velocities[n, 0]
+    before_y = velocities[n, 1]
+    before_z = velocities[n, 2]
+    velocity_x = before_x + time_step * (load_x + contact_forces[n, 0] + m * gravity[0]
+                                         - mass_damping * m * before_x + ex + jx) / m
+    velocity_y = before_y + time_step * (load_y + contact_forces[n, 1] + m * gravity[1]
+                                         - mass_damping * m * before_y + ey + jy) / m
+    velocity_z = before_z + time_step * (load_z + contact_forces[n, 2] + m * gravity[2]
+                                         - mass_damping * m * before_z + ez + jz) / m
+    if n >= first_held:
+        if constrained[n, 0]:
+            velocity_x = prescribed_velocities[n, 0]
+        if constrained[n, 1]:
+            velocity_y = prescribed_velocities[n, 1]
+        if constrained[n, 2]:
+            velocity_z = prescribed_velocities[n, 2]
+    velocities[n, 0] = velocity_x
+    velocities[n, 1] = velocity_y
+    velocities[n, 2] = velocity_z
+    positions[n, 0] += time_step * velocity_x
+    positions[n, 1] += time_step * velocity_y
+    positions[n, 2] += time_step * velocity_z
     # the trapezoidal rule for the joints' work, exact for a linear spring (the rectangle rule
     # gains k dx^2 / 2 a step: a steady drift while the joints vibrate): this step's force over
     # the intervals on both sides of it, each at its velocity
-    before = velocities[n, 0]
-    total = (external_forces[n, 0] + contact_forces[n, 0] + m * gravity[0]
-             - mass_damping * m * before + ex + jx)
-    free = before + time_step * total / m
-    held = prescribed_velocities[n, 0]
-    velocity = held if constrained[n, 0] else free
-    velocities[n, 0] = velocity
-    positions[n, 0] += time_step * velocity
-    wx = (before + velocity) * jx
-    before = velocities[n, 1]
-    total = (external_forces[n, 1] + contact_forces[n, 1] + m * gravity[1]
-             - mass_damping * m * before + ey + jy)
-    free = before + time_step * total / m
-    held = prescribed_velocities[n, 1]
-    velocity = held if constrained[n, 1] else free
-    velocities[n, 1] = velocity
-    positions[n, 1] += time_step * velocity
-    wy = (before + velocity) * jy
-    before = velocities[n, 2]
-    total = (external_forces[n, 2] + contact_forces[n, 2] + m * gravity[2]
-             - mass_damping * m * before + ez + jz)
-    free = before + time_step * total / m
-    held = prescribed_velocities[n, 2]
-    velocity = held if constrained[n, 2] else free
-    velocities[n, 2] = velocity
-    positions[n, 2] += time_step * velocity
-    wz = (before + velocity) * jz
+    wx = (before_x + velocity_x) * jx
+    wy = (before_y + velocity_y) * jy
+    wz = (before_z + velocity_z) * jz
     work = 0.5 * time_step * (wx + wy + wz)
     mx = positions[n, 0] - listed_positions[n, 0]
     my = positions[n, 1] - listed_positions[n, 1]
@@ -310,7 +314,8 @@ def update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses, extern
 @parallel_kernel
 def central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
                               masses, external_forces, contact_forces, gravity, mass_damping,
-                              constrained, prescribed_velocities, time_step, listed_positions):
+                              constrained, prescribed_velocities, first_loaded, first_held,
+                              time_step, listed_positions):
     """Sum the element forces at every node, add loads, gravity and mass-proportional damping,
     and advance the half-step velocity and the position (central difference / leapfrog).
     Returns the largest squared distance of a node from ``listed_positions`` after it (pass
@@ -325,24 +330,29 @@ def central_difference_update(positions, velocities, element_forces, node_offset
         ex, ey, ez = slot_sum(n, flat, node_offsets, node_slots)
         _, moved = update_node(n, ex, ey, ez, 0.0, 0.0, 0.0, positions, velocities, masses,
                                external_forces, contact_forces, gravity, mass_damping,
-                               constrained, prescribed_velocities, time_step, listed_positions)
+                               constrained, prescribed_velocities, first_loaded, first_held,
+                               time_step, listed_positions)
         largest = max(largest, moved)
     return largest
 
 
-@kernel
+@leaf_kernel
 def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
                                      node_slots, masses, external_forces, contact_forces, gravity,
-                                     mass_damping, constrained, prescribed_velocities, time_step,
+                                     mass_damping, constrained, prescribed_velocities,
+                                     first_loaded, first_held, time_step,
                                      listed_positions):
-    """:func:`central_difference_update` on one thread (small bodies: no thread start-up)."""
+    """:func:`central_difference_update` on one thread (small bodies: no thread start-up).
+    Compiled without reference counts (``leaf_kernel``): numba took references to the arrays
+    read in ``update_node``'s branches, per node."""
     flat = element_forces.reshape((-1, 3))
     largest = 0.0
     for n in range(positions.shape[0]):
         ex, ey, ez = slot_sum(n, flat, node_offsets, node_slots)
         _, moved = update_node(n, ex, ey, ez, 0.0, 0.0, 0.0, positions, velocities, masses,
                                external_forces, contact_forces, gravity, mass_damping,
-                               constrained, prescribed_velocities, time_step, listed_positions)
+                               constrained, prescribed_velocities, first_loaded, first_held,
+                               time_step, listed_positions)
         largest = max(largest, moved)
     return largest
 
@@ -350,11 +360,12 @@ def central_difference_update_serial(positions, velocities, element_forces, node
 @parallel_kernel
 def jointed_update(positions, velocities, element_forces, node_offsets, node_slots, masses,
                    external_forces, contact_forces, gravity, mass_damping, constrained,
-                   prescribed_velocities, time_step, joint_forces, joint_slot_rows,
-                   listed_positions):
+                   prescribed_velocities, first_loaded, first_held, time_step, joint_forces,
+                   joint_slot_rows, listed_positions):
     """:func:`central_difference_update` with the joints' forces added (``joint_forces``: a row
     per joint vertex, ``kernels/joints.joint_forces``; ``joint_slot_rows``: the rows of each
-    element slot's three faces); returns also the joints' work over the step. (A loop of its own: the bodies without joints read no joint rows.)"""
+    element slot's three faces); returns also the joints' work over the step. (A loop of its
+    own: the bodies without joints read no joint rows.)"""
     flat = element_forces.reshape((-1, 3))
     work = 0.0
     largest = 0.0
@@ -363,19 +374,20 @@ def jointed_update(positions, velocities, element_forces, node_offsets, node_slo
                                                 node_offsets, node_slots)
         node_work, moved = update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses,
                                        external_forces, contact_forces, gravity, mass_damping,
-                                       constrained, prescribed_velocities, time_step,
-                                       listed_positions)
+                                       constrained, prescribed_velocities, first_loaded,
+                                       first_held, time_step, listed_positions)
         work += node_work
         largest = max(largest, moved)
     return work, largest
 
 
-@kernel
+@leaf_kernel
 def jointed_update_serial(positions, velocities, element_forces, node_offsets, node_slots,
                           masses, external_forces, contact_forces, gravity, mass_damping,
-                          constrained, prescribed_velocities, time_step, joint_forces,
-                          joint_slot_rows, listed_positions):
-    """:func:`jointed_update` on one thread."""
+                          constrained, prescribed_velocities, first_loaded, first_held, time_step,
+                          joint_forces, joint_slot_rows, listed_positions):
+    """:func:`jointed_update` on one thread (without reference counts, as
+    :func:`central_difference_update_serial`)."""
     flat = element_forces.reshape((-1, 3))
     work = 0.0
     largest = 0.0
@@ -384,8 +396,8 @@ def jointed_update_serial(positions, velocities, element_forces, node_offsets, n
                                                 node_offsets, node_slots)
         node_work, moved = update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses,
                                        external_forces, contact_forces, gravity, mass_damping,
-                                       constrained, prescribed_velocities, time_step,
-                                       listed_positions)
+                                       constrained, prescribed_velocities, first_loaded,
+                                       first_held, time_step, listed_positions)
         work += node_work
         largest = max(largest, moved)
     return work, largest
@@ -528,6 +540,17 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
      joint_buffer, joint_slot_rows, joint_released, joint_work, joint_anchors) = joint_data
     has_joints = joint_nodes.shape[0] > 0
+    # the nodes before the first loaded one and before the first held one read the first row
+    # (zero, free) of the loads and of the held components instead of their own
+    # (``update_node``): a body split by joints then reads a fifth fewer bytes per node (the
+    # rigid bodies' nodes, held, come after the deformable ones)
+    first_loaded = first_held = positions.shape[0]
+    for n in range(positions.shape[0] - 1, -1, -1):
+        for d in range(3):
+            if external_forces[n, d] != 0.0:
+                first_loaded = n
+            if constrained[n, d]:
+                first_held = n
     # the one-thread joints' scratch (``joint_forces``; on threads, each block has its own)
     joint_scratch = np.empty(joint_kernels.JOINT_SCRATCH_SIZE if has_joints else 0)
     tet4 = elements.shape[1] == 4
@@ -598,22 +621,24 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
             work, largest_move = jointed_update(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, joint_buffer, joint_slot_rows, moves_from)
+                prescribed_velocities, first_loaded, first_held, time_step, joint_buffer,
+                joint_slot_rows, moves_from)
             joint_work[0] += work
         elif has_joints:
             work, largest_move = jointed_update_serial(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, joint_buffer, joint_slot_rows, moves_from)
+                prescribed_velocities, first_loaded, first_held, time_step, joint_buffer,
+                joint_slot_rows, moves_from)
             joint_work[0] += work
         elif parallel:
             largest_move = central_difference_update(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, moves_from)
+                prescribed_velocities, first_loaded, first_held, time_step, moves_from)
         else:
             largest_move = central_difference_update_serial(
                 positions, velocities, element_forces, node_offsets, node_slots, masses,
                 external_forces, contact_forces, gravity, mass_damping, constrained,
-                prescribed_velocities, time_step, moves_from)
+                prescribed_velocities, first_loaded, first_held, time_step, moves_from)
     return n_steps, DONE, -1, 1.0

@@ -516,8 +516,12 @@ def _scatter_block(first, count, tan_phi, penalty, damage, broken, anchors, buff
             continue
         failed = 0
         for q in range(3):
-            damage[j, q] = scratch[_at(_DAMAGE + q, i)]
-            failed += scratch[_at(_DAMAGE + q, i)] >= 1.0
+            grown = scratch[_at(_DAMAGE + q, i)]
+            failed += grown >= 1.0
+            # stored only where it grew: most joints' damage stays, and a store would dirty
+            # its line (written back to memory every step)
+            if grown != damage[j, q]:
+                damage[j, q] = grown
         share = scratch[_at(_SHARE, i)]
         t0x, t0y, t0z = _read3(scratch, _TRACTIONS, i)
         t1x, t1y, t1z = _read3(scratch, _TRACTIONS + 3, i)
