@@ -576,11 +576,14 @@ def joint_range(start, stop, positions, joints, sizes, properties, joint_materia
                           anchors, buffer)
     newly = 0
     first = start
+    one_material = properties.shape[0] == 1
     while first < stop:
         row = joint_material[first]
-        last = first + 1
-        while last < stop and last - first < JOINT_BLOCK and joint_material[last] == row:
-            last += 1
+        last = min(first + JOINT_BLOCK, stop)
+        if not one_material:
+            last = first + 1
+            while last < stop and last - first < JOINT_BLOCK and joint_material[last] == row:
+                last += 1
         count = last - first
         _gather_block(first, count, positions, joints, sizes, damage, scratch)
         # properties (JointMaterial.kernel_row): f_t, c, tan phi, p, f_t A / G_I, A / G_II,
