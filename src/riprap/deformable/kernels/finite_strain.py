@@ -267,8 +267,9 @@ def update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses, extern
     it."""
     m = masses[n]
     # nodes before ``first_loaded`` (``first_held``) have no load (no held component): they skip
-    # those reads and choices (a split body's node update 80 -> 68 microseconds; with the
-    # reads branch-free from a row of zeros it stayed at 80: the cost is the instructions)
+    # those reads and choices (examples/11's split unit: its node update alone 80 -> 62
+    # microseconds; with the same reads made branch-free from a row of zeros it stayed at 80:
+    # the cost is the instructions, not the bytes)
     load_x = load_y = load_z = 0.0
     if n >= first_loaded:
         load_x = external_forces[n, 0]
