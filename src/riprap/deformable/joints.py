@@ -212,9 +212,10 @@ def check_crack_resolution(nodes, tets, name: str) -> None:
 
 
 def slot_joint_rows(tets, joints, joint_tets, face_joint) -> np.ndarray:
-    """(4 m, 3) int32 (half the bytes the node update reads for it): for each (tet, corner) slot 4 t + c, the rows of a (6 n + 1, 3) joint force
-    buffer (``kernels/joints.joint_forces``: row 6 j + k for joint j's vertex k, 0-2 on face A,
-    3-5 on face B) that hold the forces on that corner from the joints on the tet's three faces
+    """(4 m, 3) int32 (half the bytes of int64 for the node update to read): for each
+    (tet, corner) slot 4 t + c, the rows of a (6 n + 1, 3) joint force buffer
+    (``kernels/joints.joint_forces``: row 6 j + k for joint j's vertex k, 0-2 on face A, 3-5 on
+    face B) that hold the forces on that corner from the joints on the tet's three faces
     there (column f - (f > c) for face f, the face opposite corner f); row 6 n, kept zero, where
     a face has no joint."""
     tets = np.asarray(tets, dtype=np.int64)

@@ -518,7 +518,7 @@ def _scatter_block(first, count, tan_phi, penalty, damage, broken, anchors, buff
         for q in range(3):
             grown = scratch[_at(_DAMAGE + q, i)]
             failed += grown >= 1.0
-            # stored only where it grew: most joints' damage stays, and a store would dirty
+            # stored only where it changed: most joints' damage stays, and a store would dirty
             # its line (written back to memory every step)
             if grown != damage[j, q]:
                 damage[j, q] = grown
