@@ -324,8 +324,8 @@ def central_difference_update(positions, velocities, element_forces, node_offset
 
     ``node_slots[node_offsets[n]:node_offsets[n + 1]]`` lists the flat (element, local node)
     entries of ``element_forces`` that act on node n; ``single_slots[n]`` names its one entry
-    where it has only one, else -1 (``slots.single_slots_of``). Components flagged in ``constrained`` take
-    ``prescribed_velocities`` instead."""
+    where it has only one, else -1 (``slots.single_slots_of``). Components flagged in
+    ``constrained`` take ``prescribed_velocities`` instead."""
     flat = element_forces.reshape((-1, 3))
     largest = 0.0
     for n in prange(positions.shape[0]):
@@ -361,8 +361,7 @@ def central_difference_update_serial(positions, velocities, element_forces, node
 
 @parallel_kernel
 def jointed_update(positions, velocities, element_forces, node_offsets, node_slots, single_slots,
-                   masses,
-                   external_forces, contact_forces, gravity, mass_damping, constrained,
+                   masses, external_forces, contact_forces, gravity, mass_damping, constrained,
                    prescribed_velocities, first_loaded, first_held, time_step, joint_forces,
                    joint_slot_rows, listed_positions):
     """:func:`central_difference_update` with the joints' forces added (``joint_forces``: a row
@@ -628,29 +627,25 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
         if has_joints and parallel:
             work, largest_move = jointed_update(
                 positions, velocities, element_forces, node_offsets, node_slots, single_slots,
-                masses,
-                external_forces, contact_forces, gravity, mass_damping, constrained,
+                masses, external_forces, contact_forces, gravity, mass_damping, constrained,
                 prescribed_velocities, first_loaded, first_held, time_step, joint_buffer,
                 joint_slot_rows, moves_from)
             joint_work[0] += work
         elif has_joints:
             work, largest_move = jointed_update_serial(
                 positions, velocities, element_forces, node_offsets, node_slots, single_slots,
-                masses,
-                external_forces, contact_forces, gravity, mass_damping, constrained,
+                masses, external_forces, contact_forces, gravity, mass_damping, constrained,
                 prescribed_velocities, first_loaded, first_held, time_step, joint_buffer,
                 joint_slot_rows, moves_from)
             joint_work[0] += work
         elif parallel:
             largest_move = central_difference_update(
                 positions, velocities, element_forces, node_offsets, node_slots, single_slots,
-                masses,
-                external_forces, contact_forces, gravity, mass_damping, constrained,
+                masses, external_forces, contact_forces, gravity, mass_damping, constrained,
                 prescribed_velocities, first_loaded, first_held, time_step, moves_from)
         else:
             largest_move = central_difference_update_serial(
                 positions, velocities, element_forces, node_offsets, node_slots, single_slots,
-                masses,
-                external_forces, contact_forces, gravity, mass_damping, constrained,
+                masses, external_forces, contact_forces, gravity, mass_damping, constrained,
                 prescribed_velocities, first_loaded, first_held, time_step, moves_from)
     return n_steps, DONE, -1, 1.0
