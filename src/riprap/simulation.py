@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, OverlapError, RiprapError
-from riprap.work_estimate import check_deformable_run, check_rigid_run
+from riprap.work_estimate import (MAX_CHECKPOINTS, MAX_FRAMES, check_deformable_run,
+                                   check_rigid_run, schedule_problems)
 from riprap.geometry.tetmesh import TetMesh
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
@@ -38,6 +39,9 @@ _MAX_MOTION_PER_STEP = 0.1
 # Gravity above this (m/s^2) is named as the likely cause of a blow-up (a centrifuge model runs
 # at tens of g; more is a typo).
 _ABSURD_GRAVITY = 1000.0
+# A run whose clock and step count stay where they are over this many chunks in a row is stuck
+# (a step too small to change the clock): it stops with an error instead of spinning.
+_MOST_CHUNKS_WITHOUT_PROGRESS = 1000
 
 
 @dataclass
@@ -146,6 +150,10 @@ class Simulation:
         _require(checkpoint_interval >= 0, "checkpoint_interval", checkpoint_interval, ">= 0 s")
         _require(rest_speed >= 0, "rest_speed", rest_speed, ">= 0 m/s")
         _require(rest_kinetic_energy >= 0, "rest_kinetic_energy", rest_kinetic_energy, ">= 0 J")
+        for key, value, message in schedule_problems(end_time=end_time,
+                                                     output_interval=output_interval,
+                                                     checkpoint_interval=checkpoint_interval):
+            raise CaseFileError(f"simulation.{key} = {value:g}: {message}")
         self.rest_kinetic_energy = float(rest_kinetic_energy)
         self.adaptive_time_step = bool(adaptive_time_step)
         self._last_stability_ratio = 0.0
@@ -485,8 +493,10 @@ class Simulation:
         end_reason = "end_time"
         good = model.state_arrays()
         with _Progress(self.progress, self.end_time, model.name) as progress:
+            stalled = 0
             while not model.reached(self.end_time):
                 until = min(time for time in self._scheduled_times() if not model.reached(time))
+                before = (model.time, model.step_count)
                 try:
                     model.advance(until)
                 except InstabilityError as error:
@@ -497,14 +507,22 @@ class Simulation:
                     raise InstabilityError(
                         f"{error}\nThe last good state (t = {float(good['clock'][0]):.6g} s) was "
                         f"written to {path}. {model.failure_advice(good)}") from None
+                stalled = stalled + 1 if (model.time, model.step_count) == before else 0
+                if stalled > _MOST_CHUNKS_WITHOUT_PROGRESS:
+                    raise RiprapError(
+                        f"the {model.name} run is stuck at t = {model.time:.9g} s: "
+                        f"{_MOST_CHUNKS_WITHOUT_PROGRESS} chunks of work in a row moved neither "
+                        f"the clock nor the step count (time step {model.last_time_step():.3g} "
+                        "s); check [simulation] time_step and the intervals")
                 good = model.state_arrays()
                 if model.reached(self._frame_index * self.output_interval):
                     self._write_scheduled_frame(model)
                     last_frame_time = model.time
                 if (self.checkpoint_interval > 0 and model.reached(
                         (self._checkpoints_written + 1) * self.checkpoint_interval)):
-                    while model.reached((self._checkpoints_written + 1) * self.checkpoint_interval):
-                        self._checkpoints_written += 1
+                    self._checkpoints_written = _first_not_reached(
+                        model, self._checkpoints_written + 1, self.checkpoint_interval,
+                        MAX_CHECKPOINTS, "checkpoint_interval") - 1
                     self._save_checkpoint("checkpoint.npz", good)
                 progress.update(model, start_wall, start_steps)
                 if after_chunk is not None:
@@ -543,8 +561,10 @@ class Simulation:
     def _write_scheduled_frame(self, model) -> None:
         model.write_frame(self._frame_index)
         self._frame_index += 1
-        while model.reached(self._frame_index * self.output_interval) and not model.reached(self.end_time):
-            self._frame_index += 1      # a chunk longer than a frame interval: no frame twice
+        if not model.reached(self.end_time):
+            # a chunk longer than a frame interval: no frame twice
+            self._frame_index = _first_not_reached(model, self._frame_index, self.output_interval,
+                                                   MAX_FRAMES, "output_interval")
 
     def _step_keeps_motion_small(self, time_step: float) -> bool:
         """No body moves more than _MAX_MOTION_PER_STEP of the smallest boundary sub-tet height in
@@ -759,6 +779,18 @@ _ACCEPTED_KINDS = {"riprap rigid run": ("riprap rigid run",),
                    "riprap deformable coupled run": ("riprap deformable coupled run",),
                    "riprap fluid run": ("riprap fluid run",),
                    "riprap coupled run": ("riprap coupled run", "riprap fluid run")}
+
+
+def _first_not_reached(model, index: int, interval: float, most: int, key: str) -> int:
+    """The first of ``index``, ``index + 1``, ... whose time ``index * interval`` the model has not
+    reached. The schedule holds at most ``most`` such times (``schedule_problems``), so more
+    steps than that mean a clock that cannot be trusted: an error, not a loop without end."""
+    for _ in range(most + 2):
+        if not model.reached(index * interval):
+            return index
+        index += 1
+    raise RiprapError(f"the schedule of simulation.{key} = {interval:g} s ran past {most} entries "
+                      f"at t = {model.time:.6g} s; the run's clock has left its schedule, report it")
 
 
 def _require(ok: bool, key: str, value, expected: str) -> None:

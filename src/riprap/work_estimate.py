@@ -30,6 +30,12 @@ WARN_WALL_SECONDS = 12 * 3600.0
 REFUSE_STEPS = 1.0e10
 #: A fluid grid needing more than this fraction of the machine's memory is refused.
 MEMORY_FRACTION = 0.8
+#: Most ParaView frames a run may write (each is a file per body set and one of the fluid; a
+#: hundred thousand already fills a disk and no viewer steps through them).
+MAX_FRAMES = 100_000
+#: Most periodic checkpoints a run may write (each writes the whole state: at this many the run
+#: spends its time writing, not simulating).
+MAX_CHECKPOINTS = 10_000
 
 
 class WorkTooLargeError(RiprapError):
@@ -79,6 +85,24 @@ def check_deformable_run(*, end_time: float, time_step: float, elements: int) ->
             "mesh_size, or shorten end_time")
     if seconds > WARN_WALL_SECONDS:
         warnings.warn(f"this run will take {figure}", RiprapWarning, stacklevel=3)
+
+
+def schedule_problems(*, end_time: float, output_interval: float,
+                      checkpoint_interval: float) -> list[tuple[str, float, str]]:
+    """(key of [simulation], its value, what is wrong) for each interval that would write more
+    than :data:`MAX_FRAMES` frames or :data:`MAX_CHECKPOINTS` checkpoints up to ``end_time``:
+    the run writes everything its schedule asks for, so such an interval would keep it writing
+    (or, far below the time step, counting frames) for ever."""
+    problems = []
+    for key, interval, most, what in (("output_interval", output_interval, MAX_FRAMES, "frames"),
+                                      ("checkpoint_interval", checkpoint_interval, MAX_CHECKPOINTS,
+                                       "checkpoints")):
+        if interval > 0 and end_time / interval > most:
+            problems.append((key, interval, (
+                f"{end_time / interval:.3g} {what} in end_time = {end_time:g} s, more than the "
+                f"{most} a run may write; set {key} >= {end_time / most:.3g} s (end_time / "
+                f"{most})")))
+    return problems
 
 
 def available_memory_bytes() -> float:

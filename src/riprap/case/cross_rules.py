@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from riprap.work_estimate import schedule_problems
+
 # The validated tables: name -> dict of values (defaults filled, _INVALID where a value was
 # refused), a list of such dicts for arrays, or None for an absent optional table.
 Tables = dict
@@ -31,6 +33,12 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
             add(("simulation", "time_step"),
                 f"longer than end_time = {simulation['end_time']:g} s: the run would make no "
                 "step; 0 chooses the step automatically", simulation["time_step"])
+    if simulation and ok(simulation["end_time"], simulation["output_interval"],
+                         simulation["checkpoint_interval"]):
+        for key, value, message in schedule_problems(
+                end_time=simulation["end_time"], output_interval=simulation["output_interval"],
+                checkpoint_interval=simulation["checkpoint_interval"]):
+            add(("simulation", key), message, value)
 
     for name in ("waves", "gauges", "porous_zones"):
         if tables.get(name) and tables.get("fluid") is None:

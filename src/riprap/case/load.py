@@ -749,6 +749,8 @@ class _Validator:
         if kind == "integer":
             if isinstance(value, bool) or not isinstance(value, int):
                 return _INVALID, _type_name(value)
+            if not _fits_64_bits(value):
+                return _INVALID, _BEYOND_64_BITS
             return value, ""
         if kind == "number":
             return _as_number(value)
@@ -768,6 +770,8 @@ class _Validator:
             for number, item in enumerate(value):
                 if isinstance(item, bool) or not isinstance(item, int) or item < 0:
                     return _INVALID, f"{item!r} at item {number}"
+                if not _fits_64_bits(item):
+                    return _INVALID, f"{_BEYOND_64_BITS} at item {number}"
             if len(set(value)) != len(value):
                 return _INVALID, "a body listed twice"
             return tuple(value), ""
@@ -804,6 +808,8 @@ class _Validator:
             if kind == "integer_vector":
                 if isinstance(item, bool) or not isinstance(item, int):
                     return _INVALID, f"{_type_name(item)} at item {number}"
+                if not _fits_64_bits(item):
+                    return _INVALID, f"{_BEYOND_64_BITS} at item {number}"
                 items.append(item)
             else:
                 converted, detail = _as_number(item)
@@ -1043,14 +1049,27 @@ class _Validator:
                     )
 
     def _check_body_count(self, tables: dict, top: dict | None = None) -> None:
+        total, named = len(tables["bodies"]), False
+        for number, values in enumerate(tables["body_grids"]):
+            counts = None if values is None else values.get("counts", _INVALID)
+            count = 1 if counts is None or counts is _INVALID else math.prod(counts)
+            if count > schema.MAXIMUM_BODY_COUNT:
+                # refused before anything is built: building them alone would take hours
+                self._problems.add(
+                    ("body_grids", number, "counts"),
+                    f"{' x '.join(map(str, counts))} = {_count(count)} bodies, more than the "
+                    f"{schema.MAXIMUM_BODY_COUNT:,} a case may create; use fewer", counts)
+                named = True
+            total += count
+        if total > schema.MAXIMUM_BODY_COUNT:
+            if not named:
+                self._problems.add(("body_grids",), f"the case creates {_count(total)} bodies, more "
+                                   f"than the {schema.MAXIMUM_BODY_COUNT:,} a case may create")
+            return
         if tables.get("placement") is not None or tables.get("fluid") is not None:
             return               # riprap place makes the bodies; a fluid case needs none
         if top and top.get("pack") not in (None, "", _INVALID):
             return               # the pack brings its bodies
-        total = len(tables["bodies"])
-        for values in tables["body_grids"]:
-            counts = None if values is None else values.get("counts", _INVALID)
-            total += 1 if counts is None or counts is _INVALID else math.prod(counts)
         if total < schema.MINIMUM_BODY_COUNT:
             self._problems.add(
                 ("bodies",),
@@ -1134,6 +1153,19 @@ def _with_pack(case: Case, pack_path) -> Case:
 
 def _optional(spec_class, values: dict | None):
     return None if values is None else spec_class(**values)
+
+
+def _count(number: int) -> str:
+    """A count as an engineer reads it: digits in groups of three, or powers of ten when long."""
+    return f"{number:,}" if number < 10**12 else f"{number:.3g}"
+
+
+_BEYOND_64_BITS = "an integer beyond 64 bits (more than 9.2e18 in size)"
+
+
+def _fits_64_bits(value: int) -> bool:
+    """Whether ``value`` fits a 64-bit signed integer, as every count and seed reaches numpy."""
+    return -2**63 <= value < 2**63
 
 
 def _as_number(value: object) -> tuple[object, str]:

@@ -52,20 +52,41 @@ def check_case(case: Case, *, output_directory=None) -> CheckReport:
             not_checked=["whether the flow stays stable (the time step adapts to it)"])
         if run.coupled:
             report.checked.append("bodies: meshes, overlaps, inside the fluid box, cells across")
+            report.checked.append(_bodies_step(run))
     else:
         from riprap.case.build import build_simulation
 
         sim = build_simulation(case, output_directory=out, progress=False)
         sim.prepare()
-        solver = sim.solver
-        checked = ["tables and keys", f"{len(case.shapes)} shape meshes",
-                   f"time step {solver.time_step:.3e} s and the work of "
-                   f"{sim.end_time / solver.time_step:.3g} steps",
+        checked = ["tables and keys", f"{len(case.shapes)} shape meshes", _bodies_step(sim),
                    "overlapping and coincident bodies at the start"]
         if case.simulation.contact_history:
             checked.append(f"contact history ({len(sim.accepted_overlaps)} resting contacts)")
-        report = CheckReport(f"{solver.n_bodies} bodies", checked=checked,
+        deformable = len(sim.deformable_bodies)
+        rigid = sim.solver.n_bodies
+        bodies = (f"{deformable} deformable and {rigid} rigid bodies" if deformable and rigid
+                  else f"{deformable} deformable bodies" if deformable else f"{rigid} bodies")
+        report = CheckReport(bodies, checked=checked,
                              not_checked=["whether the contacts that form later stay stable at "
                                           "this time step (a run stops with a checkpoint if not)"])
     report.checked.append(check_output_folder(out))
     return report
+
+
+def _bodies_step(sim) -> str:
+    """The bodies' time step and the work it implies, as the run estimated it when its model was
+    built (the run refuses an absurd one there, so reaching this line means it passed)."""
+    model = sim.model
+    system = getattr(model, "system", None)
+    if system is not None:              # deformable bodies, dry or in the flow
+        step, what = system.time_step, f"{len(system.elements)} elements"
+        text = f"deformable bodies' stable time step {step:.3e} s"
+        if sim.solver.n_bodies:
+            what += f" and {sim.solver.n_bodies} rigid bodies"
+    else:
+        step, what = sim.solver.time_step, f"{sim.solver.n_bodies} bodies"
+        text = f"time step {step:.3e} s"
+    if sim.fluid is not None:
+        # the fluid's own step follows its Courant number; the bodies' is a sub-step inside it
+        return f"{text} (a sub-step of each fluid step) for {what}"
+    return f"{text} and the work of {sim.end_time / step:.3g} steps of {what}"

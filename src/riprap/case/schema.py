@@ -17,6 +17,7 @@ __all__ = [
     "MINIMUM_QUATERNION_NORM",
     "MINIMUM_DIRECTION_NORM",
     "MINIMUM_BODY_COUNT",
+    "MAXIMUM_BODY_COUNT",
     "MAXIMUM_REPORTED_PROBLEMS",
     "REQUIRED",
     "KINDS",
@@ -45,6 +46,11 @@ MINIMUM_DIRECTION_NORM = 1e-12
 
 #: A case must create at least this many bodies from ``[[bodies]]`` and ``[[body_grids]]``.
 MINIMUM_BODY_COUNT = 1
+
+#: A case may create at most this many bodies: rigid runs step 3e4-6e4 body-steps/s
+#: (bench/README.md), so a million bodies take a day for a hundred steps, and their meshes and
+#: contact arrays fill the memory long before more is built.
+MAXIMUM_BODY_COUNT = 1_000_000
 
 #: At most this many problems are listed in one error message; the rest are counted.
 MAXIMUM_REPORTED_PROBLEMS = 20
