@@ -30,12 +30,12 @@ WARN_WALL_SECONDS = 12 * 3600.0
 REFUSE_STEPS = 1.0e10
 #: A fluid grid needing more than this fraction of the machine's memory is refused.
 MEMORY_FRACTION = 0.8
-#: Most ParaView frames a run may write (each is a file per body set and one of the fluid; a
-#: hundred thousand already fills a disk and no viewer steps through them).
-MAX_FRAMES = 100_000
-#: Most periodic checkpoints a run may write (each writes the whole state: at this many the run
-#: spends its time writing, not simulating).
-MAX_CHECKPOINTS = 10_000
+#: Most ParaView frames a run may write: a million, each a file per body set and one of the fluid
+#: (at the default 0.05 s, 14 hours of simulated time: a storm of thousands of waves fits).
+MAX_FRAMES = 1_000_000
+#: Most periodic checkpoints a run may write (each writes the whole state: a hundred thousand
+#: already spend more time writing than simulating).
+MAX_CHECKPOINTS = 100_000
 
 
 class WorkTooLargeError(RiprapError):

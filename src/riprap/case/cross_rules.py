@@ -58,6 +58,10 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
             add(("fluid",), "a case is either an armour placement ([slope], [underlayer], [armour], "
                 "[placement]; riprap place) or a fluid run ([fluid]; riprap run), not both: place "
                 "the layer first, then run its pack")
+        if tables.get("deformable") is not None:
+            add(("deformable",), "riprap place drops rigid rocks and units and would ignore "
+                "[deformable]; remove it, and add it to the case that runs the placed pack "
+                "(pack = \"pack.toml\")")
         if has_bodies:
             where = "bodies" if tables.get("bodies") else "body_grids"
             add((where,), "riprap place makes its own bodies (rocks and units) and would ignore "

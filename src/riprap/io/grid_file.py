@@ -227,6 +227,22 @@ def _quaternions_from_angles(angles_deg: np.ndarray) -> np.ndarray:
     return np.stack([w, x, y, z], axis=1)
 
 
+def _check_repeated_positions(positions: np.ndarray, lines: list[int], problems: _Problems) -> None:
+    """Two rows with the same centroid would place two units in one place: the solver cannot
+    part them (no direction to push), so the second row is refused, naming the first."""
+    first_line: dict[tuple, int] = {}
+    for row, line in enumerate(lines):
+        key = tuple(positions[row].tolist())
+        if not all(math.isfinite(value) for value in key):
+            continue                      # already reported as not a number
+        if key in first_line:
+            shown = ", ".join(f"{value:g}" for value in key)
+            problems.add(line, f"the centroid ({shown}) repeats line {first_line[key]}: two units "
+                         "would start in the same place; remove one of the two rows")
+        else:
+            first_line[key] = line
+
+
 def read_grid_file(path: str | os.PathLike) -> GridPoints:
     """Read a placement grid file (CSV; format in the module docstring).
 
@@ -293,6 +309,7 @@ def read_grid_file(path: str | os.PathLike) -> GridPoints:
         if valid.any():
             orientations[valid] = _quaternions_from_angles(angles[valid])
     velocities = _columns(values, names, VELOCITY_COLUMNS)
+    _check_repeated_positions(positions, lines, problems)
     problems.raise_if_any()
     return GridPoints(positions=positions, orientations=orientations, velocities=velocities,
                       lines=np.asarray(lines, dtype=np.int64), source=source)
