@@ -735,11 +735,14 @@ class _Validator:
             hint = _suggestion(converted, entry.choices)
             self._problems.add(path, f"not an allowed value; {hint}expected {expected}", value)
             return _INVALID
+        components = converted if isinstance(converted, tuple) else (converted,)
         if entry.valid_range is not None:
-            components = converted if isinstance(converted, tuple) else (converted,)
             if not all(entry.valid_range.contains(item) for item in components):
                 self._problems.add(path, f"out of range; expected {expected}", value)
                 return _INVALID
+        if entry.plausible is not None and any(entry.implausible(item) for item in components):
+            self._problems.add(path, _implausible(entry), value)
+            return _INVALID
         if entry.kind == "path":
             return self._check_path(entry, converted, path, value)
         return converted
@@ -1153,6 +1156,14 @@ def _with_pack(case: Case, pack_path) -> Case:
 
 def _optional(spec_class, values: dict | None):
     return None if values is None else spec_class(**values)
+
+
+def _implausible(entry: Key) -> str:
+    """Why a value outside the key's plausible range is refused, with the range."""
+    unit = "" if entry.unit == "-" else f" {entry.unit}"
+    each = " for each component" if entry.kind == "vector" else ""
+    return (f"far outside any physical value: plausible is {entry.plausible.describe()}{unit}"
+            f"{each} (docs/case-file.md); check the unit and the exponent")
 
 
 def _count(number: int) -> str:

@@ -10,7 +10,7 @@ change here (a unit test fails while the page is out of date).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 __all__ = [
     "FORMAT_VERSION",
@@ -26,6 +26,7 @@ __all__ = [
     "Table",
     "TABLES",
     "KEYS",
+    "PLAUSIBLE",
     "table",
     "keys_of",
     "key",
@@ -190,6 +191,11 @@ class Key:
         Allowed file name endings for ``path`` keys (lower case, with the dot).
     greater_than : str or None
         Name of a vector key of the same entry that this one must exceed in every component.
+    plausible : Range or None
+        Physically plausible numbers (each component for vector kinds), orders of magnitude
+        around real materials, flumes and seas (:data:`PLAUSIBLE`, where each bound's source is
+        given): a value outside is refused as a slip (a wrong unit, a stray exponent). 0 passes
+        where the key allows it (off, automatic or not given).
     """
 
     table: str
@@ -205,6 +211,15 @@ class Key:
     unique: bool = False
     extensions: tuple[str, ...] = ()
     greater_than: str | None = None
+    plausible: Range | None = None
+
+    def implausible(self, value: float) -> bool:
+        """Whether ``value`` lies outside the physically plausible range (0 passes where the key
+        allows it: off, automatic or not given)."""
+        zero_allowed = self.valid_range is not None and self.valid_range.contains(0.0)
+        if self.plausible is None or (value == 0 and zero_allowed):
+            return False
+        return not self.plausible.contains(value)
 
     @property
     def required(self) -> bool:
@@ -742,6 +757,97 @@ KEYS: tuple[Key, ...] = (
 )
 
 
+
+def _between(low: float, high: float) -> Range:
+    return Range(minimum=low, maximum=high)
+
+
+#: Physically plausible values of the physical keys, (table, key) -> range, applied to every
+#: variant of the key. The bounds are generous on purpose, orders of magnitude around real
+#: materials, laboratory flumes and prototype seas, so that only a slip is refused (a value in
+#: the wrong unit, a stray exponent: a water viscosity of 1e12 Pa s runs for 18 million minutes).
+#: Sources: material tables of Eurocode 2 (EN 1992-1-1, table 3.1) and the CRC Handbook of
+#: Chemistry and Physics; CIRIA/CUR/CEM The Rock Manual (2007), chapter 3; EurOtop (2018); the
+#: Coastal Engineering Manual (EM 1110-2-1100), part II; and the values in riprap's own
+#: examples and tests.
+PLAUSIBLE: dict[tuple[str, str], Range] = {
+    # gravity: the earth's 9.81; a geotechnical centrifuge spins models at up to a few hundred g
+    # (simulation._ABSURD_GRAVITY is 1000 m/s^2 too)
+    ("simulation", "gravity"): _between(-1000.0, 1000.0),
+    # densities of solids: expanded polystyrene (about 15 kg/m^3) to osmium (22,590)
+    ("materials", "density"): _between(10.0, 25000.0),
+    # Coulomb friction: ice on ice about 0.02, rock on rock 0.6-0.9, rubber on concrete up to 2
+    ("materials", "friction_coefficient"): _between(0.0, 5.0),
+    # contact penalty: of the order of the Young's modulus of the softer body, gels (1e3 Pa) to
+    # ten times diamond's (1.2e12 Pa)
+    ("materials", "contact_penalty"): _between(1.0e3, 1.0e13),
+    # tangential over normal contact stiffness: 2/7 (Hertz-Mindlin, rigid spheres) to about 1
+    ("materials", "tangential_stiffness_ratio"): _between(1.0e-3, 10.0),
+    # liquids as "water": petrol (about 700 kg/m^3) to heavy brines and slurries (2000), with
+    # room either side; the second fluid ("air") may be a second liquid (examples/03: an oil)
+    ("fluid", "water_density"): _between(500.0, 3000.0),
+    ("fluid", "air_density"): _between(1.0e-2, 3000.0),
+    # dynamic viscosities: air 1.8e-5 Pa s, water 1.0e-3, silicone oils and glycerol 0.1-1.5,
+    # honey about 10; 100 Pa s is already a paste
+    ("fluid", "water_viscosity"): _between(1.0e-5, 100.0),
+    ("fluid", "air_viscosity"): _between(1.0e-6, 100.0),
+    # surface tension: organic liquids about 0.02 N/m, water 0.073, mercury 0.49
+    ("fluid", "surface_tension"): _between(1.0e-3, 1.0),
+    # porous media (Rock Manual, 3.4; van Gent 1995): porosity of packed rock and units 0.25-0.6
+    ("porous_zones", "porosity"): _between(0.05, 0.95),
+    # stones: coarse sand (1 mm) to the largest quarried blocks (Dn50 about 3 m)
+    ("porous_zones", "stone_diameter"): _between(1.0e-3, 10.0),
+    # Darcy-Forchheimer coefficients (van Gent 1995; Jensen et al. 2014): a 0-1500, b 0.3-3.6
+    # (a ten times wider range each way still catches a stray exponent), c about 0.34
+    ("porous_zones", "linear_friction"): _between(0.0, 1.0e5),
+    ("porous_zones", "quadratic_friction"): _between(0.0, 100.0),
+    ("porous_zones", "added_mass"): _between(0.0, 10.0),
+    # waves: laboratory flumes (a centimetre, half a second) to the highest storm waves at sea
+    # (about 30 m) and swell periods (25 s), with infragravity periods in room
+    ("waves", "height"): _between(1.0e-3, 50.0),
+    ("waves", "period"): _between(0.1, 300.0),
+    ("waves", "significant_height"): _between(1.0e-3, 50.0),
+    ("waves", "peak_period"): _between(0.1, 300.0),
+    # JONSWAP peak enhancement: 1 (Pierson-Moskowitz) to about 7 for young swell-free seas
+    ("waves", "peak_enhancement"): _between(1.0, 20.0),
+    # elastic material: gels (1e3 Pa) to diamond (1.2e12); concrete about 3e10
+    ("deformable", "young_modulus"): _between(1.0e3, 1.0e13),
+    # viscous damping of the elements: riprap's examples use 2-300 Pa s; far beyond 1e9 the
+    # viscous step limit takes over and nothing moves
+    ("deformable", "viscosity"): _between(1.0e-3, 1.0e9),
+    # strengths: weak mortars and rock (1e3-1e5 Pa) to high-strength steel (2e9)
+    ("deformable", "tensile_strength"): _between(1.0e3, 1.0e10),
+    ("deformable", "cohesion"): _between(1.0e3, 1.0e10),
+    # penalties: as the Young's modulus, joints ten times stiffer
+    ("deformable", "contact_penalty"): _between(1.0e3, 1.0e14),
+    ("deformable", "joint_penalty"): _between(1.0e3, 1.0e15),
+    # mass damping: the settling aid of examples/08 is 2000 1/s; a 1 m concrete unit's lowest
+    # mode is about 1e4 rad/s, so 1e6 1/s already freezes any unit
+    ("deformable", "mass_damping"): _between(1.0e-6, 1.0e6),
+    # fracture energies: glass (about 10 J/m^2), concrete 100 (mode I) and 1000 (mode II), to
+    # tough steels (1e5)
+    ("deformable", "fracture_energy_mode_i"): _between(0.1, 1.0e6),
+    ("deformable", "fracture_energy_mode_ii"): _between(0.1, 1.0e6),
+    # the flume and the face: a narrow laboratory flume (a few cm) to a prototype section
+    # (hundreds of m); slopes from 1:0.5 (steep rock) to 1:20 (a beach)
+    ("slope", "cotangent"): _between(0.5, 20.0),
+    ("slope", "width"): _between(0.02, 1000.0),
+    ("slope", "length"): _between(0.02, 1000.0),
+    # rock gradings (Rock Manual, 3.4.3): laboratory stones of 1 mm to 10-15 t blocks (Dn50
+    # about 1.8 m); a very wide grading has Dn85/Dn15 up to about 3
+    ("underlayer", "dn50"): _between(1.0e-3, 5.0),
+    ("underlayer", "dn85_over_dn15"): _between(1.0, 5.0),
+    # armour units: model units of 2 cm to the largest concrete units (Tetrapods 6 m high, 80 t;
+    # Accropode II Dn about 3.5 m)
+    ("armour", "height"): _between(0.01, 20.0),
+    ("armour", "nominal_diameter"): _between(5.0e-3, 10.0),
+    ("armour", "mass"): _between(1.0e-3, 1.0e6),
+}
+
+KEYS = tuple(replace(entry, plausible=PLAUSIBLE[(entry.table, entry.name)])
+             if (entry.table, entry.name) in PLAUSIBLE else entry for entry in KEYS)
+
+
 def table(name: str) -> Table:
     """The :class:`Table` called ``name`` (``""`` for the top level)."""
     for candidate in TABLES:
@@ -836,6 +942,11 @@ def _allowed_cell(entry: Key) -> str:
         notes.append(" ".join(f"`{extension}`" for extension in entry.extensions))
     if entry.greater_than is not None:
         notes.append(f"each component > `{entry.greater_than}`")
+    if entry.plausible is not None:
+        prefix = "each " if entry.kind in _VECTOR_KINDS else ""
+        zero_allowed = entry.valid_range is not None and entry.valid_range.contains(0.0)
+        zero = " (or 0)" if zero_allowed and not entry.plausible.contains(0.0) else ""
+        notes.append(f"plausible: {prefix}{entry.plausible.describe()}{zero}")
     return "; ".join(notes) if notes else "any"
 
 
@@ -893,6 +1004,10 @@ def render_markdown() -> str:
         "- Keys listed under a `type` exist only for that type: giving one for another type is an "
         "error, and a required one must be given.",
         "- Relative file paths are relative to the folder of the case file.",
+        "- A physical key's value outside its *plausible* range (the allowed column) is refused "
+        "as a slip (a wrong unit, a stray exponent): the ranges span orders of magnitude around "
+        "real materials, flumes and seas (their sources are in src/riprap/case/schema.py, "
+        "`PLAUSIBLE`). 0 passes where the key allows it (off, automatic or not given).",
         "",
     ]
     for part in TABLES:
