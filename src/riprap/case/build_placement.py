@@ -11,14 +11,18 @@ Output folder:
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from riprap.case.build import SMOKE_END_TIME, build_material, smoke_mode
+from riprap.case.schema import MAXIMUM_BODY_COUNT
 from riprap.errors import CaseFileError
-from riprap.placement.place import UNIT_SHAPE_NAME
+from riprap.placement.checks import check_filter_rule, check_row_fits
+from riprap.placement.place import UNIT_SHAPE_NAME, rock_lattice, rock_shapes
+from riprap.work_estimate import RiprapWarning
 from riprap.placement import (PlacementMaterials, Slope, build_underlayer, design_grid,
                               place_units, unit_orientations)
 
@@ -75,6 +79,7 @@ class PlacementInputs:
     unit: object            # riprap.geometry.armour_units.ArmourUnit
     rocks: list             # the rock library (riprap.geometry.rock_grading)
     grid: object = None     # riprap.io.grid_file.GridFile, when [placement] grid_file is given
+    rock_count: int = 0     # rocks in the underlayer's start lattice
 
 
 #: What ``riprap check`` cannot know of a placement case without running it.
@@ -101,21 +106,74 @@ def prepare_placement(case) -> PlacementInputs:
 
         grid = read_grid_file(case.base_dir / pl.grid_file)
     unit = _armour_unit(case)
+    check_filter_rule(nominal_diameter=unit.nominal_diameter, dn50=ul.dn50, unit=case.armour.unit,
+                      where=case.source)
     if grid is not None:
         from riprap.placement.place import check_start_positions
 
         check_start_positions(slope, unit, grid.positions, _unit_orientations(case, slope, grid),
                               grid_lines=grid.lines, release=pl.release)
+    else:
+        _check_design_grid(case, slope, unit)
     rocks = rock_library(RockGrading(dn50=ul.dn50, dn85_over_dn15=ul.dn85_over_dn15),
                          n_shapes=ul.rock_shapes, n_size_classes=ul.size_classes, seed=ul.seed)
-    return PlacementInputs(slope=slope, materials=materials, unit=unit, rocks=rocks, grid=grid)
+    # the underlayer's start lattice, as build_underlayer lays it (it refuses a band holding no
+    # rock, or too many)
+    lattice = rock_lattice(slope, rock_shapes(rocks), (ul.from_s, ul.to_s or slope.length),
+                           ul.layers)
+    return PlacementInputs(slope=slope, materials=materials, unit=unit, rocks=rocks, grid=grid,
+                           rock_count=len(lattice))
+
+
+def _check_design_grid(case, slope, unit) -> None:
+    """The checks ``place_units`` makes of a design grid, before the underlayer run: rows of
+    units that fit across the section, rows that stay on the face, no more units than a case may
+    have bodies, and no unit wider than the flume (its orientation as the run draws it)."""
+    from riprap.placement.place import check_generated_positions
+
+    pl = case.placement
+    for key in ("units_per_row", "units_per_alternate_row"):
+        if getattr(pl, key) > 0:
+            check_row_fits(units_per_row=getattr(pl, key), nominal_diameter=unit.nominal_diameter,
+                           width=slope.width, where=case.source, key=key)
+    units = (pl.rows + 1) // 2 * pl.units_per_row + pl.rows // 2 * (pl.units_per_alternate_row
+                                                                    or pl.units_per_row)
+    if units > MAXIMUM_BODY_COUNT:
+        raise CaseFileError(f"{case.source}: [placement] rows = {pl.rows} of units_per_row = "
+                            f"{pl.units_per_row} make {units:,} units, more than the "
+                            f"{MAXIMUM_BODY_COUNT:,} bodies a case may have")
+    # the centroids' height above the face is the underlayer's business; 0 here changes
+    # neither the rows along the face nor the units' widths
+    generated = _design_grid(case, slope, unit, centroid_height=0.0)
+    check_generated_positions(slope, unit, generated.positions,
+                              _orientations(case, slope, len(generated.positions), None))
+
+
+def _design_grid(case, slope, unit, *, centroid_height: float):
+    """The design grid of ``[placement]``: staggered rows of unit centroids ``centroid_height``
+    (m) above the face, each unit starting its drop height above its centroid."""
+    pl = case.placement
+    counts = (pl.units_per_row, pl.units_per_alternate_row or pl.units_per_row)
+    packing = pl.packing_density_coefficient or unit.design.packing_density_coefficient
+    return design_grid(slope, nominal_diameter=unit.nominal_diameter, rows=pl.rows,
+                       units_per_row=counts, packing_density_coefficient=packing,
+                       first_row_s=pl.first_row_s or 0.5 * unit.height,
+                       centroid_height=centroid_height,
+                       drop_height=(pl.drop_height or unit.height
+                                    if pl.release == "free_fall" else 0.0))
+
+
+def _orientations(case, slope, count: int, user):
+    """The orientations of ``count`` units as the placement draws them (seeded: the same in
+    ``riprap check`` and ``riprap place``)."""
+    pl = case.placement
+    return unit_orientations(count, mode=pl.orientation, slope=slope, seed=pl.seed,
+                             max_tilt_deg=pl.max_tilt_deg, user=user)
 
 
 def _unit_orientations(case, slope, grid):
     """The orientations of the units of a grid file, as the placement will use them."""
-    pl = case.placement
-    return unit_orientations(len(grid.positions), mode=pl.orientation, slope=slope, seed=pl.seed,
-                             max_tilt_deg=pl.max_tilt_deg, user=grid.orientations)
+    return _orientations(case, slope, len(grid.positions), grid.orientations)
 
 
 def run_placement(case, *, output_directory=None, progress: bool = True) -> dict:
@@ -142,18 +200,10 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
         if pl.rows < 1 or pl.units_per_row < 1:
             raise CaseFileError(f"{case.source}: [placement] without grid_file needs rows and "
                                 "units_per_row (a design grid)")
-        counts = (pl.units_per_row, pl.units_per_alternate_row or pl.units_per_row)
-        packing = pl.packing_density_coefficient or unit.design.packing_density_coefficient
         # Design centroids half a design layer thickness above the underlayer top.
-        design = unit.design
         centroid_height = (underlayer.top_level
-                           + 0.5 * design.layer_thickness_coefficient * unit.nominal_diameter)
-        generated = design_grid(slope, nominal_diameter=unit.nominal_diameter, rows=pl.rows,
-                                units_per_row=counts, packing_density_coefficient=packing,
-                                first_row_s=pl.first_row_s or 0.5 * unit.height,
-                                centroid_height=centroid_height,
-                                drop_height=(pl.drop_height or unit.height
-                                             if pl.release == "free_fall" else 0.0))
+                           + 0.5 * unit.design.layer_thickness_coefficient * unit.nominal_diameter)
+        generated = _design_grid(case, slope, unit, centroid_height=centroid_height)
         positions, velocities, lines, user, lift = generated.positions, None, None, None, True
         rows = generated.rows
     # Where each unit was meant to go: the grid point of its centroid (a free-fall drop height
@@ -161,14 +211,20 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
     design_positions = np.array(positions, dtype=float)
     if not pl.grid_file and pl.release == "free_fall":
         design_positions[:, 2] -= pl.drop_height or unit.height
-    orientations = unit_orientations(len(positions), mode=pl.orientation, slope=slope,
-                                     seed=pl.seed, max_tilt_deg=pl.max_tilt_deg, user=user)
+    orientations = _orientations(case, slope, len(positions), user)
     result = place_units(slope, unit, underlayer, positions=positions, orientations=orientations,
                          materials=materials, velocities=velocities, grid_lines=lines,
                          lift_overlapping=lift, initial_velocity=pl.initial_velocity,
                          deposition=pl.deposition, rows=rows, release=pl.release,
                          **_settings(case, pl.settle_time, out / "deposition", progress))
     summary = dict(result.summary)
+    stacked = summary["units_not_on_underlayer"]
+    if stacked and not smoke_mode():
+        warnings.warn(f"{len(stacked)} of {summary['units_placed']} units rest on other units, "
+                      f"not on the underlayer (units {_listed(stacked)}; summary.json "
+                      "units_not_on_underlayer): the layer is stacked, not one layer on the rocks; "
+                      "check the unit size against the section and the underlayer",
+                      RiprapWarning, stacklevel=2)
     summary["smoke"] = smoke_mode()
     if summary["smoke"]:
         summary["smoke_note"] = (f"RIPRAP_SMOKE=1 cut every deposition run to {SMOKE_END_TIME} s: "
@@ -179,6 +235,11 @@ def run_placement(case, *, output_directory=None, progress: bool = True) -> dict
     summary["underlayer_run"] = underlayer.summary
     write_json(out / "summary.json", summary)
     return summary
+
+
+def _listed(numbers, most: int = 10) -> str:
+    shown = ", ".join(str(n) for n in numbers[:most])
+    return shown + (f" and {len(numbers) - most} more" if len(numbers) > most else "")
 
 
 def _layer_description(unit, slope, underlayer, result, design_positions):

@@ -35,10 +35,16 @@ def check_case(case: Case, *, output_directory=None) -> CheckReport:
             f"an armour placement for riprap place: {case.armour.unit} units on a "
             f"1:{case.slope.cotangent:g} slope",
             checked=["tables and keys", f"unit mesh ({len(inputs.unit.mesh.tets)} tetrahedra)",
-                     f"{len(inputs.rocks)} rock shapes"],
+                     f"{len(inputs.rocks)} rock shapes",
+                     f"the underlayer's start lattice ({inputs.rock_count} rocks)",
+                     f"the filter rule (Dn / Dn50 = "
+                     f"{inputs.unit.nominal_diameter / case.underlayer.dn50:.2f})"],
             not_checked=list(PLACEMENT_NOT_CHECKED))
         if inputs.grid is not None:
             report.checked.append(f"grid file ({len(inputs.grid.positions)} units)")
+        else:
+            report.checked.append("design grid: units per row across the section, rows on the "
+                                  "face, units inside the side walls")
     elif case.is_fluid:
         from riprap.case.build_fluid import build_fluid_run
 

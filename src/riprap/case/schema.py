@@ -459,7 +459,11 @@ KEYS: tuple[Key, ...] = (
         references="materials"),
     # [underlayer]
     Key("underlayer", "material", "string", "-", "Material of the rocks.", references="materials"),
-    Key("underlayer", "dn50", "number", "m", "Median nominal diameter of the rocks.",
+    Key("underlayer", "dn50", "number", "m",
+        "Median nominal diameter of the rocks. The filter rule (Rock Manual 2007, ch. 6; CEM part "
+        "VI, ch. 5: underlayer stones of W/10 to W/15 of the armour unit's mass W) asks the "
+        "armour's Dn / dn50 = 2.15-2.47; riprap warns outside 1.8-3.0 and refuses outside 1.3-4 "
+        "(src/riprap/placement/checks.py).",
         valid_range=_POSITIVE),
     Key("underlayer", "dn85_over_dn15", "number", "-",
         "Grading width Dn85 / Dn15 (1 = uniform).", default=1.5, valid_range=Range(minimum=1.0)),
@@ -501,8 +505,9 @@ KEYS: tuple[Key, ...] = (
         default=""),
     Key("placement", "rows", "integer", "-", "Rows of units up the face (design grid).",
         default=0, valid_range=_NON_NEGATIVE),
-    Key("placement", "units_per_row", "integer", "-", "Units in the first and every other row.",
-        default=0, valid_range=_NON_NEGATIVE),
+    Key("placement", "units_per_row", "integer", "-",
+        "Units in the first and every other row; units_per_row x the unit's Dn must fit across "
+        "the section (slope.width).", default=0, valid_range=_NON_NEGATIVE),
     Key("placement", "units_per_alternate_row", "integer", "-",
         "Units in the rows between (staggered, e.g. 11 between rows of 12); 0: the same.",
         default=0, valid_range=_NON_NEGATIVE),

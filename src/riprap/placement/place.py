@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from riprap.case.schema import default_of
+from riprap.case.schema import MAXIMUM_BODY_COUNT, default_of
 from riprap.errors import CaseFileError, OverlapError
 from riprap.placement import layer_metrics
 from riprap.placement.lowering import Surface, VerticalLowering
@@ -113,30 +113,10 @@ def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range, la
     ``run``: :class:`Simulation` settings (``end_time`` is the longest settling time).
     """
     rng = np.random.default_rng(seed)
-    shapes = [RigidShape.from_mesh(r.mesh, name=f"rock_{k}") for k, r in enumerate(rocks)]
+    shapes = rock_shapes(rocks)
     probability = np.array([r.probability for r in rocks], dtype=float)
     probability /= probability.sum()
-    radius = max(s.bounding_radius for s in shapes)
-    spacing = 2.0 * radius * (1.0 + _ROCK_LATTICE_GAP)
-    s_low, s_high = (float(v) for v in s_range)
-    n_s = int((s_high - s_low) // spacing)
-    n_y = int((slope.width - 2.0 * radius) // spacing) + 1
-    if n_s < 1 or n_y < 1:
-        raise CaseFileError(f"underlayer: the band s = {s_low:g}..{s_high:g} m of a {slope.width:g} m "
-                            f"wide face holds no rock of bounding diameter {2 * radius:.3g} m")
-    y0 = 0.5 * (slope.width - (n_y - 1) * spacing)
-    points = []
-    for layer in range(layers):
-        shift = 0.5 * spacing * (layer % 2)
-        for i in range(n_s):
-            for j in range(n_y - (layer % 2)):
-                points.append((s_low + (i + 0.5) * spacing + shift, y0 + j * spacing + shift,
-                               radius * (1.0 + _ROCK_LATTICE_GAP) + layer * spacing))
-    points = np.array(points)
-    if slope.toe_stop_distance > 0:
-        # Upper layers of the lattice lean out over the toe: keep them behind the toe stop.
-        x = slope.to_world(points[:, 0], points[:, 1], points[:, 2])[:, 0]
-        points = points[x - radius * (1.0 + _ROCK_LATTICE_GAP) > slope.toe_x - slope.toe_stop_distance]
+    points = rock_lattice(slope, shapes, s_range, layers)
     sim = Simulation(**_run_settings(run))
     for m in materials.all():
         sim.add_material(m)
@@ -159,6 +139,45 @@ def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range, la
                             top_level=0.0, summary=summary.as_dict())
     underlayer.top_level = layer_metrics.underlayer_top(slope, underlayer.node_sets())
     return underlayer
+
+
+def rock_shapes(rocks) -> list[RigidShape]:
+    """The rigid shapes of a rock library, named as the underlayer run names them."""
+    return [RigidShape.from_mesh(r.mesh, name=f"rock_{k}") for k, r in enumerate(rocks)]
+
+
+def rock_lattice(slope, shapes, s_range, layers: int) -> np.ndarray:
+    """Start points (s, y, h) of the underlayer rocks: ``layers`` staggered layers of a loose
+    lattice over the band ``s_range`` (no two bounding spheres touch). Refuses a band that holds
+    no rock, or more rocks than a case may have bodies, before building any."""
+    radius = max(shape.bounding_radius for shape in shapes)
+    spacing = 2.0 * radius * (1.0 + _ROCK_LATTICE_GAP)
+    s_low, s_high = (float(v) for v in s_range)
+    n_s = int((s_high - s_low) // spacing)
+    n_y = int((slope.width - 2.0 * radius) // spacing) + 1
+    if n_s < 1 or n_y < 1:
+        raise CaseFileError(f"underlayer: the band s = {s_low:g}..{s_high:g} m of a {slope.width:g} m "
+                            f"wide face holds no rock of bounding diameter {2 * radius:.3g} m")
+    if n_s * n_y * layers > MAXIMUM_BODY_COUNT:
+        raise CaseFileError(
+            f"underlayer: {n_s} x {n_y} rocks in each of {layers} layers on the band s = "
+            f"{s_low:g}..{s_high:g} m of a {slope.width:g} m wide face is more than the "
+            f"{MAXIMUM_BODY_COUNT:,} bodies a case may have; use larger rocks (dn50), a narrower "
+            "band (from_s, to_s) or fewer layers")
+    y0 = 0.5 * (slope.width - (n_y - 1) * spacing)
+    points = []
+    for layer in range(layers):
+        shift = 0.5 * spacing * (layer % 2)
+        for i in range(n_s):
+            for j in range(n_y - (layer % 2)):
+                points.append((s_low + (i + 0.5) * spacing + shift, y0 + j * spacing + shift,
+                               radius * (1.0 + _ROCK_LATTICE_GAP) + layer * spacing))
+    points = np.array(points)
+    if slope.toe_stop_distance > 0:
+        # Upper layers of the lattice lean out over the toe: keep them behind the toe stop.
+        x = slope.to_world(points[:, 0], points[:, 1], points[:, 2])[:, 0]
+        points = points[x - radius * (1.0 + _ROCK_LATTICE_GAP) > slope.toe_x - slope.toe_stop_distance]
+    return points
 
 
 def _stick_to_face(sim: Simulation) -> bool:
@@ -466,6 +485,14 @@ def _shift_inside_walls(slope, unit_shape, positions, orientations) -> None:
             positions[k, 1] -= y.max() - (slope.width - gap)
 
 
+def check_generated_positions(slope, unit, positions, orientations) -> None:
+    """Refuse a generated grid's unit wider than the flume, as ``place_units`` would (on a copy:
+    the run moves them itself)."""
+    unit_shape = RigidShape.from_mesh(unit.mesh, name=UNIT_SHAPE_NAME)
+    _shift_inside_walls(slope, unit_shape, np.array(positions, dtype=float),
+                        np.asarray(orientations, dtype=float))
+
+
 def check_start_positions(slope, unit, positions, orientations, *, grid_lines=None,
                           release: str = default_of("placement", "release")) -> None:
     """Refuse units of a user's grid that start outside the flume (naming unit and grid line),
@@ -493,6 +520,26 @@ def _check_inside(slope, unit_shape, positions, orientations, grid_lines, above_
                             + "\n".join(problems[:20]) + more)
 
 
+# Walls of Slope.walls that do not carry a unit: the two side walls (0 is the bed, 1 the face,
+# 4 the toe stop).
+_SIDE_WALLS = (2, 3)
+
+
+def _units_not_on_underlayer(solver, unit_bodies, n_rocks: int) -> np.ndarray:
+    """For each unit, whether it touches no underlayer rock, nor the face, the bed or the toe
+    stop: it rests on other units only (stacked on the layer instead of in it), or on nothing."""
+    contacts = solver.contacts
+    body_i, body_j = np.asarray(contacts.body_i), np.asarray(contacts.body_j)
+    on_ground = np.zeros(solver.n_bodies, dtype=bool)
+    wall = body_j < 0
+    ground_wall = wall & ~np.isin(-1 - body_j, _SIDE_WALLS)
+    on_ground[body_i[ground_wall]] = True
+    rock_pair = ~wall & ((body_i < n_rocks) | (body_j < n_rocks))
+    on_ground[body_i[rock_pair]] = True
+    on_ground[body_j[rock_pair]] = True
+    return ~on_ground[np.asarray(unit_bodies)]
+
+
 def placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies, unit_rows) -> dict:
     """The layer as designers read it (``layer_metrics``) plus what came to rest; ``unit_rows``:
     the row each unit was placed in."""
@@ -514,6 +561,7 @@ def placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies, uni
         slope, solver.positions[unit_bodies][on_face], [n for n, ok in zip(node_sets, on_face) if ok],
         rows=np.asarray(unit_rows)[on_face], nominal_diameter=dn, unit_volume=unit.volume,
         underlayer_level=underlayer.top_level)
+    not_on_underlayer = _units_not_on_underlayer(solver, unit_bodies, len(underlayer.positions))
     overlaps = [depth for i, j, depth in solver.overlaps(0.0)
                 if i in set(unit_bodies.tolist()) or j in set(unit_bodies.tolist())]
     design = unit.design
@@ -525,6 +573,7 @@ def placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies, uni
         "units_at_rest": int(at_rest.sum()),
         "units_rolled_off": [int(k) for k in np.flatnonzero(rolled_off)],
         "units_not_at_rest": [int(k) for k in np.flatnonzero(~at_rest & ~rolled_off)],
+        "units_not_on_underlayer": [int(k) for k in np.flatnonzero(not_on_underlayer & ~rolled_off)],
         **figures,
         "design_packing_density_coefficient": float(design.packing_density_coefficient),
         "design_layer_thickness_m": float(design.layers * design.layer_thickness_coefficient * dn),
