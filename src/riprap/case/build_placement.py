@@ -119,10 +119,35 @@ def prepare_placement(case) -> PlacementInputs:
                          n_shapes=ul.rock_shapes, n_size_classes=ul.size_classes, seed=ul.seed)
     # the underlayer's start lattice, as build_underlayer lays it (it refuses a band holding no
     # rock, or too many)
-    lattice = rock_lattice(slope, rock_shapes(rocks), (ul.from_s, ul.to_s or slope.length),
-                           ul.layers)
+    shapes = rock_shapes(rocks)
+    lattice = rock_lattice(slope, shapes, (ul.from_s, ul.to_s or slope.length), ul.layers)
+    units = len(grid.positions) if grid is not None else _unit_count(pl)
+    _check_work(case, materials, shapes, unit, rocks=len(lattice), units=units)
     return PlacementInputs(slope=slope, materials=materials, unit=unit, rocks=rocks, grid=grid,
                            rock_count=len(lattice))
+
+
+def _check_work(case, materials, rock_shapes, unit, *, rocks: int, units: int) -> None:
+    """The work estimates the two runs make when they start (the rocks settling, then every unit
+    moving on the fixed rocks), made now with the same time steps, so that a run of months is
+    refused before the underlayer is built."""
+    from riprap.placement.place import free_body_time_step
+    from riprap.solid.shape import RigidShape
+    from riprap.work_estimate import check_rigid_run
+
+    for end_time, shapes, material, moving in (
+            (case.underlayer.settle_time, rock_shapes, materials.rock.name, rocks),
+            (case.placement.settle_time, [RigidShape.from_mesh(unit.mesh, name=UNIT_SHAPE_NAME)],
+             materials.unit.name, units)):
+        settings = _settings(case, end_time, case.output.directory, False)
+        step = free_body_time_step(shapes, materials, material, **settings)
+        check_rigid_run(end_time=settings["end_time"], time_step=step, moving_bodies=moving)
+
+
+def _unit_count(pl) -> int:
+    """Units of a design grid: rows alternate units_per_row and units_per_alternate_row."""
+    alternate = pl.units_per_alternate_row or pl.units_per_row
+    return (pl.rows + 1) // 2 * pl.units_per_row + pl.rows // 2 * alternate
 
 
 def _check_design_grid(case, slope, unit) -> None:
@@ -136,8 +161,7 @@ def _check_design_grid(case, slope, unit) -> None:
         if getattr(pl, key) > 0:
             check_row_fits(units_per_row=getattr(pl, key), nominal_diameter=unit.nominal_diameter,
                            width=slope.width, where=case.source, key=key)
-    units = (pl.rows + 1) // 2 * pl.units_per_row + pl.rows // 2 * (pl.units_per_alternate_row
-                                                                    or pl.units_per_row)
+    units = _unit_count(pl)
     if units > MAXIMUM_BODY_COUNT:
         raise CaseFileError(f"{case.source}: [placement] rows = {pl.rows} of units_per_row = "
                             f"{pl.units_per_row} make {units:,} units, more than the "

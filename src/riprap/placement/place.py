@@ -180,6 +180,22 @@ def rock_lattice(slope, shapes, s_range, layers: int) -> np.ndarray:
     return points
 
 
+def free_body_time_step(shapes, materials: PlacementMaterials, material: str, **run) -> float:
+    """The time step a placement run of free bodies of ``shapes`` (of ``material``) starts
+    with: the one its ``Simulation`` chooses from their masses and the contact stiffness (rocks
+    held fixed do not count), found without running, for the work estimate before the runs."""
+    sim = Simulation(**_run_settings(run))
+    for m in materials.all():
+        sim.add_material(m)
+    for k, shape in enumerate(shapes):
+        sim.add_shape(shape.name, shape)
+        # far apart: only the masses and stiffness count, not where the bodies are
+        sim.add_body(shape=shape.name, material=material,
+                     position=(0.0, 0.0, 10.0 * k * (1.0 + shape.bounding_radius)))
+    sim.build_without_checks()
+    return sim.solver.time_step
+
+
 def _stick_to_face(sim: Simulation) -> bool:
     """Hold every rock that touches the face, the bed or a rock already held: the underlayer is
     built like a compacted bed, each rock staying where it first lands (loose rocks on a face
