@@ -87,20 +87,20 @@ def check_deformable_run(*, end_time: float, time_step: float, elements: int) ->
         warnings.warn(f"this run will take {figure}", RiprapWarning, stacklevel=3)
 
 
-def schedule_problems(*, end_time: float, output_interval: float,
-                      checkpoint_interval: float) -> list[tuple[str, float, str]]:
+def schedule_problems(*, end_time: float, output_interval: float, checkpoint_interval: float,
+                      end_key: str = "end_time") -> list[tuple[str, float, str]]:
     """(key of [simulation], its value, what is wrong) for each interval that would write more
-    than :data:`MAX_FRAMES` frames or :data:`MAX_CHECKPOINTS` checkpoints up to ``end_time``:
-    the run writes everything its schedule asks for, so such an interval would keep it writing
-    (or, far below the time step, counting frames) for ever."""
+    than :data:`MAX_FRAMES` frames or :data:`MAX_CHECKPOINTS` checkpoints up to ``end_time``
+    (the key ``end_key`` gives it): the run writes everything its schedule asks for, so such an
+    interval would keep it writing (or, far below the time step, counting frames) for ever."""
     problems = []
     for key, interval, most, what in (("output_interval", output_interval, MAX_FRAMES, "frames"),
                                       ("checkpoint_interval", checkpoint_interval, MAX_CHECKPOINTS,
                                        "checkpoints")):
         if interval > 0 and end_time / interval > most:
             problems.append((key, interval, (
-                f"{end_time / interval:.3g} {what} in end_time = {end_time:g} s, more than the "
-                f"{most} a run may write; set {key} >= {end_time / most:.3g} s (end_time / "
+                f"{end_time / interval:.3g} {what} in {end_key} = {end_time:g} s, more than the "
+                f"{most} a run may write; set {key} >= {end_time / most:.3g} s ({end_key} / "
                 f"{most})")))
     return problems
 

@@ -99,6 +99,17 @@ BROKEN_CASES = {
         _edit(PLACEMENT, "height = 0.5", "height = 0.025")
         .replace("dn50 = 0.2", "dn50 = 0.01").replace("width = 3.0", "width = 500.0")
         .replace("length = 6.0", "length = 500.0"), "place", ("underlayer:", "1,000,000 bodies")),
+    "deposition_of_a_million_seconds": (
+        _edit(PLACEMENT, "units_per_row = 3", "units_per_row = 3\nsettle_time = 1.0e6")
+        .replace("end_time = 1.0", "end_time = 1.0\noutput_interval = 10.0"), "place",
+        ("steps of", "9 moving bodies")),
+    "placement_frames_every_microsecond": (
+        _edit(PLACEMENT, "end_time = 1.0", "end_time = 1.0\noutput_interval = 1e-6"), "place",
+        ("simulation.output_interval = 1e-06", "in placement.settle_time = 10 s")),
+    "underlayer_settling_for_a_million_seconds": (
+        _edit(PLACEMENT, "dn50 = 0.2", "dn50 = 0.2\nsettle_time = 1.0e6")
+        .replace("end_time = 1.0", "end_time = 1.0\noutput_interval = 10.0"), "place",
+        ("steps of", "143 moving bodies")),
     "units_wider_than_the_row": (_edit(PLACEMENT, "units_per_row = 3", "units_per_row = 7"),
                                  "place", ("units_per_row = 7", "3.5 m across", "3 m wide")),
     "three_metre_units_on_small_rocks": (

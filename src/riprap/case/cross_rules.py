@@ -35,9 +35,14 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
                 "step; 0 chooses the step automatically", simulation["time_step"])
     if simulation and ok(simulation["end_time"], simulation["output_interval"],
                          simulation["checkpoint_interval"]):
+        # a placement's runs last their settle_time (the longer one counts), a run its end_time
+        ends = [(tables[name]["settle_time"], f"{name}.settle_time")
+                for name in ("underlayer", "placement")
+                if tables.get(name) is not None and ok(tables[name]["settle_time"])]
+        end_time, end_key = max(ends) if ends else (simulation["end_time"], "end_time")
         for key, value, message in schedule_problems(
-                end_time=simulation["end_time"], output_interval=simulation["output_interval"],
-                checkpoint_interval=simulation["checkpoint_interval"]):
+                end_time=end_time, output_interval=simulation["output_interval"],
+                checkpoint_interval=simulation["checkpoint_interval"], end_key=end_key):
             add(("simulation", key), message, value)
 
     for name in ("waves", "gauges", "porous_zones"):
