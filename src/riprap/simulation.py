@@ -343,7 +343,8 @@ class Simulation:
             step = min(step, solver.time_step)
             solver.set_time_step(step)
         system.time_step = step
-        check_deformable_run(end_time=self.end_time, time_step=step, elements=len(system.elements))
+        check_deformable_run(end_time=self.end_time, time_step=step, elements=len(system.elements),
+                             rigid_bodies=int((~solver.fixed).sum()) if solver.n_bodies else 0)
         return DeformableModel(system, rigid=self if solver.n_bodies > 0 else None,
                                case_numbers=self._case_numbers(),
                                accepted_depths=self.deformable_accepted_depths)
@@ -425,9 +426,25 @@ class Simulation:
             return
         self.build_without_checks()
         check_rigid_run(end_time=self.end_time, time_step=solver.time_step,
-                        moving_bodies=int((~solver.fixed).sum()), start_time=solver.time)
+                        moving_bodies=int((~solver.fixed).sum()), start_time=solver.time,
+                        setting_the_step=self._body_setting_the_step())
         if not self._restarted:
             self.check_start_overlaps()
+
+    def _body_setting_the_step(self, numbered: bool = True) -> str:
+        """The body whose mass and contact stiffness chose the automatic time step, in words
+        (with its number when ``numbered``); "" for a step the user gave."""
+        if self.requested_time_step > 0:
+            return ""
+        solver = self.solver
+        steps = solver.critical_time_steps()
+        if not np.isfinite(steps).any():
+            return ""
+        body = int(np.argmin(steps))
+        shape = solver.shapes[int(solver.shape_index[body])]
+        return ((f"body {body}, " if numbered else "")
+                + f"shape '{shape.name}', Dn = {shape.volume ** (1 / 3):.3g} m, "
+                f"{solver.masses[body]:.3g} kg")
 
     def check_start_overlaps(self) -> None:
         """Refuse bodies that overlap at the start (beyond the accepted resting contacts of a

@@ -55,28 +55,35 @@ def _duration(seconds: float) -> str:
 
 
 def check_rigid_run(*, end_time: float, time_step: float, moving_bodies: int,
-                    start_time: float = 0.0) -> None:
-    """Refuse (or warn about) a rigid run of ``(end_time - start_time) / time_step`` steps."""
+                    start_time: float = 0.0, setting_the_step: str = "",
+                    end_key: str = "end_time") -> None:
+    """Refuse (or warn about) a rigid run of ``(end_time - start_time) / time_step`` steps;
+    ``setting_the_step`` names the body whose mass and stiffness chose the step, if known."""
     steps = max(end_time - start_time, 0.0) / time_step
     seconds = steps * max(moving_bodies, 1) / RIGID_BODY_STEPS_PER_SECOND
     figure = (f"{steps:.3g} steps of {time_step:.3g} s for {end_time - start_time:.3g} s of "
               f"simulated time with {moving_bodies} moving bodies: about {_duration(seconds)} at "
               f"{RIGID_BODY_STEPS_PER_SECOND:.0e} body-steps/s")
     if steps > REFUSE_STEPS or seconds > REFUSE_WALL_SECONDS:
+        which = f" ({setting_the_step})" if setting_the_step else ""
         raise WorkTooLargeError(
-            f"the run would take {figure}. The time step comes from the smallest, lightest body "
-            "and the contact stiffness: check the sizes (in metres), densities and contact_penalty, "
-            "or shorten end_time")
+            f"the run would take {figure}. The time step comes from the smallest, lightest "
+            f"body{which} and the contact stiffness: check the sizes (in metres), densities and "
+            f"contact_penalty, or shorten {end_key}")
     if seconds > WARN_WALL_SECONDS:
         warnings.warn(f"this run will take {figure}", RiprapWarning, stacklevel=3)
 
 
-def check_deformable_run(*, end_time: float, time_step: float, elements: int) -> None:
-    """Refuse (or warn about) ``end_time / time_step`` steps of ``elements`` finite elements."""
+def check_deformable_run(*, end_time: float, time_step: float, elements: int,
+                         rigid_bodies: int = 0) -> None:
+    """Refuse (or warn about) ``end_time / time_step`` steps of ``elements`` finite elements
+    (and of ``rigid_bodies`` moving rigid bodies stepped with them)."""
     steps = max(end_time, 0.0) / time_step
-    seconds = steps * max(elements, 1) / DEFORMABLE_ELEMENT_STEPS_PER_SECOND
+    seconds = steps * (max(elements, 1) / DEFORMABLE_ELEMENT_STEPS_PER_SECOND
+                       + rigid_bodies / RIGID_BODY_STEPS_PER_SECOND)
+    rigid = f" and {rigid_bodies} moving rigid bodies" if rigid_bodies else ""
     figure = (f"{steps:.3g} steps of {time_step:.3g} s for {end_time:.3g} s of simulated time with "
-              f"{elements} elements: about {_duration(seconds)} at "
+              f"{elements} elements{rigid}: about {_duration(seconds)} at "
               f"{DEFORMABLE_ELEMENT_STEPS_PER_SECOND:.0e} element-steps/s")
     if steps > REFUSE_STEPS or seconds > REFUSE_WALL_SECONDS:
         raise WorkTooLargeError(

@@ -135,13 +135,14 @@ def _check_work(case, materials, rock_shapes, unit, *, rocks: int, units: int) -
     from riprap.solid.shape import RigidShape
     from riprap.work_estimate import check_rigid_run
 
-    for end_time, shapes, material, moving in (
-            (case.underlayer.settle_time, rock_shapes, materials.rock.name, rocks),
-            (case.placement.settle_time, [RigidShape.from_mesh(unit.mesh, name=UNIT_SHAPE_NAME)],
+    for table, shapes, material, moving in (
+            ("underlayer", rock_shapes, materials.rock.name, rocks),
+            ("placement", [RigidShape.from_mesh(unit.mesh, name=UNIT_SHAPE_NAME)],
              materials.unit.name, units)):
-        settings = _settings(case, end_time, case.output.directory, False)
-        step = free_body_time_step(shapes, materials, material, **settings)
-        check_rigid_run(end_time=settings["end_time"], time_step=step, moving_bodies=moving)
+        settings = _settings(case, getattr(case, table).settle_time, case.output.directory, False)
+        step, setting = free_body_time_step(shapes, materials, material, **settings)
+        check_rigid_run(end_time=settings["end_time"], time_step=step, moving_bodies=moving,
+                        setting_the_step=setting, end_key=f"[{table}] settle_time")
 
 
 def _unit_count(pl) -> int:

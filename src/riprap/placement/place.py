@@ -180,10 +180,12 @@ def rock_lattice(slope, shapes, s_range, layers: int) -> np.ndarray:
     return points
 
 
-def free_body_time_step(shapes, materials: PlacementMaterials, material: str, **run) -> float:
+def free_body_time_step(shapes, materials: PlacementMaterials, material: str,
+                        **run) -> tuple[float, str]:
     """The time step a placement run of free bodies of ``shapes`` (of ``material``) starts
     with: the one its ``Simulation`` chooses from their masses and the contact stiffness (rocks
-    held fixed do not count), found without running, for the work estimate before the runs."""
+    held fixed do not count), found without running, for the work estimate before the runs;
+    with the shape that sets it, in words."""
     sim = Simulation(**_run_settings(run))
     for m in materials.all():
         sim.add_material(m)
@@ -193,7 +195,7 @@ def free_body_time_step(shapes, materials: PlacementMaterials, material: str, **
         sim.add_body(shape=shape.name, material=material,
                      position=(0.0, 0.0, 10.0 * k * (1.0 + shape.bounding_radius)))
     sim.build_without_checks()
-    return sim.solver.time_step
+    return sim.solver.time_step, sim._body_setting_the_step(numbered=False)
 
 
 def _stick_to_face(sim: Simulation) -> bool:

@@ -240,9 +240,18 @@ class SolidSolver:
         check Delta t <= 0.2 * 2 sqrt(m/k) follows the Y3D practice summarised in
         shared/research/munjiza.md.
         """
+        steps = self.critical_time_steps()
+        best = float(steps.min(initial=np.inf))
+        if not np.isfinite(best):
+            best = 1e-3
+        return safety * best
+
+    def critical_time_steps(self) -> np.ndarray:
+        """Per body, the critical step 2 sqrt(m / k) of :meth:`stable_time_step` (inf for fixed
+        bodies): the smallest names the body that sets the run's step."""
         if not self._ready:
             self._build_arrays()
-        best = np.inf
+        steps = np.full(len(self.shape_index), np.inf)
         for b in range(len(self.shape_index)):
             if self.fixed[b]:
                 continue
@@ -251,10 +260,8 @@ class SolidSolver:
             stiffness = 2.0 * penalty * shape.volume ** (2.0 / 3.0) / shape.min_subtet_height
             rotational_mass = self.principal_inertia[b].min() / shape.bounding_radius ** 2
             mass = min(self.masses[b], rotational_mass)
-            best = min(best, 2.0 * np.sqrt(mass / stiffness))
-        if not np.isfinite(best):
-            best = 1e-3
-        return safety * best
+            steps[b] = 2.0 * np.sqrt(mass / stiffness)
+        return steps
 
     def _common_arguments(self):
         return (self.masses, self.inverse_masses, self.inverse_principal_inertia, self.fixed,
