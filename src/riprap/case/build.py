@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from riprap.case.body_start import check_body_starts, shape_radius
 from riprap.errors import RiprapError
 from riprap.geometry import shapes as builtin_shapes
 from riprap.geometry.armour_units import armour_unit
@@ -80,6 +81,7 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
         sim.case_file = str(Path(case.source).resolve())
     for m in case.materials:
         sim.add_material(build_material(m))
+    radii = {}
     for spec in case.shapes:
         try:
             mesh = build_shape(spec)
@@ -87,6 +89,8 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
             # The shape builders name the key and value; the case file names the entry.
             raise type(error)(f"{case.source}: [[shapes]] '{spec.name}': {error}") from None
         sim.add_shape(spec.name, mesh)
+        radii[spec.name] = shape_radius(mesh)
+    check_body_starts(case, radii.__getitem__)
     place = _BodyPlacer(sim, case)
     for body in case.bodies:
         place(shape=body.shape, material=body.material, position=body.position,
