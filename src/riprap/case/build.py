@@ -4,6 +4,7 @@ Everything here is available from Python too: the case file and the API use the 
 """
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -171,12 +172,18 @@ class _BodyPlacer:
         for key, hint in hints.items():
             if not getattr(spec, key) > 0:
                 raise RiprapError(f"{where} needs {key} > 0 ({hint}); it is {getattr(spec, key)!r}")
+        penalty = spec.joint_penalty or 10.0 * spec.young_modulus
+        if not math.isfinite(penalty):
+            raise RiprapError(f"{self.case.source}: [deformable] young_modulus = "
+                              f"{spec.young_modulus:g} Pa makes the default joint_penalty (10 "
+                              "young_modulus per metre) infinite; give young_modulus in Pa "
+                              "(concrete about 3e10)")
         return JointMaterial(
             tensile_strength=spec.tensile_strength, cohesion=spec.cohesion,
             friction_angle=spec.friction_angle,
             fracture_energy_mode_i=spec.fracture_energy_mode_i,
             fracture_energy_mode_ii=spec.fracture_energy_mode_ii,
-            joint_penalty=spec.joint_penalty or 10.0 * spec.young_modulus)
+            joint_penalty=penalty)
 
     def __call__(self, *, shape, material, position, orientation=(1.0, 0.0, 0.0, 0.0),
                  velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0), fixed=False) -> None:
