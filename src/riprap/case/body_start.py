@@ -25,7 +25,7 @@ START_SPEED_LIMIT = 100.0
 
 def check_coordinates(where: str, key: str, values) -> None:
     """Refuse a coordinate beyond ``LARGEST_COORDINATE``; ``where`` names the file and entry."""
-    values = np.asarray(values, dtype=float).reshape(-1)
+    values = np.asarray(values, dtype=float)
     largest = float(np.abs(values).max(initial=0.0))
     if not largest <= LARGEST_COORDINATE:
         raise CaseFileError(f"{where}: {key} = {_listed(values)} m reaches {largest:.3g} m from "
@@ -75,8 +75,11 @@ def _check_speed(where: str, key: str, vector) -> None:
 
 
 def _listed(values) -> str:
-    """A vector as the user typed it: [0, 0, 1e+308], not numpy's repr."""
-    return "[" + ", ".join(f"{float(v):g}" for v in np.asarray(values).reshape(-1)) + "]"
+    """A vector (or a list of points) as the user typed it: [0, 0, 1e+308], not numpy's repr."""
+    values = np.asarray(values, dtype=float)
+    if values.ndim > 1:
+        return "[" + ", ".join(_listed(row) for row in values) + "]"
+    return "[" + ", ".join(f"{float(v):g}" for v in values.reshape(-1)) + "]"
 
 
 def shape_radius(mesh) -> float:

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from riprap.case.body_start import check_body_starts, shape_radius
+from riprap.case.body_start import check_body_starts, check_coordinates, shape_radius
 from riprap.errors import RiprapError
 from riprap.geometry import shapes as builtin_shapes
 from riprap.geometry.armour_units import armour_unit
@@ -113,7 +113,11 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
 
 def add_case_walls(sim: Simulation, case) -> None:
     """The ``[[walls]]`` of ``case``."""
-    for wall in case.walls:
+    for number, wall in enumerate(case.walls):
+        where = f"{case.source} [[walls]] entry {number + 1}"
+        for key in ("point", "min", "max"):
+            if key in wall.parameters:
+                check_coordinates(where, key, wall.parameters[key])
         if wall.type == "plane":
             sim.add_walls(wall_builders.plane(point=wall.parameters["point"],
                                               normal=wall.parameters["normal"],

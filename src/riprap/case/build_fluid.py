@@ -19,6 +19,7 @@ def build_fluid_solver(case) -> FluidSolver:
     if spec is None:
         raise CaseFileError(f"{case.source}: no [fluid] table")
     where = f"{case.source} [fluid]"
+    _check_fluid_coordinates(case)
     try:
         grid = FluidGrid(lower=spec.lower, upper=spec.upper, cells=spec.cells,
                          boundaries={side: getattr(spec, side) for side in SIDES})
@@ -57,6 +58,22 @@ def build_fluid_solver(case) -> FluidSolver:
                             "the [[water_regions]] (or the regions hold less than a cell of water); "
                             "move the obstacles or the water")
     return solver
+
+
+def _check_fluid_coordinates(case) -> None:
+    """Every coordinate of the fluid box, its water, obstacles, porous zones and gauges within
+    riprap.case.body_start.LARGEST_COORDINATE: a box reaching 1e308 m overflows its cell size."""
+    from riprap.case.body_start import check_coordinates
+
+    check_coordinates(f"{case.source} [fluid]", "lower", case.fluid.lower)
+    check_coordinates(f"{case.source} [fluid]", "upper", case.fluid.upper)
+    for table, entries in (("water_regions", case.water_regions), ("obstacles", case.obstacles),
+                           ("porous_zones", case.porous_zones), ("gauges", case.gauges)):
+        for number, entry in enumerate(entries):
+            for key in ("level", "lower", "upper", "points", "position", "to_x"):
+                value = entry.parameters.get(key)
+                if value is not None:
+                    check_coordinates(f"{case.source} [[{table}]] entry {number + 1}", key, value)
 
 
 def _add_porous_zones(case, solver) -> None:

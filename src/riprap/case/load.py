@@ -811,12 +811,12 @@ class _Validator:
                     return _INVALID, f"{detail} at item {number}"
                 items.append(converted)
         if kind == "quaternion":
-            norm = math.sqrt(sum(item * item for item in items))
+            norm = math.hypot(*items)      # not sqrt(sum of squares): 1e308 squared overflows
             if norm < schema.MINIMUM_QUATERNION_NORM:
                 return _INVALID, f"a quaternion of norm {norm:.3g}"
             items = [item / norm for item in items]
         if kind == "direction":
-            norm = math.sqrt(sum(item * item for item in items))
+            norm = math.hypot(*items)
             if norm < schema.MINIMUM_DIRECTION_NORM:
                 return _INVALID, "the zero vector"
             items = [item / norm for item in items]

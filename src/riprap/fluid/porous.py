@@ -138,6 +138,10 @@ class PorousMedium:
             porosity = porosity * (1.0 - cover) + cover * n
             linear = linear * (1.0 - cover) + cover * zone.linear * (1.0 - n) ** 3 / (n ** 3 * d * d)
             quadratic = quadratic * (1.0 - cover) + cover * zone.quadratic * (1.0 - n) / (n ** 3 * d)
+            if not (np.isfinite(linear).all() and np.isfinite(quadratic).all()):
+                raise CaseFileError(f"{zone.name}: stone_diameter = {d:g} m with porosity = {n:g} "
+                                    "makes the friction of the zone infinite; give stone_diameter "
+                                    "in metres")
             added = added * (1.0 - cover) + cover * zone.added_mass
         self.porosity = porosity
         self.minimum_porosity = float(porosity.min())
