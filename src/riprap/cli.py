@@ -20,7 +20,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from riprap.errors import CaseFileError, RiprapError
+from riprap.errors import CaseFileError, RiprapError, plain_numbers
 
 
 def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> int:
@@ -239,7 +239,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
     from riprap.work_estimate import RiprapWarning
 
     if issubclass(category, RiprapWarning):
-        print(f"riprap: warning: {message}", file=sys.stderr)
+        print(f"riprap: warning: {plain_numbers(str(message))}", file=sys.stderr)
     elif not issubclass(category, RuntimeWarning):
         print(f"riprap: warning ({category.__name__}): {message}", file=sys.stderr)
 

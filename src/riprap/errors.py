@@ -1,8 +1,30 @@
 """Named errors. Every message says what is wrong, where (file, line, key, body) and what to do."""
 
 
+import re
+
+# numpy's reprs of scalars and small arrays, as an f-string's {value!r} or a tuple of numpy values
+# writes them (np.float64(0.28), np.True_, array([0., 1.])): shown as the user typed the numbers.
+_NUMPY_SCALAR = re.compile(r"np\.(?:float|int|uint|complex)\d*\(([^()]*)\)")
+_NUMPY_BOOL = re.compile(r"np\.(True|False)_")
+_NUMPY_STRING = re.compile(r"np\.str_\(('[^']*'|\"[^\"]*\")\)")
+_NUMPY_ARRAY = re.compile(r"array\((\[[^()]*\])(?:, dtype=\w+)?\)")
+
+
+def plain_numbers(text: str) -> str:
+    """``text`` with numpy's reprs of numbers replaced by the numbers: np.float64(0.28) -> 0.28."""
+    text = _NUMPY_SCALAR.sub(r"\1", text)
+    text = _NUMPY_BOOL.sub(r"\1", text)
+    text = _NUMPY_STRING.sub(r"\1", text)
+    return _NUMPY_ARRAY.sub(r"\1", text)
+
+
 class RiprapError(Exception):
-    """Base class of every error riprap raises on purpose."""
+    """Base class of every error riprap raises on purpose. Its text never shows numpy's reprs
+    (``np.float64(0.28)``), whichever message formatted a numpy value with ``!r``."""
+
+    def __str__(self) -> str:
+        return plain_numbers(super().__str__())
 
 
 class CaseFileError(RiprapError):

@@ -4,12 +4,14 @@ Everything here is available from Python too: the case file and the API use the 
 """
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from riprap.case.body_start import check_body_starts, check_coordinates, shape_radius
 from riprap.errors import RiprapError
 from riprap.geometry import shapes as builtin_shapes
 from riprap.geometry.armour_units import armour_unit
@@ -80,6 +82,7 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
         sim.case_file = str(Path(case.source).resolve())
     for m in case.materials:
         sim.add_material(build_material(m))
+    radii = {}
     for spec in case.shapes:
         try:
             mesh = build_shape(spec)
@@ -87,6 +90,8 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
             # The shape builders name the key and value; the case file names the entry.
             raise type(error)(f"{case.source}: [[shapes]] '{spec.name}': {error}") from None
         sim.add_shape(spec.name, mesh)
+        radii[spec.name] = shape_radius(mesh)
+    check_body_starts(case, radii.__getitem__)
     place = _BodyPlacer(sim, case)
     for body in case.bodies:
         place(shape=body.shape, material=body.material, position=body.position,
@@ -108,7 +113,11 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
 
 def add_case_walls(sim: Simulation, case) -> None:
     """The ``[[walls]]`` of ``case``."""
-    for wall in case.walls:
+    for number, wall in enumerate(case.walls):
+        where = f"{case.source} [[walls]] entry {number + 1}"
+        for key in ("point", "min", "max"):
+            if key in wall.parameters:
+                check_coordinates(where, key, wall.parameters[key])
         if wall.type == "plane":
             sim.add_walls(wall_builders.plane(point=wall.parameters["point"],
                                               normal=wall.parameters["normal"],
@@ -167,12 +176,18 @@ class _BodyPlacer:
         for key, hint in hints.items():
             if not getattr(spec, key) > 0:
                 raise RiprapError(f"{where} needs {key} > 0 ({hint}); it is {getattr(spec, key)!r}")
+        penalty = spec.joint_penalty or 10.0 * spec.young_modulus
+        if not math.isfinite(penalty):
+            raise RiprapError(f"{self.case.source}: [deformable] young_modulus = "
+                              f"{spec.young_modulus:g} Pa makes the default joint_penalty (10 "
+                              "young_modulus per metre) infinite; give young_modulus in Pa "
+                              "(concrete about 3e10)")
         return JointMaterial(
             tensile_strength=spec.tensile_strength, cohesion=spec.cohesion,
             friction_angle=spec.friction_angle,
             fracture_energy_mode_i=spec.fracture_energy_mode_i,
             fracture_energy_mode_ii=spec.fracture_energy_mode_ii,
-            joint_penalty=spec.joint_penalty or 10.0 * spec.young_modulus)
+            joint_penalty=penalty)
 
     def __call__(self, *, shape, material, position, orientation=(1.0, 0.0, 0.0, 0.0),
                  velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0), fixed=False) -> None:

@@ -19,6 +19,7 @@ def build_fluid_solver(case) -> FluidSolver:
     if spec is None:
         raise CaseFileError(f"{case.source}: no [fluid] table")
     where = f"{case.source} [fluid]"
+    _check_fluid_coordinates(case)
     try:
         grid = FluidGrid(lower=spec.lower, upper=spec.upper, cells=spec.cells,
                          boundaries={side: getattr(spec, side) for side in SIDES})
@@ -59,6 +60,22 @@ def build_fluid_solver(case) -> FluidSolver:
     return solver
 
 
+def _check_fluid_coordinates(case) -> None:
+    """Every coordinate of the fluid box, its water, obstacles, porous zones and gauges within
+    riprap.case.body_start.LARGEST_COORDINATE: a box reaching 1e308 m overflows its cell size."""
+    from riprap.case.body_start import check_coordinates
+
+    check_coordinates(f"{case.source} [fluid]", "lower", case.fluid.lower)
+    check_coordinates(f"{case.source} [fluid]", "upper", case.fluid.upper)
+    for table, entries in (("water_regions", case.water_regions), ("obstacles", case.obstacles),
+                           ("porous_zones", case.porous_zones), ("gauges", case.gauges)):
+        for number, entry in enumerate(entries):
+            for key in ("level", "lower", "upper", "points", "position", "to_x"):
+                value = entry.parameters.get(key)
+                if value is not None:
+                    check_coordinates(f"{case.source} [[{table}]] entry {number + 1}", key, value)
+
+
 def _add_porous_zones(case, solver) -> None:
     from riprap.fluid.porous import PorousZone
 
@@ -74,6 +91,28 @@ def _add_porous_zones(case, solver) -> None:
     solver.add_porous_zones(zones)
 
 
+def _check_bodies_not_too_light(case) -> None:
+    """Refuse a free body far lighter than the water: the coupling holds the fluid's load over a
+    step, which a body much lighter than the water it displaces cannot carry (it sinks where it
+    should rise; riprap.coupling.coupled.MINIMUM_DENSITY_RATIO)."""
+    from riprap.coupling.coupled import MINIMUM_DENSITY_RATIO
+
+    water = case.fluid.water_density
+    entries = [(f"[[bodies]] entry {n + 1}", body.material)
+               for n, body in enumerate(case.bodies) if not body.fixed]
+    entries += [(f"[[body_grids]] entry {n + 1}", grid.material)
+                for n, grid in enumerate(case.body_grids)]
+    for entry, name in entries:
+        density = case.material(name).density
+        if density < MINIMUM_DENSITY_RATIO * water:
+            raise CaseFileError(
+                f"{case.source}: [[materials]] '{name}' (used by {entry}) has density = "
+                f"{density:g} kg/m^3, {density / water:.3g} of the water's {water:g} kg/m^3; the "
+                f"coupling to the flow carries free bodies down to {MINIMUM_DENSITY_RATIO:g} of "
+                "it (a lighter one sinks where it should float): give the material's density in "
+                "kg/m^3, or make the body fixed")
+
+
 def build_fluid_run(case, *, output_directory=None, progress: bool = True):
     """The run of ``case``: its fluid alone, or, with bodies, the bodies moving in the flow and
     pushing it (two-way coupling, ``docs/coupling.md``); a :class:`riprap.simulation.Simulation`
@@ -85,6 +124,7 @@ def build_fluid_run(case, *, output_directory=None, progress: bool = True):
 
     fluid = build_fluid_solver(case)
     if case.body_count > 0:
+        _check_bodies_not_too_light(case)
         simulation = build_simulation(case, output_directory=output_directory, progress=progress)
         simulation.add_fluid(fluid)
         simulation.prepare()

@@ -2,6 +2,8 @@
 or the boundary) and the absorbing zone, the wave they make, the gauges; and the checks that the flume can carry those waves (``riprap.waves.checks``)."""
 from __future__ import annotations
 
+import numpy as np
+
 from riprap.errors import CaseFileError
 from riprap.waves.boundary_generation import BoundaryWaveMaker
 from riprap.waves.checks import check_flume
@@ -14,6 +16,9 @@ __all__ = ["build_waves", "wave_of"]
 # An absorption zone of this many wave lengths when the case gives none (docs/waves.md: measured
 # reflection against zone length).
 DEFAULT_ABSORPTION_WAVE_LENGTHS = 2.0
+# The water the [[water_regions]] put at the wave maker may differ from [waves] still_water_level
+# by this share of a cell: round-off of the cell fractions, not a mistake.
+_LEVEL_TOLERANCE_CELLS = 0.25
 
 
 def wave_of(spec, depth: float, end_time: float, gravity: float):
@@ -70,6 +75,8 @@ def build_waves(case, solver) -> None:
         if spec.absorbing_end:
             zones.append(RelaxationZone(ABSORPTION, x_high - absorption, x_high))
         check_flume(wave, solver.h, zones, where=where)
+        _check_porous_zones_clear_of_the_wave_maker(case, solver, x_low + generation, boundary)
+        _check_water_level_at_the_zones(case, solver, level, spec.absorbing_end)
         ramp_time = spec.ramp_periods * wave.period
         if boundary:
             maker = BoundaryWaveMaker(wave, level, ramp_time=ramp_time,
@@ -100,3 +107,59 @@ def build_waves(case, solver) -> None:
         except CaseFileError as error:
             raise CaseFileError(f"{case.source} [[gauges]]: {error}") from None
         solver.gauges = gauges
+
+
+def _check_porous_zones_clear_of_the_wave_maker(case, solver, maker_end: float,
+                                                boundary: bool) -> None:
+    """No porous zone over the wave maker: its relaxation zone (x_low .. ``maker_end``) or the
+    cells of the boundary's wave-making faces. The maker prescribes the flow of open water there;
+    in a porous zone it would drive the filtration velocity as if it were the water's."""
+    if solver.porous is None:
+        return
+    grid = solver.grid
+    centres = grid.centres(0)
+    columns = np.zeros(len(centres), dtype=bool)
+    columns[0] = True                    # the boundary's faces: the first column of cells
+    if not boundary:
+        columns |= centres - 0.5 * solver.h < maker_end
+    maker = ("the wave-making boundary's cells" if boundary else
+             f"the generation zone ({grid.lower[0]:g} .. {maker_end:.4g} m along x)")
+    for number, (spec, zone) in enumerate(zip(case.porous_zones, solver.porous.zones)):
+        cover = zone.cover(grid)[columns]
+        if cover.any():
+            x = float(centres[columns][np.flatnonzero(cover.any(axis=(1, 2)))[0]])
+            raise CaseFileError(
+                f"{case.source} [[porous_zones]] entry {number + 1} ({spec.type}) reaches over "
+                f"{maker} (at x = {x:.4g} m): the wave maker needs open water; move the zone "
+                f"away from x = {grid.lower[0]:g} m or lengthen the flume in front of it")
+
+
+def _check_water_level_at_the_zones(case, solver, level: float, absorbing_end: bool) -> None:
+    """The [[water_regions]] must put the water surface at the wave maker (and at an absorbing
+    end) at [waves] still_water_level: the maker and the absorber hold the water there at that
+    level, so any difference would appear or vanish as water in the first step."""
+    grid = solver.grid
+    h = solver.h
+    tolerance = _LEVEL_TOLERANCE_CELLS * h
+    ends = [(0, f"the wave maker (x = {grid.lower[0]:g} m)")]
+    if absorbing_end:
+        ends.append((-1, f"the absorbing end (x = {grid.upper[0]:g} m)"))
+    for column, place in ends:
+        fraction = solver.fraction[column]                       # (ny, nz)
+        surface = grid.lower[2] + float(fraction.sum(axis=1).mean()) * h
+        if abs(surface - level) <= tolerance:
+            continue
+        x = grid.lower[0] if column == 0 else grid.upper[0]
+        sources = [f"entry {number + 1} level = {region.parameters['level']:g} m"
+                   if region.type == "level" else
+                   f"entry {number + 1} upper z = {region.parameters['upper'][2]:g} m"
+                   for number, region in enumerate(case.water_regions)
+                   if region.type == "level"
+                   or region.parameters["lower"][0] - h <= x <= region.parameters["upper"][0] + h]
+        made_by = f" ({'; '.join(sources)})" if sources else " (no entry reaches it)"
+        raise CaseFileError(
+            f"{case.source} [waves] still_water_level = {level:g} m, but the [[water_regions]]"
+            f"{made_by} put the water surface at {place} at {surface:.4g} m: the waves would add "
+            f"or remove the {abs(surface - level):.3g} m between them in the first step; make "
+            f"the two levels equal (within {_LEVEL_TOLERANCE_CELLS:g} of a cell, "
+            f"{tolerance:.3g} m)")

@@ -820,12 +820,12 @@ class _Validator:
                     return _INVALID, f"{detail} at item {number}"
                 items.append(converted)
         if kind == "quaternion":
-            norm = math.sqrt(sum(item * item for item in items))
+            norm = math.hypot(*items)      # not sqrt(sum of squares): 1e308 squared overflows
             if norm < schema.MINIMUM_QUATERNION_NORM:
                 return _INVALID, f"a quaternion of norm {norm:.3g}"
             items = [item / norm for item in items]
         if kind == "direction":
-            norm = math.sqrt(sum(item * item for item in items))
+            norm = math.hypot(*items)
             if norm < schema.MINIMUM_DIRECTION_NORM:
                 return _INVALID, "the zero vector"
             items = [item / norm for item in items]
@@ -1127,13 +1127,38 @@ class _Validator:
         return case
 
 
+#: The case files whose ``pack`` is being loaded, outermost first: a pack that includes itself,
+#: directly or through other packs, is refused with this chain instead of recursing without end.
+_PACKS_BEING_INCLUDED: list[Path] = []
+
+
 def _with_pack(case: Case, pack_path) -> Case:
     """``case`` with the pack's materials, shapes, bodies and walls first, and its contact history
     unless the case names one (the history's body and wall numbers are the pack's, which stay
     first)."""
     import dataclasses
 
-    pack = load_case(pack_path)
+    from riprap.io.pack import PACK_HEADER
+
+    including = Path(case.source).resolve()
+    chain = _PACKS_BEING_INCLUDED + [including]
+    if Path(pack_path).resolve() in chain:
+        start = chain.index(Path(pack_path).resolve())
+        files = " -> ".join(str(path) for path in chain[start:] + [Path(pack_path).resolve()])
+        raise CaseFileError(f"{case.source}: pack = {str(pack_path)!r} includes itself through "
+                            f"the chain {files}; a pack written by riprap place includes no "
+                            "other pack: remove the 'pack' key from the included file")
+    first_line = read_case_text(pack_path).split("\n", 1)[0]
+    if not first_line.startswith(PACK_HEADER):
+        raise CaseFileError(f"{case.source}: pack = {str(pack_path)!r} is not a pack written by "
+                            f"riprap place (its first line does not begin {PACK_HEADER!r}); name "
+                            "the pack.toml that 'riprap place CASE --out DIR' wrote in DIR, or "
+                            "copy this file's tables into the case instead of including it")
+    _PACKS_BEING_INCLUDED.append(including)
+    try:
+        pack = load_case(pack_path)
+    finally:
+        _PACKS_BEING_INCLUDED.pop()
     if pack.is_fluid or pack.is_placement:
         raise CaseFileError(f"{case.source}: pack = {str(pack_path)!r} is not a pack of bodies "
                             "(it has [fluid] or [placement])")

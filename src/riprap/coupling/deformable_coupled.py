@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-from riprap.coupling.coupled import MINIMUM_CELLS_ACROSS, CoupledSolver
+from riprap.coupling.coupled import MINIMUM_CELLS_ACROSS, CoupledSolver, check_substeps
 from riprap.coupling.solid_volumes import half_cell_volumes, rigid_body_half_cell_volumes
 from riprap.deformable.elements import boundary_face_nodes, boundary_faces_with_owners
 from riprap.errors import CaseFileError
@@ -533,6 +533,7 @@ class DeformableCoupledSolver(CoupledSolver):
         bodies.apply_fluid_loads(self.fluid_loads, self.fluid.pressure, self._lower, self.fluid.h,
                                  self._reference_pressure(), duration=dt)
         substeps = max(1, math.ceil(dt / self.solid_time_step - 1e-9))
+        check_substeps(substeps, dt, self.solid_time_step)
         system, every, done = bodies.system, self.steps_between_calls, 0
         while done < substeps:
             chunk = min(substeps - done, every - system.step_count % every)

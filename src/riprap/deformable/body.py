@@ -268,4 +268,6 @@ def stable_step_for(omega_max: float, viscous_time_constant: float, mass_damping
     if omega_max <= 0:
         return np.inf
     xi = mass_damping / (2.0 * omega_max) + viscous_time_constant * omega_max / 2.0
-    return 2.0 / omega_max * (math.sqrt(1.0 + xi * xi) - xi)
+    # sqrt(1 + xi^2) - xi written as 1 / (sqrt(1 + xi^2) + xi): no cancellation to 0 (or inf - inf
+    # = nan) when the damping is large
+    return 2.0 / omega_max / (math.hypot(1.0, xi) + xi)

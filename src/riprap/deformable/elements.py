@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from riprap.errors import MeshError
+from riprap.errors import CaseFileError, MeshError
 
 ELEMENT_TYPES = ("tet4", "tet10")
 
@@ -134,6 +134,13 @@ class ElementSet:
             mass = material.density * self.volumes[start:stop, None] * shares[None, :]
             inverse_root = 1.0 / np.sqrt(np.repeat(mass, 3, axis=1))
             scaled = stiffness * inverse_root[:, :, None] * inverse_root[:, None, :]
+            if not np.isfinite(scaled).all():
+                raise CaseFileError(
+                    f"[deformable] young_modulus = {material.young_modulus:g} Pa with density = "
+                    f"{material.density:g} kg/m^3 overflows the stiffness over the mass of elements "
+                    f"of {float(np.cbrt(self.volumes.min())):.3g} m: no element frequency (and so "
+                    "no time step) follows; give young_modulus in Pa (concrete about 3e10) and "
+                    "density in kg/m^3")
             result[start:stop] = np.sqrt(np.maximum(np.linalg.eigvalsh(scaled)[:, -1], 0.0))
         return result
 

@@ -465,9 +465,42 @@ class DeformableSystem:
         stiffness = self.contact_penalty * node_area * 2.0 / heights[node_body]
         omega_contact = float(np.sqrt(stiffness / self.masses[:self.n_deformable_nodes]).max())
         damping = max(b.material.viscous_time_constant for b in self.bodies)
-        self._stable_time_step = stable_step_for(math.hypot(omega_elements, omega_contact), damping,
-                                                 self.mass_damping)
+        step = stable_step_for(math.hypot(omega_elements, omega_contact), damping,
+                               self.mass_damping)
+        if not (math.isfinite(step) and step > 0.0):
+            raise CaseFileError(self._unstable_step_cause(step, omega_elements, omega_contact,
+                                                          damping))
+        self._stable_time_step = step
         return self._stable_time_step
+
+    def _unstable_step_cause(self, step: float, omega_elements: float, omega_contact: float,
+                             damping: float) -> str:
+        """Which [deformable] key made the stable step ``step`` zero, infinite or not a number."""
+        omega = math.hypot(omega_elements, omega_contact)
+        joints = [b.joint_frequency() for b in self.bodies if hasattr(b, "joint_frequency")]
+        material = self.bodies[0].material
+        if joints and not math.isfinite(max(joints)):
+            penalty = self.bodies[[hasattr(b, "joint_frequency") for b in self.bodies].index(True)
+                                  ].joint_material.joint_penalty
+            cause = f"joint_penalty = {penalty:g} Pa/m makes the joints infinitely stiff"
+        elif (not math.isfinite(omega_elements) or omega_elements == 0.0
+              or not math.isfinite(damping)):
+            cause = (f"young_modulus = {material.young_modulus:g} Pa with density = "
+                     f"{material.density:g} kg/m^3 gives an element frequency of "
+                     f"{omega_elements:g} rad/s")
+        elif not math.isfinite(omega_contact):
+            cause = (f"contact_penalty = {self.contact_penalty:g} Pa makes the contacts infinitely "
+                     "stiff")
+        elif not math.isfinite(omega):
+            cause = "the elements and contacts together are infinitely stiff"
+        elif damping * omega / 2.0 >= self.mass_damping / (2.0 * omega):
+            cause = (f"viscosity = {material.viscosity:g} Pa s damps the stiffest mode "
+                     f"({omega:.3g} rad/s) with a damping ratio of {damping * omega / 2:.3g}")
+        else:
+            cause = (f"mass_damping = {self.mass_damping:g} 1/s against the stiffest mode "
+                     f"({omega:.3g} rad/s)")
+        return (f"[deformable] {cause}, so the stable time step is {step:g} s; give the key in "
+                "its SI unit (docs/case-file.md) and a value a concrete or rock can have")
 
     @property
     def time_step(self) -> float:

@@ -78,6 +78,15 @@ class PorousZone:
                                 "or neither")
         if self.polygon is not None and len(self.polygon) < 3:
             raise CaseFileError(f"{self.name}: a polygon needs at least 3 points (x, z)")
+        if self.polygon is not None:
+            crossing = _first_crossing(np.asarray(self.polygon, dtype=float))
+            if crossing is not None:
+                i, j = crossing
+                raise CaseFileError(
+                    f"{self.name}: the polygon crosses itself: its side from point {i + 1} to "
+                    f"{i + 2} meets the side from point {j + 1} to {(j + 1) % len(self.polygon) + 1}"
+                    "; list the points in order around the zone's outline (a crossed outline "
+                    "leaves part of the zone out)")
 
     def cover(self, grid) -> np.ndarray:
         """Fraction of every cell of ``grid`` inside the zone (nx, ny, nz)."""
@@ -129,6 +138,10 @@ class PorousMedium:
             porosity = porosity * (1.0 - cover) + cover * n
             linear = linear * (1.0 - cover) + cover * zone.linear * (1.0 - n) ** 3 / (n ** 3 * d * d)
             quadratic = quadratic * (1.0 - cover) + cover * zone.quadratic * (1.0 - n) / (n ** 3 * d)
+            if not (np.isfinite(linear).all() and np.isfinite(quadratic).all()):
+                raise CaseFileError(f"{zone.name}: stone_diameter = {d:g} m with porosity = {n:g} "
+                                    "makes the friction of the zone infinite; give stone_diameter "
+                                    "in metres")
             added = added * (1.0 - cover) + cover * zone.added_mass
         self.porosity = porosity
         self.minimum_porosity = float(porosity.min())
@@ -152,6 +165,44 @@ class PorousMedium:
 
     def water_volume(self, fraction, cell_volume: float) -> float:
         return float(np.sum(self.porosity * fraction)) * cell_volume
+
+
+def _first_crossing(points: np.ndarray):
+    """The first pair (i, j) of sides of the closed polygon ``points`` (n, 2) that meet, side i
+    running from point i to point i + 1; None when the outline is simple. Sides next to each other
+    share a point and only count when they fold back over each other."""
+    n = len(points)
+    starts, ends = points, np.roll(points, -1, axis=0)
+    scale = float(np.abs(points).max()) or 1.0
+    tolerance = 1e-12 * scale * scale
+
+    def side(a, b, c):
+        value = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+        return 0 if abs(value) <= tolerance else (1 if value > 0 else -1)
+
+    def on_segment(a, b, c):            # c collinear with a-b: does it lie within it?
+        return (min(a[0], b[0]) <= c[0] <= max(a[0], b[0])
+                and min(a[1], b[1]) <= c[1] <= max(a[1], b[1]))
+
+    for i in range(n):
+        a, b = starts[i], ends[i]
+        for j in range(i + 1, n):
+            c, d = starts[j], ends[j]
+            adjacent = j == i + 1 or (i == 0 and j == n - 1)
+            d1, d2, d3, d4 = side(a, b, c), side(a, b, d), side(c, d, a), side(c, d, b)
+            if adjacent:
+                # sharing one point: they meet elsewhere only when collinear and folding back
+                shared, other_i, other_j = (b, a, d) if j == i + 1 else (a, b, c)
+                if (side(other_i, shared, other_j) == 0
+                        and np.dot(other_i - shared, other_j - shared) > 0):
+                    return i, j
+                continue
+            if d1 * d2 < 0 and d3 * d4 < 0:
+                return i, j
+            if ((d1 == 0 and on_segment(a, b, c)) or (d2 == 0 and on_segment(a, b, d))
+                    or (d3 == 0 and on_segment(c, d, a)) or (d4 == 0 and on_segment(c, d, b))):
+                return i, j
+    return None
 
 
 def face_means(cells, axis) -> np.ndarray:

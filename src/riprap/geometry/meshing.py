@@ -294,8 +294,11 @@ def check_tetrahedron_estimate(volume: float, mesh_size: float, name: str,
     """
     volume = abs(float(volume))
     mesh_size = float(mesh_size)
-    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-        estimate = TETRAHEDRA_PER_CUBED_MESH_SIZE * volume / mesh_size**3
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore", under="ignore"):
+        # numpy floats: a mesh_size of 1e308 or 1e-308 gives 0 or inf, not Python's OverflowError
+        # or ZeroDivisionError
+        estimate = float(TETRAHEDRA_PER_CUBED_MESH_SIZE * np.float64(volume)
+                         / np.float64(mesh_size) ** 3)
     if not estimate <= MAX_TETRAHEDRA_PER_SHAPE:
         smallest = (TETRAHEDRA_PER_CUBED_MESH_SIZE * volume
                     / MAX_TETRAHEDRA_PER_SHAPE) ** (1.0 / 3.0)

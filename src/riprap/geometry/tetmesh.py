@@ -19,6 +19,14 @@ from riprap.errors import CaseFileError, MeshError
 # which would make the contact stiffness, and so the stable time step, absurd.
 DEGENERATE_VOLUME_FRACTION = 1e-12
 
+# The volume of the tetrahedra and the volume their boundary encloses (divergence theorem) agree
+# to round-off in a valid mesh; a relative difference above this means overlaps or gaps.
+_VOLUME_ROUND_OFF = 1e-9
+
+# Pieces of a mesh (tetrahedra joined by no face to the rest), and tetrahedra of each, tested for
+# lying inside the rest: a valid body has one piece, so a few tested show an overlap.
+_MAX_PIECES_TESTED = 20
+
 # How many offending tetrahedra or edges an error message lists before it says "and N more".
 _MAX_LISTED = 5
 
@@ -254,6 +262,7 @@ class TetMesh:
             )
         boundary = faces[first[counts == 1]]
         self._check_closed_boundary(boundary)
+        self._check_no_overlapping_tets(faces, volumes, boundary)
 
     def _check_repeated_tets(self) -> None:
         # A repeated tetrahedron (same four nodes, any order) counts its volume and mass twice and
@@ -271,6 +280,70 @@ class TetMesh:
                 f"mesh '{self.name}' has {repeated.size} repeated tetrahedra (the same four nodes "
                 f"more than once): {_listing(listed, repeated.size)}; remove the duplicates"
             )
+
+    def _check_no_overlapping_tets(self, faces: np.ndarray, volumes: np.ndarray,
+                                   boundary: np.ndarray) -> None:
+        """Tetrahedra that overlap count their volume (and mass) twice. Three tests: the two
+        tetrahedra on an interior face lie on opposite sides of it; the tetrahedra fill exactly
+        the volume their boundary encloses (divergence theorem, to round-off); a piece of the
+        mesh joined to the rest by no face does not lie inside the rest."""
+        keys = np.sort(faces, axis=1)
+        _, inverse = np.unique(keys, axis=0, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        order = np.argsort(inverse, kind="stable")
+        runs = np.flatnonzero(np.diff(inverse[order]) == 0)       # two faces with one key
+        face_a, face_b = order[runs], order[runs + 1]
+        # The node order of a face against its sorted order: opposite sides reverse it.
+        parity = ((faces[:, 0] > faces[:, 1]).astype(int) + (faces[:, 0] > faces[:, 2])
+                  + (faces[:, 1] > faces[:, 2])) % 2
+        same_side = np.flatnonzero(parity[face_a] == parity[face_b])
+        if same_side.size:
+            listed = [f"{(face_a[k] // 4)} and {(face_b[k] // 4)} on face {keys[face_a[k]].tolist()}"
+                      for k in same_side[:_MAX_LISTED]]
+            raise MeshError(
+                f"mesh '{self.name}' has {same_side.size} pairs of overlapping tetrahedra (both on "
+                f"the same side of the face they share): tets {_listing(listed, same_side.size)}; "
+                "remove the extra tetrahedra or remesh the body")
+        centre = self.nodes[np.unique(self.tets)].mean(axis=0)
+        corners = self.nodes[boundary] - centre
+        enclosed = float(np.einsum("ij,ij->i", corners[:, 0],
+                                   np.cross(corners[:, 1], corners[:, 2])).sum()) / 6.0
+        total = float(volumes.sum())
+        if abs(total - enclosed) > _VOLUME_ROUND_OFF * total:
+            raise MeshError(
+                f"mesh '{self.name}': its tetrahedra fill {total:.6g} m^3 but its boundary encloses "
+                f"{enclosed:.6g} m^3 ({100 * (total - enclosed) / enclosed:+.3g} %): tetrahedra "
+                "overlap or leave gaps; remesh the body")
+        self._check_pieces_apart(face_a // 4, face_b // 4)
+
+    def _check_pieces_apart(self, tet_a: np.ndarray, tet_b: np.ndarray) -> None:
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        n = self.n_tets
+        graph = coo_matrix((np.ones(len(tet_a)), (tet_a, tet_b)), shape=(n, n))
+        count, piece = connected_components(graph, directed=False)
+        if count == 1:
+            return
+        sizes = np.bincount(piece, minlength=count)
+        corners = self.nodes[self.tets]                            # (n, 4, 3)
+        # Barycentric coordinates of a point in every tet: solve with the inverse edge matrices.
+        edges = (corners[:, 1:] - corners[:, :1]).transpose(0, 2, 1)
+        inverses = np.linalg.inv(edges)
+        for label in np.argsort(sizes)[:-1][:_MAX_PIECES_TESTED]:   # all but the largest piece
+            members = np.flatnonzero(piece == label)[:_MAX_PIECES_TESTED]
+            others = np.flatnonzero(piece != label)
+            for tet in members:
+                point = corners[tet].mean(axis=0)
+                local = np.einsum("nij,nj->ni", inverses[others], point - corners[others, 0])
+                weights = np.concatenate([1.0 - local.sum(axis=1)[:, None], local], axis=1)
+                inside = np.flatnonzero((weights > 1e-9).all(axis=1))
+                if inside.size:
+                    raise MeshError(
+                        f"mesh '{self.name}': tetrahedron {tet} (in a piece of {sizes[label]} "
+                        f"joined to the rest by no face) lies inside tetrahedron "
+                        f"{others[inside[0]]}: overlapping elements count their volume and mass "
+                        "twice; remove the extra tetrahedra or remesh the body")
 
     def _check_closed_boundary(self, boundary: np.ndarray) -> None:
         edges = np.sort(boundary[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)

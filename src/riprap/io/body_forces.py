@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from riprap.io.output_folder import naming_the_file
+
 __all__ = ["BODY_FORCE_COLUMNS", "BodyForceTable"]
 
 BODY_FORCE_COLUMNS = ("body", "time_s", "x_m", "y_m", "z_m", "vx_m_per_s", "vy_m_per_s",
@@ -21,9 +23,10 @@ class BodyForceTable:
     def __init__(self, path, *, append: bool = False):
         self.path = Path(path)
         if not (append and self.path.is_file()):
-            self.path.write_text(",".join(BODY_FORCE_COLUMNS) + "\n")
+            with naming_the_file(self.path):
+                self.path.write_text(",".join(BODY_FORCE_COLUMNS) + "\n")
 
     def append(self, rows) -> None:
-        with open(self.path, "a") as stream:
+        with naming_the_file(self.path), open(self.path, "a") as stream:
             stream.write("".join(row + "\n" for row in rows))
             stream.flush()

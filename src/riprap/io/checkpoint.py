@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import CaseFileError, RiprapError
+from riprap.io.output_folder import naming_the_file
 
 __all__ = ["CheckpointError", "CHECKPOINT_FORMAT", "save_checkpoint", "load_checkpoint"]
 
@@ -58,12 +59,13 @@ def _atomic_target(path: str | os.PathLike) -> Iterator[Path]:
     target.parent.mkdir(parents=True, exist_ok=True)
     temporary = target.with_name(f".{target.name}.{os.getpid()}.tmp")
     try:
-        yield temporary
+        with naming_the_file(target):
+            yield temporary
         # Flush to disk before the rename so that a power loss cannot leave the new name
         # pointing at an empty file.
-        with open(temporary, "rb+") as handle:
-            os.fsync(handle.fileno())
-        os.replace(temporary, target)
+            with open(temporary, "rb+") as handle:
+                os.fsync(handle.fileno())
+            os.replace(temporary, target)
     finally:
         with contextlib.suppress(FileNotFoundError):
             temporary.unlink()

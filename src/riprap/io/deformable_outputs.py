@@ -9,6 +9,8 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+from riprap.io.output_folder import naming_the_file
+
 __all__ = ["UNIT_COLUMNS", "FRAGMENT_COLUMNS", "write_units_csv", "write_fragments_csv"]
 
 UNIT_COLUMNS = ("body", "name", "mass_kg", "elements", "element_type", "max_tensile_stress_Pa",
@@ -31,7 +33,7 @@ def write_fragments_csv(path, rows) -> Path:
 
 def _write_rows(path, rows, columns) -> Path:
     path = Path(path)
-    with open(path, "w", newline="") as stream:
+    with naming_the_file(path), open(path, "w", newline="") as stream:
         writer = csv.DictWriter(stream, fieldnames=columns)
         writer.writeheader()
         for row in rows:

@@ -3,6 +3,7 @@ so that a read-only folder, a path under a file, a name too long or a full disk 
 error at the start, not a traceback after an hour of simulation."""
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 from pathlib import Path
@@ -10,16 +11,30 @@ from pathlib import Path
 from riprap.errors import RiprapError
 
 __all__ = ["OutputFolderError", "prepare_output_folder", "check_output_folder",
-           "describe_os_error"]
+           "describe_os_error", "naming_the_file"]
 
 
 class OutputFolderError(RiprapError):
     """The output folder cannot be made or written."""
 
 
+@contextlib.contextmanager
+def naming_the_file(path):
+    """Give an OSError raised while ``path`` is written (a full disk fails in ``write``, whose
+    error names no file) the file's name, so that the user learns which file could not be
+    written."""
+    try:
+        yield
+    except OSError as error:
+        if error.filename is None or str(error.filename).endswith(".tmp"):
+            error.filename = str(path)
+        raise
+
+
 def describe_os_error(error: OSError) -> str:
     """An OSError in words an engineer can act on, naming the file."""
-    where = error.filename if error.filename is not None else "?"
+    where = (error.filename if error.filename is not None
+             else "writing an output file (the system did not say which)")
     reason = error.strerror or str(error)
     hints = {errno.ENOSPC: "free some space or choose another --out folder",
              errno.EDQUOT: "free some space or choose another --out folder",

@@ -41,11 +41,14 @@ from riprap.errors import CaseFileError
 from riprap.geometry.tetmesh import TetMesh
 from riprap.io.mesh_files import write_volume_mesh
 
-__all__ = ["PackBody", "write_pack", "PACK_FILE_NAME", "SHAPES_FOLDER", "DEFAULT_PACK_SIMULATION",
-           "DEFAULT_PACK_OUTPUT"]
+__all__ = ["PackBody", "write_pack", "PACK_FILE_NAME", "PACK_HEADER", "SHAPES_FOLDER",
+           "DEFAULT_PACK_SIMULATION", "DEFAULT_PACK_OUTPUT"]
 
 #: Name of the case file inside a pack folder.
 PACK_FILE_NAME = "pack.toml"
+#: How the first line of every pack file begins: a case that includes a pack (``pack = "..."``)
+#: refuses a file without it, which is a plain case, not a pack written by ``riprap place``.
+PACK_HEADER = "# riprap pack:"
 #: Sub-folder of a pack holding the shapes' meshes.
 SHAPES_FOLDER = "shapes"
 
@@ -229,7 +232,7 @@ def _header(comment: str, n_bodies: int, n_shapes: int) -> list[str]:
 
     now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
     lines = [
-        f"# riprap pack: {n_bodies} bodies, {n_shapes} shapes; written by riprap "
+        f"{PACK_HEADER} {n_bodies} bodies, {n_shapes} shapes; written by riprap "
         f"{riprap.__version__} (riprap.io.pack.write_pack) on {now}",
         "# Start a run from it with: riprap run pack.toml",
         "# Each shape's mesh (shapes/*.vtu) is in the body's own frame; a body's orientation",

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from riprap.io.output_folder import naming_the_file
+
 
 def _plain(value):
     """``value`` as plain JSON types; non-finite floats become None (``null``)."""
@@ -37,6 +39,8 @@ def write_json(path, data: dict) -> Path:
     """
     path = Path(path)
     tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(_plain(data), indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    os.replace(tmp, path)
+    with naming_the_file(path):
+        tmp.write_text(json.dumps(_plain(data), indent=2, allow_nan=False) + "\n",
+                       encoding="utf-8")
+        os.replace(tmp, path)
     return path

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.io.output_folder import naming_the_file
 
 __all__ = ["write_vti", "read_vti"]
 
@@ -58,7 +59,7 @@ def write_vti(path, *, origin, spacing: float, cells, cell_data) -> Path:
     footer = "\n</AppendedData>\n</VTKFile>\n"
     path.parent.mkdir(parents=True, exist_ok=True)
     temporary = path.with_name(path.name + ".partial")
-    with open(temporary, "wb") as stream:
+    with naming_the_file(path), open(temporary, "wb") as stream:
         stream.write(header.encode("ascii"))
         for block in blocks:
             stream.write(block)

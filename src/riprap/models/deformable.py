@@ -10,7 +10,7 @@ import numpy as np
 
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.stresses import principal_stresses, von_mises
-from riprap.errors import OverlapError, RiprapError
+from riprap.errors import InstabilityError, OverlapError, RiprapError
 from riprap.models.base import Model
 
 __all__ = ["DeformableModel", "UnitStressRecord"]
@@ -219,7 +219,21 @@ class DeformableModel(Model):
         elapsed = wallclock.perf_counter() - tick
         self._chunk = max(1, min(1_000_000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
 
+    def _check_finite(self) -> None:
+        """Stop with the failure checkpoint once a node's position or velocity is not finite
+        (an element gone NaN does not invert, so the kernel's own check does not see it)."""
+        s = self.system
+        bad = ~(np.isfinite(s.positions).all(axis=1) & np.isfinite(s.velocities).all(axis=1))
+        if bad[:s.n_deformable_nodes].any():
+            node = int(np.argmax(bad))
+            k = int(np.searchsorted(s.node_offsets, node, side="right") - 1)
+            raise InstabilityError(
+                f"deformable body '{s.bodies[k].name}' has a non-finite state at t = {s.time:.6g} s "
+                f"(node {node - int(s.node_offsets[k])}, step {s.step_count}); the bodies moved "
+                "more than the step can carry: check the start velocities and the loads")
+
     def _record_stresses(self) -> None:
+        self._check_finite()
         before = self.records.stress.max()
         all_sigma_1 = []
         for k, body in enumerate(self.system.bodies):

@@ -182,6 +182,11 @@ def jonswap_spectrum(frequencies, significant_height: float, peak_period: float,
     return shape * (significant_height / 4.0) ** 2 / m0
 
 
+#: Most frequency components of an irregular sea: each is summed at every relaxation cell and
+#: boundary face on every step.
+MAXIMUM_COMPONENTS = 10_000
+
+
 @dataclass(frozen=True)
 class IrregularWave:
     """A linear irregular sea: the sum of ``components`` regular linear waves with a JONSWAP
@@ -206,6 +211,17 @@ class IrregularWave:
             raise CaseFileError(f"waves: duration {self.duration:g} s is shorter than ten peak "
                                 f"periods ({10.0 * self.peak_period:g} s): too few frequencies for "
                                 f"a spectrum")
+        # 2.5 components per peak period of the duration (frequencies 0.5 .. 3 fp, 1/duration
+        # apart): counted before they are allocated, so that a duration in the wrong unit is named
+        # rather than exhausting the memory
+        components = 2.5 * (self.duration / self.peak_period)
+        if components > MAXIMUM_COMPONENTS:
+            raise CaseFileError(
+                f"waves: duration = {self.duration:g} s is {self.duration / self.peak_period:.3g} "
+                f"peak periods and would make {components:.3g} frequency components, more than "
+                f"{MAXIMUM_COMPONENTS:,} ({MAXIMUM_COMPONENTS / 2.5:,.0f} peak periods; a storm "
+                "test runs about 1000 waves); give duration in seconds (it defaults to "
+                "[simulation] end_time)")
         spacing = 1.0 / self.duration
         fp = 1.0 / self.peak_period
         frequencies = np.arange(math.ceil(0.5 * fp / spacing), math.floor(3.0 * fp / spacing) + 1) * spacing
