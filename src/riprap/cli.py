@@ -69,7 +69,20 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
               f"{summary.contacts} contacts, max speed {summary.max_speed:.3g} m/s")
     for key, value in summary.outputs.items():
         print(f"riprap: {key}: {value}")
+    if "waves_report" in summary.outputs:
+        _say_waves_report(Path(summary.outputs["waves_report"]))
     return 0
+
+
+def _say_waves_report(path: Path) -> None:
+    """What the flume run's wave analysis could not compute, and its cautions (few waves)."""
+    from riprap.io.json_files import read_json_object
+
+    report = read_json_object(path, "waves report", "the run wrote it just now")
+    for item in report.get("not_computed", []):
+        print(f"riprap: waves: not computed: {item}")
+    for item in report.get("cautions", []):
+        print(f"riprap: waves: caution: {item}")
 
 
 def _say_if_smoke() -> None:

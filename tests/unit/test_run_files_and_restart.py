@@ -170,7 +170,9 @@ def test_a_short_flume_run_is_warned_about_and_its_report_says_why(tmp_path, cap
     assert "riprap: warning:" in warned and "flume.toml [simulation] end_time" in warned
     assert "to 4.67 s at b" in warned and "Run to at least 9 s" in warned
     assert main(["run", str(case), "--out", str(tmp_path / "out"), "--quiet"]) == 0
-    assert "Run to at least 9 s" in capsys.readouterr().err
+    said = capsys.readouterr()
+    assert "Run to at least 9 s" in said.err
+    assert "riprap: waves: not computed: b: wave heights and periods" in said.out
     report = _strict((tmp_path / "out" / "waves_report.json").read_text())
     assert report["record_end_s"] == pytest.approx(0.2)
     reasons = "\n".join(report["not_computed"])

@@ -123,8 +123,12 @@ def short_run_warning(windows: FlumeWindows, end_time: float, *, case_end_time: 
         return None
     first = min(windows.gauges, key=lambda g: g.opens)
     last = max(windows.gauges, key=lambda g: g.opens)
-    ends = (f"this run ends at t = {end_time:g} s (smoke mode; the case's end_time is "
-            f"{case_end_time:g} s)" if end_time != case_end_time else f"end_time = {end_time:g} s")
+    ends = (f"this smoke run ends at t = {end_time:g} s (the case's end_time is "
+            f"{case_end_time:g} s)" if end_time != case_end_time
+            else f"end_time = {end_time:g} s ends sooner")
+    fewest, most = (min(g.needs for g in windows.gauges) / windows.period,
+                    max(g.needs for g in windows.gauges) / windows.period)
+    needs = f"{fewest:g}" if fewest == most else f"{fewest:g} to {most:g}"
     lost = windows.missing(end_time)
     gives = ("; ".join(lost) if lost else
              f"statistics from fewer than {FEW_WAVES + 1} waves at some gauges (they carry a caution)")
@@ -133,7 +137,6 @@ def short_run_warning(windows: FlumeWindows, end_time: float, *, case_end_time: 
             f"{first.travel:.3g} s at the group velocity {windows.group_velocity:.3g} m/s + two "
             f"periods {first.settle:.3g} s)"
             + (f" to {last.opens:.3g} s at {last.name}" if last is not first else "")
-            + f", and needs {min(g.needs for g in windows.gauges) / windows.period:g} to "
-            f"{max(g.needs for g in windows.gauges) / windows.period:g} periods after that; "
-            f"{ends} will give {gives}. Run to at least {math.ceil(windows.complete):g} s for "
+            + f", and needs {needs} periods after that; "
+            f"{ends}: the run will give {gives}. Run to at least {math.ceil(windows.complete):g} s for "
             "every result (many more waves for a sea state's statistics)")
