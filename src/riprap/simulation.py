@@ -586,8 +586,9 @@ class Simulation:
                     else "lower [simulation] time_step_safety (or set a smaller time_step)")
             causes.append(f"the time step {s.time_step:.3e} s is too large for the contact "
                           f"stiffness: {what}, or lower contact_penalty")
-        return ("Likely cause: " + "; ".join(causes) + ". Then restart from the checkpoint with "
-                "--restart: the new time step is used from there.")
+        return ("Likely cause: " + "; ".join(causes) + ". After lowering the time step, restart "
+                "from the checkpoint with --restart: the new time step is used from there (any "
+                "other change to the case, such as contact_penalty or gravity, needs a new run).")
 
     def at_rest(self) -> bool:
         """Every free body slower than ``rest_speed`` and, under gravity, with a net force below
