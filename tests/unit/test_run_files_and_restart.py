@@ -298,3 +298,39 @@ def test_an_irregular_sea_lasting_the_end_time_makes_end_time_part_of_the_run():
     changes = record(20.0).changes(record(10.0).values)
     assert changes == ["[waves] duration was 10.0, is now 20.0"]
     assert record(20.0, "\nduration = 30.0").changes(record(10.0, "\nduration = 30.0").values) == []
+
+
+# ---------------------------------------------------------------------------- run tables
+def test_gauge_records_read_back_exactly_and_broken_ones_are_named(tmp_path):
+    from riprap.errors import CaseFileError
+    from riprap.io.gauge_files import read_gauges_csv, write_gauges_csv
+
+    times = np.array([0.01, 0.02, 0.03])
+    values = np.array([[0.001, -0.5], [0.002, -0.25], [-0.003, 0.125]])
+    gauges = SimpleNamespace(count=3, times=times, values=values, columns=["a_eta_m", "up_level_m"])
+    path = write_gauges_csv(tmp_path / "gauges.csv", gauges)
+    read_times, columns = read_gauges_csv(path)
+    assert np.array_equal(read_times, times) and np.array_equal(columns["up_level_m"], values[:, 1])
+    for body, phrase in (("0.01,0.1,0.2\n0.02,nan,0.2\n", "gauges.csv:3: a_eta_m = nan is not finite"),
+                         ("0.01,0.1,0.2\n0.005,0.1,0.2\n", "gauges.csv:3: time_s = 0.005 s does not"),
+                         ("0.01,0.1,0.2\n0.02,0.1\n", "gauges.csv:3: 2 fields, the header has 3"),
+                         ("0.01,x,0.2\n", "gauges.csv:2: a_eta_m = 'x' is not a number")):
+        path.write_text("time_s,a_eta_m,up_level_m\n" + body)
+        with pytest.raises(CaseFileError, match=phrase):
+            read_gauges_csv(path)
+
+
+def test_body_forces_are_read_back_and_broken_ones_are_named(tmp_path):
+    from riprap.errors import CaseFileError
+    from riprap.io.body_forces import BODY_FORCE_COLUMNS, BodyForceTable, read_body_forces
+
+    table = BodyForceTable(tmp_path / "body_forces.csv")
+    table.append([",".join(["0", "0.5"] + ["1.25"] * 15), ",".join(["1", "0.5"] + ["-2"] * 15)])
+    data = read_body_forces(table.path, n_bodies=2)
+    assert list(data["body"]) == [0, 1] and list(data["pressure_force_z_N"]) == [1.25, -2.0]
+    with pytest.raises(CaseFileError, match="body_forces.csv:3: body = 1: expected a whole body "
+                                            "number from 0 to 0"):
+        read_body_forces(table.path, n_bodies=1)
+    table.path.write_text(",".join(BODY_FORCE_COLUMNS[:-1]) + "\n")
+    with pytest.raises(CaseFileError, match="body_forces.csv:1: columns"):
+        read_body_forces(table.path)

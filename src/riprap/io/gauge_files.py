@@ -6,7 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_gauges_csv", "gauges_png", "write_waves_report"]
+from riprap.errors import CaseFileError
+
+__all__ = ["write_gauges_csv", "read_gauges_csv", "gauges_png", "write_waves_report"]
 
 
 def write_gauges_csv(path, gauges) -> Path:
@@ -17,6 +19,27 @@ def write_gauges_csv(path, gauges) -> Path:
     np.savetxt(path, table, delimiter=",", header=",".join(["time_s"] + gauges.columns),
                comments="", fmt="%.9g")
     return path
+
+
+def read_gauges_csv(path) -> tuple[np.ndarray, dict]:
+    """``(times (s), {column: values})`` of a run's ``gauges.csv``, checked: the header starts with
+    ``time_s``, every field is a finite number, the times increase (the file is rewritten whole at
+    every frame). Errors name the file, the line and the column."""
+    from riprap.io.csv_tables import read_number_table
+
+    path = Path(path)
+    advice = "run the case again (gauges.csv is rewritten whole at every frame)"
+    header, table, lines = read_number_table(path, "gauge table", advice=advice)
+    if header[0] != "time_s":
+        raise CaseFileError(f"{path}:1: the first column is {header[0]!r}; gauges.csv starts with "
+                            f"time_s; {advice}")
+    times = table[:, 0]
+    back = np.flatnonzero(np.diff(times) <= 0.0)
+    if back.size:
+        row = int(back[0]) + 1
+        raise CaseFileError(f"{path}:{lines[row]}: time_s = {times[row]:g} s does not increase (the "
+                            f"row before has {times[row - 1]:g} s); {advice}")
+    return times, {name: table[:, k] for k, name in enumerate(header) if k > 0}
 
 
 def gauges_png(path, gauges, report=None) -> Path:

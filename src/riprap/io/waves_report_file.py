@@ -78,12 +78,45 @@ def _line_of(text: str, names) -> int | None:
     position, found = 0, None
     for name in names:
         if isinstance(name, int):
+            position = _element_start(text, position, name)
             continue
         match = re.compile(r'"' + re.escape(name) + r'"\s*:').search(text, position)
         if match is None:
             break
         position, found = match.end(), match.start()
     return None if found is None else text.count("\n", 0, found) + 1
+
+
+def _element_start(text: str, position: int, index: int) -> int:
+    """Where element ``index`` of the JSON list opening at or after ``position`` starts (its end
+    when the list is shorter), skipping strings and nested values."""
+    start = text.find("[", position)
+    if start < 0:
+        return position
+    depth, count, in_string, escaped = 0, 0, False, False
+    for k in range(start, len(text)):
+        char = text[k]
+        if in_string:
+            if escaped:
+                escaped = False
+            elif char == "\\":
+                escaped = True
+            elif char == '"':
+                in_string = False
+            continue
+        if char == '"':
+            in_string = True
+        elif char in "[{":
+            depth += 1
+            if depth == 2 and count == index:
+                return k
+        elif char in "]}":
+            depth -= 1
+            if depth == 0:
+                return k
+        elif char == "," and depth == 1:
+            count += 1
+    return position
 
 
 def _problem(path: Path, text: str, names, message: str) -> CaseFileError:
