@@ -69,7 +69,20 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
               f"{summary.contacts} contacts, max speed {summary.max_speed:.3g} m/s")
     for key, value in summary.outputs.items():
         print(f"riprap: {key}: {value}")
+    if "waves_report" in summary.outputs:
+        _say_waves_report(Path(summary.outputs["waves_report"]))
     return 0
+
+
+def _say_waves_report(path: Path) -> None:
+    """What the flume run's wave analysis could not compute, and its cautions (few waves)."""
+    from riprap.io.json_files import read_json_object
+
+    report = read_json_object(path, "waves report", "the run wrote it just now")
+    for item in report.get("not_computed", []):
+        print(f"riprap: waves: not computed: {item}")
+    for item in report.get("cautions", []):
+        print(f"riprap: waves: caution: {item}")
 
 
 def _say_if_smoke() -> None:
@@ -134,6 +147,7 @@ def _analyse(paths: list[Path], out: str | None, frame: int, labels: list[str] |
         print(f"riprap: packing density coefficient {layer['packing_density_coefficient']:.3f} "
               f"(design {layer['design_packing_density_coefficient']:.3f}), porosity "
               f"{layer['porosity']:.3f}, layer thickness {layer['layer_thickness_m']:.3f} m")
+        _say_flume_test(layer.get("flume_test"))
         print(f"riprap: report: {layer['outputs']['report']}")
         return 0
     if out is None:
@@ -148,11 +162,26 @@ def _analyse(paths: list[Path], out: str | None, frame: int, labels: list[str] |
     return 0
 
 
-def _check(path: Path, out: str | None) -> int:
+def _say_flume_test(flume: dict | None) -> None:
+    """The flume test's stability number, or what could not be computed and why; cautions."""
+    if flume is None:
+        return
+    if flume.get("stability_number") is not None:
+        hudson = flume.get("hudson")
+        print(f"riprap: flume test: Hm0 {flume['Hm0_m']:.3g} m ({flume['wave_height_source']}), "
+              f"stability number {flume['stability_number']:.3g}"
+              + (f" (Hudson's {hudson['stability_number']:.3g})" if hudson else ""))
+    for item in flume.get("not_computed", []):
+        print(f"riprap: flume test: not computed: {item}")
+    for item in flume.get("cautions", []):
+        print(f"riprap: flume test: caution: {item}")
+
+
+def _check(path: Path, out: str | None, restart: str | None = None) -> int:
     from riprap.case.load import load_case
     from riprap.case.preflight import check_case
 
-    report = check_case(load_case(path), output_directory=out)
+    report = check_case(load_case(path), output_directory=out, restart=restart)
     print(f"{path}: valid ({report.description})")
     print(f"  checked: {'; '.join(report.checked)}")
     for item in report.not_checked:
@@ -212,6 +241,8 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("case", type=Path)
     check.add_argument("--out", default=None,
                        help="output folder to check (default: [output] directory)")
+    check.add_argument("--restart", default=None,
+                       help="also check a restart from this checkpoint (.npz), as run --restart")
     sub.add_parser("info", help="versions of riprap, Python and its libraries; threads")
     return parser
 
@@ -229,7 +260,7 @@ def _dispatch(args) -> int:
     if args.command in ("analyse", "analyze"):
         return _analyse(args.paths, args.out, args.frame, args.labels)
     if args.command == "check":
-        return _check(args.case, args.out)
+        return _check(args.case, args.out, args.restart)
     return _info()
 
 

@@ -169,6 +169,10 @@ class Simulation:
         # The case file this simulation was built from (set by build_simulation); recorded in
         # summary.json so that `riprap analyse RUN` finds the pack a run started from.
         self.case_file = ""
+        # What defines the run (riprap.case.run_record.RunDefinition, set by the case builders):
+        # kept in every checkpoint, and a restart with a case changed beyond what may change is
+        # refused. None for a run built in Python: its restarts are not checked.
+        self.run_definition = None
         self.progress = bool(progress)
         if fluid is not None and tuple(np.asarray(gravity, dtype=float)) == (0.0, 0.0, -9.81):
             gravity = fluid.gravity
@@ -619,8 +623,9 @@ class Simulation:
                     else "lower [simulation] time_step_safety (or set a smaller time_step)")
             causes.append(f"the time step {s.time_step:.3e} s is too large for the contact "
                           f"stiffness: {what}, or lower contact_penalty")
-        return ("Likely cause: " + "; ".join(causes) + ". Then restart from the checkpoint with "
-                "--restart: the new time step is used from there.")
+        return ("Likely cause: " + "; ".join(causes) + ". After lowering the time step, restart "
+                "from the checkpoint with --restart: the new time step is used from there (any "
+                "other change to the case, such as contact_penalty or gravity, needs a new run).")
 
     def at_rest(self) -> bool:
         """Every free body slower than ``rest_speed`` and, under gravity, with a net force below
@@ -765,20 +770,33 @@ class Simulation:
         metadata.update({"kind": model.kind, "frame_index": self._frame_index,
                          "checkpoints_written": self._checkpoints_written,
                          "time": float(state["clock"][0])})
+        if self.run_definition is not None:
+            metadata["case_record"] = self.run_definition.values
         return save_checkpoint(self.output_directory / name, arrays=arrays, metadata=metadata)
 
-    def restart(self, path) -> None:
-        """Continue from a checkpoint written by a run of the same case."""
+    def check_restart(self, path) -> tuple[dict, dict]:
+        """Every check of a restart from ``path`` (``riprap check --restart`` makes them too): a
+        readable checkpoint of this kind of run, of this case (nothing changed but what may
+        change), with the model's own checks (meshes, cells, bodies). Returns its arrays and
+        metadata."""
         from riprap.io.checkpoint import load_checkpoint
 
         arrays, metadata = load_checkpoint(path)
-        self._restarted = True          # before the model is built: a restart's overlaps are its own
+        self._check_same_run(path, metadata)
         model = self.model
         kind = metadata.get("kind")
         if kind not in _ACCEPTED_KINDS[model.kind]:
             raise RiprapError(f"{path}: a checkpoint of a {kind!r} run; this case is a "
                               f"{model.name} run ({model.kind!r})")
         model.check_checkpoint(path, arrays, metadata)
+        return arrays, metadata
+
+    def restart(self, path) -> None:
+        """Continue from a checkpoint written by a run of the same case."""
+        self._restarted = True          # before the model is built: a restart's overlaps are its own
+        arrays, metadata = self.check_restart(path)
+        model = self.model
+        kind = metadata.get("kind")
         model.restore(arrays)
         self._frame_index = int(metadata["frame_index"])
         if "checkpoints_written" in metadata:
@@ -788,6 +806,28 @@ class Simulation:
             # next checkpoint (from 1), a fluid run the number written.
             self._checkpoints_written = (int(metadata["checkpoint_index"])
                                          - (1 if kind == "riprap rigid run" else 0))
+
+
+    def _check_same_run(self, path, metadata: dict) -> None:
+        """Refuse a restart whose case changed in what defines the run (not the end time, the
+        outputs or the time step); a checkpoint of an older riprap, without that record, restarts
+        with a warning."""
+        if self.run_definition is None:
+            return
+        recorded = metadata.get("case_record")
+        if recorded is None:
+            import warnings
+
+            from riprap.work_estimate import RiprapWarning
+
+            warnings.warn(f"{path} was written by an older riprap and does not record the case it "
+                          "was run with: restarting without checking that the case is unchanged "
+                          "(only end_time, outputs and the time step may change)", RiprapWarning,
+                          stacklevel=3)
+            return
+        refusal = self.run_definition.refusal(path, recorded)
+        if refusal is not None:
+            raise CaseFileError(refusal)
 
 
 # Checkpoint kinds a model restarts from: coupled runs were "fluid runs" before the one run loop.

@@ -19,13 +19,15 @@ def analyse(path, *, out=None, frame: int = -1) -> LayerAnalysis:
     """Analyse the pack folder (or ``pack.toml``) or run folder ``path``; with ``out``, write
     ``units.csv``, ``report.html``, ``stereonet.png`` and the rest there
     (:mod:`riprap.io.analysis_report`). ``frame``: which frame of a run (-1 the last)."""
-    from riprap.io.analysis_input import load_layer_state
+    from riprap.io.analysis_input import load_layer_state, load_waves_report
     from riprap.io.output_folder import prepare_output_folder
 
+    # A broken waves report is refused before any work (and before the output folder is made).
+    waves = load_waves_report(path)
     if out is not None:
         prepare_output_folder(out)
     analysis = analyse_layer(load_layer_state(path, frame=frame))
-    _add_flume_test(path, analysis)
+    _add_flume_test(waves, analysis)
     if out is not None:
         from riprap.io.analysis_report import write_analysis
 
@@ -33,13 +35,11 @@ def analyse(path, *, out=None, frame: int = -1) -> LayerAnalysis:
     return analysis
 
 
-def _add_flume_test(path, analysis) -> None:
-    """A run of a flume test (``waves_report.json`` beside its frames): the layer summary gets
-    ``flume_test``, the damage beside the design formulas for the measured waves."""
+def _add_flume_test(waves: dict | None, analysis) -> None:
+    """A run of a flume test (``waves``: its ``waves_report.json``, or None): the layer summary
+    gets ``flume_test``, the damage beside the design formulas for the measured waves."""
     from riprap.analysis.stability_report import flume_stability
-    from riprap.io.analysis_input import load_waves_report
 
-    waves = load_waves_report(path)
     if waves is None:
         return
     state = analysis.state

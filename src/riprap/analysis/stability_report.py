@@ -27,15 +27,16 @@ HUDSON_TRUNK_STABILITY = {"core_loc_like": 16.0, "accropode_like": 15.0, "xbloc_
 
 def _incident(waves_report: dict):
     """(incident Hm0, Tz, waves, where it was read) at the toe."""
-    gauges = [g for g in waves_report.get("gauges", {}).values() if "Hm0_m" in g]
+    # null: a figure the run could not compute (written for NaN)
+    gauges = [g for g in waves_report.get("gauges", {}).values() if g.get("Hm0_m") is not None]
     period = gauges[0].get("Tz_s") if gauges else None
     waves = gauges[0].get("waves") if gauges else None
     # three gauges first (Mansard & Funke: no singular spacings, less noise), then pairs
     for key, method in (("reflection_three_gauge", "Mansard-Funke, mean of the gauge triples"),
                         ("reflection", "Goda-Suzuki, mean of the gauge pairs")):
-        heights = [e.get("incident_Hm0_m", e.get("incident_height_m"))
-                   for e in waves_report.get(key, [])
-                   if "incident_Hm0_m" in e or "incident_height_m" in e]
+        heights = [height for height in (e.get("incident_Hm0_m", e.get("incident_height_m"))
+                                         for e in waves_report.get(key, []))
+                   if height is not None]
         if heights:
             return sum(heights) / len(heights), period, waves, f"incident ({method})"
     if gauges:
@@ -54,8 +55,15 @@ def flume_stability(waves_report: dict, layer_summary: dict, *, unit_kind: str,
               "units_displaced": len(layer_summary.get("units_displaced", [])),
               "damage_number_nod": layer_summary.get("damage_number_nod"),
               "damage_threshold_over_dn": layer_summary.get("damage_threshold_over_dn")}
+    # What the waves report could not compute, and its cautions (few waves), go on to the report.
+    result["not_computed"] = list(waves_report.get("not_computed", []))
+    result["cautions"] = list(waves_report.get("cautions", []))
     if height is None:
         result["note"] = "the waves report has no analysed surface gauge: no stability number"
+        result["not_computed"].append(
+            "stability number: no incident wave height (no surface gauge could be analysed"
+            + (f"; the record ends at t = {waves_report['record_end_s']:g} s"
+               if waves_report.get("record_end_s") is not None else "") + ")")
         return result
     stability = height / (delta * nominal_diameter)
     result.update({"Hm0_m": height, "Tz_s": period, "waves": waves, "stability_number": stability})

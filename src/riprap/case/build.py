@@ -12,6 +12,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from riprap.case.body_start import check_body_starts, check_coordinates, shape_radius
+from riprap.case.run_record import RunDefinition
 from riprap.errors import RiprapError
 from riprap.geometry import shapes as builtin_shapes
 from riprap.geometry.armour_units import armour_unit
@@ -80,6 +81,7 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
         paraview=case.output.paraview, picture=case.output.picture, progress=progress)
     if case.source and Path(case.source).is_file():
         sim.case_file = str(Path(case.source).resolve())
+    sim.run_definition = RunDefinition.of(case)
     for m in case.materials:
         sim.add_material(build_material(m))
     radii = {}

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from riprap.case.build import SMOKE_END_TIME, smoke_mode
+from riprap.case.run_record import RunDefinition
 from riprap.errors import CaseFileError
 from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.phases import Phase
@@ -128,6 +129,7 @@ def build_fluid_run(case, *, output_directory=None, progress: bool = True):
         simulation = build_simulation(case, output_directory=output_directory, progress=progress)
         simulation.add_fluid(fluid)
         simulation.prepare()
+        _warn_if_too_short_to_analyse(case, simulation)
         return simulation
     settings = case.simulation
     source = Path(case.source)
@@ -137,4 +139,22 @@ def build_fluid_run(case, *, output_directory=None, progress: bool = True):
         output_directory=output_directory or case.output.directory, paraview=case.output.paraview,
         picture=case.output.picture, progress=progress, fluid=fluid)
     simulation.case_file = str(source.resolve()) if source.is_file() else ""
+    simulation.run_definition = RunDefinition.of(case)
+    _warn_if_too_short_to_analyse(case, simulation)
     return simulation
+
+
+def _warn_if_too_short_to_analyse(case, simulation) -> None:
+    """Say before the run (``riprap check`` and ``riprap run`` both build it here) when it ends
+    before the wave analysis can give its results; the run goes on."""
+    import warnings
+
+    from riprap.waves.analysis_window import flume_windows, short_run_warning
+    from riprap.work_estimate import RiprapWarning
+
+    fluid = simulation.fluid
+    text = short_run_warning(flume_windows(fluid.wave_source, fluid.gauges), simulation.end_time,
+                             case_end_time=case.simulation.end_time,
+                             where=f"{case.source} [simulation] end_time")
+    if text is not None:
+        warnings.warn(text, RiprapWarning, stacklevel=3)

@@ -24,9 +24,16 @@ class CheckReport:
     not_checked: list[str] = field(default_factory=list)
 
 
-def check_case(case: Case, *, output_directory=None) -> CheckReport:
-    """Run every pre-simulation check of ``case``; raises the error the run would raise."""
+def check_case(case: Case, *, output_directory=None, restart=None) -> CheckReport:
+    """Run every pre-simulation check of ``case``; raises the error the run would raise.
+    ``restart``: a checkpoint to check a restart from (``riprap run --restart``)."""
     out = output_directory or case.output.directory
+    if restart is not None and case.is_placement:
+        from riprap.errors import CaseFileError
+
+        raise CaseFileError(f"{case.source}: a placement does not restart (--restart {restart}); "
+                            "run 'riprap place' again")
+    sim = None
     if case.is_placement:
         from riprap.case.build_placement import PLACEMENT_NOT_CHECKED, prepare_placement
 
@@ -48,7 +55,7 @@ def check_case(case: Case, *, output_directory=None) -> CheckReport:
     elif case.is_fluid:
         from riprap.case.build_fluid import build_fluid_run
 
-        run = build_fluid_run(case, output_directory=out, progress=False)
+        run = sim = build_fluid_run(case, output_directory=out, progress=False)
         cells = "x".join(map(str, case.fluid.cells))
         bodies = f" with {case.body_count} bodies in it" if run.coupled else ""
         report = CheckReport(
@@ -75,6 +82,10 @@ def check_case(case: Case, *, output_directory=None) -> CheckReport:
         report = CheckReport(bodies, checked=checked,
                              not_checked=["whether the contacts that form later stay stable at "
                                           "this time step (a run stops with a checkpoint if not)"])
+    if restart is not None:
+        sim.check_restart(restart)
+        report.checked.append(f"restart from {restart}: a checkpoint of this case (only what may "
+                              "change on a restart has changed)")
     report.checked.append(check_output_folder(out))
     return report
 

@@ -15,7 +15,6 @@
 """
 from __future__ import annotations
 
-import json
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
@@ -23,6 +22,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from riprap.errors import CaseFileError
+from riprap.io.json_files import read_json_object
 
 __all__ = ["load_layer_state", "load_pack_state", "load_run_state", "is_run_folder",
            "load_waves_report"]
@@ -336,32 +336,19 @@ def _rotation_history(run_folder, frames, frame, pack, pack_file, reference, now
     return np.array(history)
 
 
-def _json_object(path: Path, what: str, advice: str) -> dict:
-    """The JSON object in ``path``, or a CaseFileError naming the file, ``what`` it should be and
-    ``advice``."""
-    try:
-        value = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise CaseFileError(f"{path}: cannot read the {what} ({error}); {advice}") from None
-    if not isinstance(value, dict):
-        raise CaseFileError(f"{path}: not a {what} (a JSON object is expected)")
-    return value
-
-
 def load_waves_report(run_folder) -> dict | None:
-    """The ``waves_report.json`` of a flume run's folder, or None when the run wrote none."""
-    path = Path(run_folder) / "waves_report.json"
-    if not (Path(run_folder).is_dir() and path.is_file()):
-        return None
-    return _json_object(path, "waves report", "run the case again, or remove the file to "
-                                              "analyse the layer alone")
+    """The ``waves_report.json`` of a flume run's folder, every field checked
+    (:mod:`riprap.io.waves_report_file`), or None when the run wrote none."""
+    from riprap.io.waves_report_file import read_waves_report
+
+    return read_waves_report(run_folder)
 
 
 def _run_case_file(run_folder: Path) -> Path:
     """The case a run folder's ``summary.json`` says the run ran."""
     summary_path = run_folder / "summary.json"
-    summary = _json_object(summary_path, "run summary", "the analysis of a run needs it to find "
-                                                        "the case the run was started from")
+    summary = read_json_object(summary_path, "run summary", "the analysis of a run needs it to "
+                                                            "find the case the run was started from")
     case_file = summary.get("case_file")
     if not isinstance(case_file, (str, type(None))):
         raise CaseFileError(f"{summary_path}: 'case_file' must be a path (a string), got "

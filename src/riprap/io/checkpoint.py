@@ -146,7 +146,7 @@ def save_checkpoint(
     try:
         # allow_nan=False: NaN and infinity are not JSON and other readers would reject them.
         text = json.dumps(full_metadata, default=_json_default, allow_nan=False, sort_keys=True)
-    except (TypeError, ValueError) as error:
+    except (TypeError, ValueError, RecursionError) as error:
         raise CaseFileError(
             f"checkpoint {path}: metadata cannot be written as JSON ({error}); keep metadata to "
             "finite numbers, strings, lists and dicts, and put arrays in `arrays`."

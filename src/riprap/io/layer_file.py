@@ -26,6 +26,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 from riprap.io.case_text import read_text_file
+from riprap.io.json_files import strict_loads, write_json
 
 __all__ = ["LAYER_FILE_NAME", "CONTACTS_FILE_NAME", "LAYER_FORMAT", "LAYER_FORMAT_VERSION",
            "write_layer_file", "read_layer_file", "write_contact_table", "read_contact_table",
@@ -83,10 +84,7 @@ def write_layer_file(directory, layer) -> Path:
         "design": {name: float(value) for name, value in layer.design.items()},
     }
     path = Path(directory) / LAYER_FILE_NAME
-    temporary = path.with_name(path.name + ".partial")
-    temporary.write_text(json.dumps(data, indent=1, allow_nan=False) + "\n", encoding="utf-8")
-    os.replace(temporary, path)
-    return path
+    return write_json(path, data, indent=1)
 
 
 def _is_number(value) -> bool:
@@ -191,9 +189,11 @@ def read_layer_file(directory, n_bodies: int | None = None):
         raise CaseFileError(f"{path}: is empty; write it again (riprap place, or "
                             "riprap.io.layer_file.write_layer_file)")
     try:
-        data = json.loads(text)
+        data = strict_loads(text)
     except json.JSONDecodeError as error:
         raise CaseFileError(f"{path}:{error.lineno}: not valid JSON: {error.msg}") from None
+    except ValueError as error:
+        raise CaseFileError(f"{path}: not standard JSON: {error}; place the layer again") from None
     except RecursionError:
         raise CaseFileError(f"{path}: not valid JSON (nested too deeply)") from None
     if not isinstance(data, dict) or data.get("format") != LAYER_FORMAT:

@@ -175,8 +175,8 @@ class FluidModel(Model):
 
     def failure_advice(self, good: dict) -> str:
         return ("Likely cause: a flow the grid or the time step cannot carry; lower [fluid] "
-                "courant_number or max_time_step, or refine the grid, and restart from the "
-                "checkpoint with --restart.")
+                "courant_number or max_time_step and restart from the checkpoint with --restart, "
+                "or refine the grid and run again.")
 
 
 class CoupledModel(FluidModel):
@@ -306,5 +306,6 @@ class CoupledModel(FluidModel):
     def failure_advice(self, good: dict) -> str:
         return ("Likely cause: the flow or a body moved more than the steps can carry; lower "
                 "[fluid] courant_number or max_time_step, or [simulation] time_step_safety for "
-                "the contacts, and restart from the checkpoint with --restart.")
+                "the contacts, and restart from the checkpoint with --restart (these may change "
+                "on a restart; anything else needs a new run).")
 

@@ -3,7 +3,10 @@ neighbouring surface gauges the incident and reflected waves (Goda-Suzuki, Mansa
 mean discharge, per run-up gauge R_max and R2%, beside the target wave (``waves_report.json``).
 
 Each record is analysed from the time the wave train has arrived: the ramp, plus the travel from
-the generation zone at the group velocity of the (peak) period, plus two periods.
+the generation zone at the group velocity of the (peak) period, plus two periods
+(``riprap.waves.analysis_window``). What could not be computed is said, with the reason, in
+``not_computed``; statistics from one to three waves carry a ``caution`` (and are listed in
+``cautions``).
 """
 from __future__ import annotations
 
@@ -70,7 +73,9 @@ def flume_report(gauges, wave_source=None, water_density: float | None = None) -
     flume's waves: its WaveRelaxation or BoundaryWaveMaker, optional) gives the target and the
     analysis windows; ``water_density``
     (kg/m^3) is recorded for the stability report."""
-    report = {"gauges": {}, "reflection": []}
+    report = {"gauges": {}, "reflection": [], "not_computed": [], "cautions": []}
+    record_end = float(gauges.times[-1]) if gauges.count else 0.0
+    report["record_end_s"] = record_end
     if water_density is not None:
         report["water_density_kg_m3"] = float(water_density)
     wave = wave_source.wave if wave_source is not None and wave_source.wave is not None else None
@@ -89,8 +94,11 @@ def flume_report(gauges, wave_source=None, water_density: float | None = None) -
                  "samples": int(chosen.sum())}
         if chosen.sum() >= 8 and (wave is None or times[-1] - start >= 2.0 * wave.period):
             entry.update(wave_statistics(times[chosen], eta[chosen]).as_dict())
+            _caution(report, entry, gauge.name, entry["waves"])
         else:
             entry["note"] = "record too short after the wave train's arrival"
+            report["not_computed"].append(
+                f"{gauge.name}: wave heights and periods: {_too_short(record_end, start, wave, 2)}")
         report["gauges"][gauge.name] = entry
     for gauge in gauges.gauges:
         if gauge.kind not in (OVERTOPPING, RUN_UP):
@@ -106,12 +114,21 @@ def flume_report(gauges, wave_source=None, water_density: float | None = None) -
             entry["to_x_m"] = gauge.to_x
             entry.update(run_up_statistics(times[chosen], values[chosen]))
             report.setdefault("run_up", {})[gauge.name] = entry
+            _caution(report, entry, gauge.name, entry.get("run_up_waves"))
+        if "note" in entry:
+            what = "overtopping" if gauge.kind == OVERTOPPING else "run-up"
+            report["not_computed"].append(f"{gauge.name}: {what}: "
+                                          f"{_too_short(record_end, start, wave, 2)}")
     if wave is not None:
         regular = not hasattr(wave, "significant_height")
         ordered = sorted(surface, key=lambda g: g.position[0])
         for first, second in zip(ordered[:-1], ordered[1:]):
             t1, e1 = windows[second.name]
             if t1.size < 8 or t1[-1] - t1[0] < 4.0 * wave.period:
+                start = report["gauges"][second.name]["analysed_from_s"]
+                report["not_computed"].append(
+                    f"{first.name}-{second.name}: incident and reflected waves: "
+                    f"{_too_short(record_end, start, wave, 4)}")
                 continue
             _, eta_1 = gauges.series(first.columns[0])
             times = gauges.times
@@ -124,8 +141,11 @@ def flume_report(gauges, wave_source=None, water_density: float | None = None) -
                 else:
                     split = separate_incident_reflected(times[chosen], eta_1[chosen], e1, spacing,
                                                         wave.depth, wave.period)
-            except CaseFileError:
-                continue        # spacing outside 0.05 .. 0.45 wave lengths: no split for this pair
+            except CaseFileError as error:
+                # spacing outside 0.05 .. 0.45 wave lengths: no split for this pair
+                report["not_computed"].append(f"{first.name}-{second.name}: incident and reflected "
+                                              f"waves: {error}")
+                continue
             entry = {"gauges": [first.name, second.name], "spacing_m": spacing, **split.as_dict()}
             report["reflection"].append(_named_for(entry, regular))
         for triple in zip(ordered[:-2], ordered[1:-1], ordered[2:]):
@@ -133,6 +153,29 @@ def flume_report(gauges, wave_source=None, water_density: float | None = None) -
             if entry is not None:
                 report.setdefault("reflection_three_gauge", []).append(entry)
     return report
+
+
+def _too_short(record_end: float, start: float, wave, periods: float) -> str:
+    """Why a record gave nothing: it ends before (or too soon after) its window opens."""
+    if wave is None:
+        return f"the record (to t = {record_end:g} s) is too short"
+    needed = start + periods * wave.period
+    if record_end <= start:
+        return (f"the record ends at t = {record_end:g} s, before the analysis window opens at "
+                f"{start:.3g} s (the wave train's arrival); run to at least {needed:.3g} s")
+    return (f"the record ends at t = {record_end:g} s, {record_end - start:.3g} s after the analysis "
+            f"window opens at {start:.3g} s; it needs {periods:g} periods ({periods * wave.period:.3g} s)"
+            f": run to at least {needed:.3g} s")
+
+
+def _caution(report: dict, entry: dict, name: str, waves) -> None:
+    """A caution on ``entry`` (and in the report's list) for statistics from 1 to 3 waves."""
+    from riprap.waves.analysis_window import few_waves_caution
+
+    caution = few_waves_caution(waves)
+    if caution is not None:
+        entry["caution"] = caution
+        report["cautions"].append(f"{name}: {caution}")
 
 
 def _three_gauge_entry(gauges, windows, triple, wave, regular):
