@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from riprap.work_estimate import MAX_CHECKPOINTS, MAX_FRAMES
+
 __all__ = [
     "FORMAT_VERSION",
     "MINIMUM_QUATERNION_NORM",
@@ -316,10 +318,12 @@ KEYS: tuple[Key, ...] = (
     Key("simulation", "gravity", "vector", "m/s^2", "Gravitational acceleration.",
         default=(0.0, 0.0, -9.81)),
     Key("simulation", "output_interval", "number", "s",
-        "Simulated time between two ParaView frames.", default=0.05, valid_range=_POSITIVE),
+        f"Simulated time between two ParaView frames; a run writes at most {MAX_FRAMES:,} "
+        "(end_time, or a placement's settle_time, over this).", default=0.05,
+        valid_range=_POSITIVE),
     Key("simulation", "checkpoint_interval", "number", "s",
-        "Simulated time between checkpoints; 0 writes one only at the end and on failure.",
-        default=0.0, valid_range=_NON_NEGATIVE),
+        "Simulated time between checkpoints; 0 writes one only at the end and on failure; at "
+        f"most {MAX_CHECKPOINTS:,} in a run.", default=0.0, valid_range=_NON_NEGATIVE),
     Key("simulation", "local_damping", "number", "-",
         "Cundall's non-viscous local damping: numerical damping, not physics; 0 switches it off.",
         default=0.0, valid_range=Range(minimum=0.0, maximum=1.0, maximum_inclusive=False)),
@@ -415,7 +419,8 @@ KEYS: tuple[Key, ...] = (
     Key("body_grids", "origin", "vector", "m", "Centroid of the first body of the grid."),
     Key("body_grids", "spacing", "vector", "m", "Distance between neighbouring centroids.",
         valid_range=_POSITIVE),
-    Key("body_grids", "counts", "integer_vector", "-", "Number of bodies along x, y and z.",
+    Key("body_grids", "counts", "integer_vector", "-",
+        f"Number of bodies along x, y and z; a case makes at most {MAXIMUM_BODY_COUNT:,} bodies.",
         valid_range=Range(minimum=1)),
     Key("body_grids", "orientation", "string", "-",
         "Orientation of each body: uniform random rotation or the shape's own frame.",
