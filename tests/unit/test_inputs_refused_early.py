@@ -110,6 +110,10 @@ BROKEN_CASES = {
         _edit(PLACEMENT, "dn50 = 0.2", "dn50 = 0.2\nsettle_time = 1.0e6")
         .replace("end_time = 1.0", "end_time = 1.0\noutput_interval = 10.0"), "place",
         ("steps of", "143 moving bodies")),
+    "a_billion_rock_shapes": (_edit(PLACEMENT, "dn50 = 0.2", "dn50 = 0.2\nrock_shapes = 1000000000"),
+                             "place", ("underlayer.rock_shapes = 1000000000", "[1, 1000]")),
+    "more_size_classes_than_shapes": (_edit(PLACEMENT, "dn50 = 0.2", "dn50 = 0.2\nsize_classes = 10"),
+                                      "place", ("underlayer.size_classes = 10", "rock_shapes = 6")),
     "units_wider_than_the_row": (_edit(PLACEMENT, "units_per_row = 3", "units_per_row = 7"),
                                  "place", ("units_per_row = 7", "3.5 m across", "3 m wide")),
     "three_metre_units_on_small_rocks": (

@@ -472,11 +472,13 @@ KEYS: tuple[Key, ...] = (
         valid_range=_POSITIVE),
     Key("underlayer", "dn85_over_dn15", "number", "-",
         "Grading width Dn85 / Dn15 (1 = uniform).", default=1.5, valid_range=Range(minimum=1.0)),
+    # Each rock shape is meshed before anything runs (a tenth of a second each): a thousand is
+    # already minutes of meshing, far more than a grading needs (6 by default).
     Key("underlayer", "rock_shapes", "integer", "-", "Distinct random rock shapes.", default=6,
-        valid_range=Range(minimum=1)),
+        valid_range=Range(minimum=1, maximum=1000)),
     Key("underlayer", "size_classes", "integer", "-",
-        "Sizes the grading is represented by (each shape is built at every size).", default=2,
-        valid_range=Range(minimum=1)),
+        "Sizes the grading is represented by (each shape is built at every size); at most "
+        "rock_shapes.", default=2, valid_range=Range(minimum=1, maximum=1000)),
     Key("underlayer", "layers", "integer", "-",
         "Rock layers in the start lattice (they settle into a rough bed).", default=2,
         valid_range=Range(minimum=1)),
