@@ -33,9 +33,10 @@ MEMORY_FRACTION = 0.8
 #: Most ParaView frames a run may write: a million, each a file per body set and one of the fluid
 #: (at the default 0.05 s, 14 hours of simulated time: a storm of thousands of waves fits).
 MAX_FRAMES = 1_000_000
-#: Most periodic checkpoints a run may write (each writes the whole state: a hundred thousand
-#: already spend more time writing than simulating).
-MAX_CHECKPOINTS = 100_000
+#: Most periodic checkpoints a run may write: each writes the whole state (and a fluid run takes
+#: a step to land on it), so more spend the run writing; one a minute of simulated time over a
+#: week-long storm is 10,080.
+MAX_CHECKPOINTS = 10_000
 
 
 class WorkTooLargeError(RiprapError):
