@@ -790,6 +790,9 @@ PLAUSIBLE: dict[tuple[str, str], Range] = {
     ("materials", "density"): _between(10.0, 25000.0),
     # Coulomb friction: ice on ice about 0.02, rock on rock 0.6-0.9, rubber on concrete up to 2
     ("materials", "friction_coefficient"): _between(0.0, 5.0),
+    # restitution: nearly plastic impacts (wet clay, about 0.05) to glass beads (0.95); below a
+    # thousandth the contact damping is far above critical and only shortens the step
+    ("materials", "restitution"): _between(1.0e-3, 1.0),
     # contact penalty: of the order of the Young's modulus of the softer body, gels (1e3 Pa) to
     # ten times diamond's (1.2e12 Pa)
     ("materials", "contact_penalty"): _between(1.0e3, 1.0e13),
