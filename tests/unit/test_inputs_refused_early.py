@@ -272,3 +272,49 @@ def test_frames_finer_than_the_step_end_with_the_run(case, tmp_path, capsys):
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["end_reason"] == "end_time" and summary["simulated_time"] >= 0.001 * (1 - 1e-9)
     assert 1 <= summary["frames"] <= 1001
+
+
+STACKED = """format_version = 1
+[simulation]
+end_time = 1.0
+[[materials]]
+name = "concrete"
+[[materials]]
+name = "rock"
+[slope]
+cotangent = 3.0
+width = 1.2
+length = 2.0
+face_material = "rock"
+side_wall_material = "rock"
+[underlayer]
+material = "rock"
+dn50 = 0.2
+layers = 1
+settle_time = 0.5
+[armour]
+unit = "cube"
+material = "concrete"
+height = 0.5
+[placement]
+grid_file = "stack.csv"
+release = "free_fall"
+settle_time = 1.5
+orientation = "random_within"
+max_tilt_deg = 0.0
+"""
+
+
+def test_place_flags_a_unit_that_lands_on_another_unit(tmp_path, capsys):
+    """Two cubes dropped one above the other (about 15 s): the upper one rests on the lower,
+    not on the underlayer, and place says so in summary.json and in a warning line."""
+    import json
+
+    (tmp_path / "stack.csv").write_text("x,y,z\n0.9,0.6,1.0\n0.9,0.6,1.6\n")
+    path = tmp_path / "stack.toml"
+    path.write_text(STACKED)
+    assert main(["place", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["units_not_on_underlayer"] == [1]
+    err = capsys.readouterr().err
+    assert "riprap: warning: 1 of 2 units rest on other units, not on the underlayer" in err
