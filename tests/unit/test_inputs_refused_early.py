@@ -274,35 +274,13 @@ def test_frames_finer_than_the_step_end_with_the_run(case, tmp_path, capsys):
     assert 1 <= summary["frames"] <= 1001
 
 
-STACKED = """format_version = 1
-[simulation]
-end_time = 1.0
-[[materials]]
-name = "concrete"
-[[materials]]
-name = "rock"
-[slope]
-cotangent = 3.0
-width = 1.2
-length = 2.0
-face_material = "rock"
-side_wall_material = "rock"
-[underlayer]
-material = "rock"
-dn50 = 0.2
-layers = 1
-settle_time = 0.5
-[armour]
-unit = "cube"
-material = "concrete"
-height = 0.5
-[placement]
-grid_file = "stack.csv"
-release = "free_fall"
-settle_time = 1.5
-orientation = "random_within"
-max_tilt_deg = 0.0
-"""
+# two cubes on a short, narrow 1:3 face, dropped one above the other from a grid file
+STACKED = (_edit(PLACEMENT, "cotangent = 1.5\nwidth = 3.0\nlength = 6.0",
+                 "cotangent = 3.0\nwidth = 1.2\nlength = 2.0")
+           .replace("dn50 = 0.2", "dn50 = 0.2\nlayers = 1\nsettle_time = 0.5")
+           .replace("rows = 3\nunits_per_row = 3",
+                    'grid_file = "stack.csv"\nrelease = "free_fall"\nsettle_time = 1.5\n'
+                    'orientation = "random_within"\nmax_tilt_deg = 0.0'))
 
 
 def test_place_flags_a_unit_that_lands_on_another_unit(tmp_path, capsys):
