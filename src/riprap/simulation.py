@@ -431,7 +431,7 @@ class Simulation:
         self.build_without_checks()
         check_rigid_run(end_time=self.end_time, time_step=solver.time_step,
                         moving_bodies=int((~solver.fixed).sum()), start_time=solver.time,
-                        setting_the_step=self._body_setting_the_step())
+                        setting_the_step=self._body_setting_the_step)
         if not self._restarted:
             self.check_start_overlaps()
 

@@ -33,9 +33,10 @@ MEMORY_FRACTION = 0.8
 #: Most ParaView frames a run may write: a million, each a file per body set and one of the fluid
 #: (at the default 0.05 s, 14 hours of simulated time: a storm of thousands of waves fits).
 MAX_FRAMES = 1_000_000
-#: Most periodic checkpoints a run may write (each writes the whole state: a hundred thousand
-#: already spend more time writing than simulating).
-MAX_CHECKPOINTS = 100_000
+#: Most periodic checkpoints a run may write: each writes the whole state (and a fluid run takes
+#: a step to land on it), so more spend the run writing; one a minute of simulated time over a
+#: week-long storm is 10,080.
+MAX_CHECKPOINTS = 10_000
 
 
 class WorkTooLargeError(RiprapError):
@@ -55,17 +56,19 @@ def _duration(seconds: float) -> str:
 
 
 def check_rigid_run(*, end_time: float, time_step: float, moving_bodies: int,
-                    start_time: float = 0.0, setting_the_step: str = "",
+                    start_time: float = 0.0, setting_the_step=None,
                     end_key: str = "end_time") -> None:
     """Refuse (or warn about) a rigid run of ``(end_time - start_time) / time_step`` steps;
-    ``setting_the_step`` names the body whose mass and stiffness chose the step, if known."""
+    ``setting_the_step()``, if given, names the body whose mass and stiffness chose the step
+    (asked only when refusing)."""
     steps = max(end_time - start_time, 0.0) / time_step
     seconds = steps * max(moving_bodies, 1) / RIGID_BODY_STEPS_PER_SECOND
     figure = (f"{steps:.3g} steps of {time_step:.3g} s for {end_time - start_time:.3g} s of "
               f"simulated time with {moving_bodies} moving bodies: about {_duration(seconds)} at "
               f"{RIGID_BODY_STEPS_PER_SECOND:.0e} body-steps/s")
     if steps > REFUSE_STEPS or seconds > REFUSE_WALL_SECONDS:
-        which = f" ({setting_the_step})" if setting_the_step else ""
+        body = setting_the_step() if setting_the_step is not None else ""
+        which = f" ({body})" if body else ""
         raise WorkTooLargeError(
             f"the run would take {figure}. The time step comes from the smallest, lightest "
             f"body{which} and the contact stiffness: check the sizes (in metres), densities and "

@@ -55,7 +55,7 @@ BROKEN_CASES = {
         ("simulation.output_interval = 1e-300", "frames", "1000000")),
     "checkpoint_interval_1e-9": (
         _edit(FLUID, "end_time = 0.01", "end_time = 0.01\ncheckpoint_interval = 1e-9"), "run",
-        ("simulation.checkpoint_interval = 1e-09", "checkpoints", "100000")),
+        ("simulation.checkpoint_interval = 1e-09", "checkpoints", "10000")),
     # body counts and integers
     "body_grid_of_ten_trillion": (RIGID + _GRID.format("100000, 100000, 1000"), "run",
                                   ("body_grids[0].counts", "1e+13 bodies", "1,000,000")),
@@ -110,6 +110,10 @@ BROKEN_CASES = {
         _edit(PLACEMENT, "dn50 = 0.2", "dn50 = 0.2\nsettle_time = 1.0e6")
         .replace("end_time = 1.0", "end_time = 1.0\noutput_interval = 10.0"), "place",
         ("steps of", "143 moving bodies")),
+    "a_billion_rock_shapes": (_edit(PLACEMENT, "dn50 = 0.2", "dn50 = 0.2\nrock_shapes = 1000000000"),
+                             "place", ("underlayer.rock_shapes = 1000000000", "[1, 1000]")),
+    "more_size_classes_than_shapes": (_edit(PLACEMENT, "dn50 = 0.2", "dn50 = 0.2\nsize_classes = 10"),
+                                      "place", ("underlayer.size_classes = 10", "rock_shapes = 6")),
     "units_wider_than_the_row": (_edit(PLACEMENT, "units_per_row = 3", "units_per_row = 7"),
                                  "place", ("units_per_row = 7", "3.5 m across", "3 m wide")),
     "three_metre_units_on_small_rocks": (
@@ -179,7 +183,7 @@ def test_a_simulation_refuses_a_schedule_that_cannot_advance():
         Simulation(end_time=1.0, output_interval=1e-300)
     with pytest.raises(CaseFileError, match="checkpoint_interval = 1e-09"):
         Simulation(end_time=1.0, checkpoint_interval=1e-9)
-    Simulation(end_time=1.0, output_interval=1e-6, checkpoint_interval=1e-5)   # at the limits
+    Simulation(end_time=1.0, output_interval=1e-6, checkpoint_interval=1e-4)   # at the limits
 
 
 class _StuckModel:
@@ -251,3 +255,44 @@ def test_units_resting_on_units_only_are_listed():
     # face, unit 3 (body 5) on unit 2 and against a side wall only
     flags = _units_not_on_underlayer(solver, np.array([2, 3, 4, 5]), n_rocks=2)
     assert flags.tolist() == [False, False, False, True]
+
+
+@pytest.mark.parametrize("case", ["rigid", "fluid"])
+def test_frames_finer_than_the_step_end_with_the_run(case, tmp_path, capsys):
+    """Frame and checkpoint times closer than the time step: the run skips the ones a step jumps
+    over and ends, its frame count within the schedule's."""
+    import json
+
+    text = RIGID if case == "rigid" else FLUID
+    text = _edit(text, "end_time = 0.01", "end_time = 0.001\noutput_interval = 1e-6\n"
+                 "checkpoint_interval = 1e-6") + "[output]\nparaview = false\npicture = false\n"
+    path = tmp_path / "fine.toml"
+    path.write_text(text)
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["end_reason"] == "end_time" and summary["simulated_time"] >= 0.001 * (1 - 1e-9)
+    assert 1 <= summary["frames"] <= 1001
+
+
+# two cubes on a short, narrow 1:3 face, dropped one above the other from a grid file
+STACKED = (_edit(PLACEMENT, "cotangent = 1.5\nwidth = 3.0\nlength = 6.0",
+                 "cotangent = 3.0\nwidth = 1.2\nlength = 2.0")
+           .replace("dn50 = 0.2", "dn50 = 0.2\nlayers = 1\nsettle_time = 0.5")
+           .replace("rows = 3\nunits_per_row = 3",
+                    'grid_file = "stack.csv"\nrelease = "free_fall"\nsettle_time = 1.5\n'
+                    'orientation = "random_within"\nmax_tilt_deg = 0.0'))
+
+
+def test_place_flags_a_unit_that_lands_on_another_unit(tmp_path, capsys):
+    """Two cubes dropped one above the other (about 15 s): the upper one rests on the lower,
+    not on the underlayer, and place says so in summary.json and in a warning line."""
+    import json
+
+    (tmp_path / "stack.csv").write_text("x,y,z\n0.9,0.6,1.0\n0.9,0.6,1.6\n")
+    path = tmp_path / "stack.toml"
+    path.write_text(STACKED)
+    assert main(["place", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["units_not_on_underlayer"] == [1]
+    err = capsys.readouterr().err
+    assert "riprap: warning: 1 of 2 units rest on other units, not on the underlayer" in err

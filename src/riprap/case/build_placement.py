@@ -120,7 +120,10 @@ def prepare_placement(case) -> PlacementInputs:
     # the underlayer's start lattice, as build_underlayer lays it (it refuses a band holding no
     # rock, or too many)
     shapes = rock_shapes(rocks)
-    lattice = rock_lattice(slope, shapes, (ul.from_s, ul.to_s or slope.length), ul.layers)
+    try:
+        lattice = rock_lattice(slope, shapes, (ul.from_s, ul.to_s or slope.length), ul.layers)
+    except CaseFileError as error:
+        raise CaseFileError(f"{case.source}: {error}") from None
     units = len(grid.positions) if grid is not None else _unit_count(pl)
     _check_work(case, materials, shapes, unit, rocks=len(lattice), units=units)
     return PlacementInputs(slope=slope, materials=materials, unit=unit, rocks=rocks, grid=grid,
@@ -169,9 +172,12 @@ def _check_design_grid(case, slope, unit) -> None:
                             f"{MAXIMUM_BODY_COUNT:,} bodies a case may have")
     # the centroids' height above the face is the underlayer's business; 0 here changes
     # neither the rows along the face nor the units' widths
-    generated = _design_grid(case, slope, unit, centroid_height=0.0)
-    check_generated_positions(slope, unit, generated.positions,
-                              _orientations(case, slope, len(generated.positions), None))
+    try:
+        generated = _design_grid(case, slope, unit, centroid_height=0.0)
+        check_generated_positions(slope, unit, generated.positions,
+                                  _orientations(case, slope, len(generated.positions), None))
+    except CaseFileError as error:
+        raise CaseFileError(f"{case.source}: [placement] {error}") from None
 
 
 def _design_grid(case, slope, unit, *, centroid_height: float):

@@ -102,6 +102,11 @@ def _check_placement(tables: Tables, add: Callable, ok: Callable) -> None:
         if len(sizes) != 1:
             add(("armour",), "give exactly one of height, nominal_diameter and mass (> 0); got "
                 + (", ".join(sizes) or "none"))
+    if underlayer and ok(underlayer["rock_shapes"], underlayer["size_classes"]) \
+            and underlayer["size_classes"] > underlayer["rock_shapes"]:
+        add(("underlayer", "size_classes"), f"more than rock_shapes = "
+            f"{underlayer['rock_shapes']}: every size class needs a shape of its own",
+            underlayer["size_classes"])
     if slope and underlayer and ok(slope["length"], underlayer["from_s"], underlayer["to_s"]):
         length, low = slope["length"], underlayer["from_s"]
         high = underlayer["to_s"] or length

@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from riprap.work_estimate import MAX_CHECKPOINTS, MAX_FRAMES
+
 __all__ = [
     "FORMAT_VERSION",
     "MINIMUM_QUATERNION_NORM",
@@ -316,10 +318,12 @@ KEYS: tuple[Key, ...] = (
     Key("simulation", "gravity", "vector", "m/s^2", "Gravitational acceleration.",
         default=(0.0, 0.0, -9.81)),
     Key("simulation", "output_interval", "number", "s",
-        "Simulated time between two ParaView frames.", default=0.05, valid_range=_POSITIVE),
+        f"Simulated time between two ParaView frames; a run writes at most {MAX_FRAMES:,} "
+        "(end_time, or a placement's settle_time, over this).", default=0.05,
+        valid_range=_POSITIVE),
     Key("simulation", "checkpoint_interval", "number", "s",
-        "Simulated time between checkpoints; 0 writes one only at the end and on failure.",
-        default=0.0, valid_range=_NON_NEGATIVE),
+        "Simulated time between checkpoints; 0 writes one only at the end and on failure; at "
+        f"most {MAX_CHECKPOINTS:,} in a run.", default=0.0, valid_range=_NON_NEGATIVE),
     Key("simulation", "local_damping", "number", "-",
         "Cundall's non-viscous local damping: numerical damping, not physics; 0 switches it off.",
         default=0.0, valid_range=Range(minimum=0.0, maximum=1.0, maximum_inclusive=False)),
@@ -415,7 +419,8 @@ KEYS: tuple[Key, ...] = (
     Key("body_grids", "origin", "vector", "m", "Centroid of the first body of the grid."),
     Key("body_grids", "spacing", "vector", "m", "Distance between neighbouring centroids.",
         valid_range=_POSITIVE),
-    Key("body_grids", "counts", "integer_vector", "-", "Number of bodies along x, y and z.",
+    Key("body_grids", "counts", "integer_vector", "-",
+        f"Number of bodies along x, y and z; a case makes at most {MAXIMUM_BODY_COUNT:,} bodies.",
         valid_range=Range(minimum=1)),
     Key("body_grids", "orientation", "string", "-",
         "Orientation of each body: uniform random rotation or the shape's own frame.",
@@ -467,11 +472,13 @@ KEYS: tuple[Key, ...] = (
         valid_range=_POSITIVE),
     Key("underlayer", "dn85_over_dn15", "number", "-",
         "Grading width Dn85 / Dn15 (1 = uniform).", default=1.5, valid_range=Range(minimum=1.0)),
+    # Each rock shape is meshed before anything runs (a tenth of a second each): a thousand is
+    # already minutes of meshing, far more than a grading needs (6 by default).
     Key("underlayer", "rock_shapes", "integer", "-", "Distinct random rock shapes.", default=6,
-        valid_range=Range(minimum=1)),
+        valid_range=Range(minimum=1, maximum=1000)),
     Key("underlayer", "size_classes", "integer", "-",
-        "Sizes the grading is represented by (each shape is built at every size).", default=2,
-        valid_range=Range(minimum=1)),
+        "Sizes the grading is represented by (each shape is built at every size); at most "
+        "rock_shapes.", default=2, valid_range=Range(minimum=1, maximum=1000)),
     Key("underlayer", "layers", "integer", "-",
         "Rock layers in the start lattice (they settle into a rough bed).", default=2,
         valid_range=Range(minimum=1)),
@@ -783,6 +790,9 @@ PLAUSIBLE: dict[tuple[str, str], Range] = {
     ("materials", "density"): _between(10.0, 25000.0),
     # Coulomb friction: ice on ice about 0.02, rock on rock 0.6-0.9, rubber on concrete up to 2
     ("materials", "friction_coefficient"): _between(0.0, 5.0),
+    # restitution: nearly plastic impacts (wet clay, about 0.05) to glass beads (0.95); below a
+    # thousandth the contact damping is far above critical and only shortens the step
+    ("materials", "restitution"): _between(1.0e-3, 1.0),
     # contact penalty: of the order of the Young's modulus of the softer body, gels (1e3 Pa) to
     # ten times diamond's (1.2e12 Pa)
     ("materials", "contact_penalty"): _between(1.0e3, 1.0e13),

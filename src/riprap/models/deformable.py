@@ -211,11 +211,16 @@ class DeformableModel(Model):
         n = min(self._steps_at(until) - system.step_count, self._chunk)
         target = system.step_count + n
         tick = wallclock.perf_counter()
-        while system.step_count < target:
+        for _ in range(max(n, 0)):          # every pass makes at least one step
+            if system.step_count >= target:
+                break
             next_record = (system.step_count // RECORD_EVERY_STEPS + 1) * RECORD_EVERY_STEPS
             self._step(min(target, next_record) - system.step_count)
             if system.step_count % RECORD_EVERY_STEPS == 0:
                 self._record_stresses()
+        if system.step_count < target:
+            raise RiprapError(f"the deformable bodies made {n - (target - system.step_count)} of "
+                              f"{n} steps at t = {system.time:.6g} s and stopped; report it")
         elapsed = wallclock.perf_counter() - tick
         self._chunk = max(1, min(1_000_000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
 

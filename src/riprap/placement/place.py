@@ -181,11 +181,11 @@ def rock_lattice(slope, shapes, s_range, layers: int) -> np.ndarray:
 
 
 def free_body_time_step(shapes, materials: PlacementMaterials, material: str,
-                        **run) -> tuple[float, str]:
+                        **run) -> tuple[float, object]:
     """The time step a placement run of free bodies of ``shapes`` (of ``material``) starts
     with: the one its ``Simulation`` chooses from their masses and the contact stiffness (rocks
     held fixed do not count), found without running, for the work estimate before the runs;
-    with the shape that sets it, in words."""
+    with a function naming the shape that sets it."""
     sim = Simulation(**_run_settings(run))
     for m in materials.all():
         sim.add_material(m)
@@ -195,7 +195,7 @@ def free_body_time_step(shapes, materials: PlacementMaterials, material: str,
         sim.add_body(shape=shape.name, material=material,
                      position=(0.0, 0.0, 10.0 * k * (1.0 + shape.bounding_radius)))
     sim.build_without_checks()
-    return sim.solver.time_step, sim._body_setting_the_step(numbered=False)
+    return sim.solver.time_step, lambda: sim._body_setting_the_step(numbered=False)
 
 
 def _stick_to_face(sim: Simulation) -> bool:
