@@ -97,9 +97,11 @@ def prepare_placement(case) -> PlacementInputs:
                                    side_wall=_material(case, sl.side_wall_material))
     grid = None
     if pl.grid_file:
+        from riprap.case.body_start import check_grid_starts
         from riprap.io.grid_file import read_grid_file
 
         grid = read_grid_file(case.base_dir / pl.grid_file)
+        check_grid_starts(grid)
     unit = _armour_unit(case)
     if grid is not None:
         from riprap.placement.place import check_start_positions
