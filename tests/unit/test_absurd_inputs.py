@@ -252,3 +252,12 @@ def test_a_wall_normal_of_1e308_is_a_direction(tmp_path, capsys):
     path = tmp_path / "normal.toml"
     path.write_text(_edit(RIGID, "normal = [0.0, 0.0, 1.0]", "normal = [0.0, 0.0, 1e308]"))
     assert main(["check", str(path)]) == 0, capsys.readouterr().err
+
+
+def test_a_fluid_step_needing_too_many_contact_sub_steps_stops_the_run():
+    from riprap.coupling.coupled import MAXIMUM_SUBSTEPS, check_substeps
+    from riprap.errors import InstabilityError
+
+    check_substeps(MAXIMUM_SUBSTEPS, 1e-3, 1e-8)
+    with pytest.raises(InstabilityError, match="contact sub-steps"):
+        check_substeps(MAXIMUM_SUBSTEPS + 1, 1e-3, 1e-9)
