@@ -477,11 +477,10 @@ class DeformableSystem:
                              damping: float) -> str:
         """Which [deformable] key made the stable step ``step`` zero, infinite or not a number."""
         omega = math.hypot(omega_elements, omega_contact)
-        joints = [b.joint_frequency() for b in self.bodies if hasattr(b, "joint_frequency")]
+        jointed = [b for b in self.bodies if hasattr(b, "joint_frequency")]
         material = self.bodies[0].material
-        if joints and not math.isfinite(max(joints)):
-            penalty = self.bodies[[hasattr(b, "joint_frequency") for b in self.bodies].index(True)
-                                  ].joint_material.joint_penalty
+        if not all(math.isfinite(b.joint_frequency()) for b in jointed):
+            penalty = jointed[0].joint_material.joint_penalty
             cause = f"joint_penalty = {penalty:g} Pa/m makes the joints infinitely stiff"
         elif (not math.isfinite(omega_elements) or omega_elements == 0.0
               or not math.isfinite(damping)):
