@@ -88,6 +88,8 @@ ABSURD_CASES = {
                                   "run", ["[waves]", "duration = 1e+308", "components"]),
     "joint_penalty_1e308": (DEFORMABLE + "joint_penalty = 1e308\n", "run",
                             ["[deformable]", "joint_penalty = 1e+308", "time step"]),
+    "deformable_viscosity_1e20": (DEFORMABLE + "viscosity = 1e20\n", "run",
+                                  ["[deformable]", "viscosity = 1e+20", "time step"]),
     "young_modulus_1e308": (_edit(DEFORMABLE, "young_modulus = 1e9", "young_modulus = 1e308"),
                             "run", ["[deformable]", "young_modulus = 1e+308"]),
     "overlapping_tetrahedron_in_a_volume_mesh": (MESH_FILE_CASE, "run",
