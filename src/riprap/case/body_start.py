@@ -85,6 +85,8 @@ def _check_speed(where: str, key: str, vector) -> None:
 def _listed(values) -> str:
     """A vector (or a list of points) as the user typed it: [0, 0, 1e+308], not numpy's repr."""
     values = np.asarray(values, dtype=float)
+    if values.ndim == 0:
+        return f"{float(values):g}"
     if values.ndim > 1:
         return "[" + ", ".join(_listed(row) for row in values) + "]"
     return "[" + ", ".join(f"{float(v):g}" for v in values.reshape(-1)) + "]"
