@@ -18,7 +18,7 @@ import pytest
 
 from riprap.cli import main
 from riprap.errors import CaseFileError
-from test_cli_bad_inputs import FLUID, RIGID, _edit
+from test_cli_bad_inputs import FLUID, PLACEMENT, RIGID, _edit
 
 # RIGID's one body spinning or placed far away; FLUID with a body, a flume, porous zones.
 BODY_IN_WATER = (_edit(_edit(FLUID, "upper = [0.2, 0.02, 0.1]", "upper = [0.2, 0.2, 0.1]"),
@@ -88,6 +88,8 @@ ABSURD_CASES = {
                                   "run", ["[waves]", "duration = 1e+308", "components"]),
     "joint_penalty_1e308": (DEFORMABLE + "joint_penalty = 1e308\n", "run",
                             ["[deformable]", "joint_penalty = 1e+308", "time step"]),
+    "deformable_viscosity_1e20": (DEFORMABLE + "viscosity = 1e20\n", "run",
+                                  ["[deformable]", "viscosity = 1e+20", "time step"]),
     "young_modulus_1e308": (_edit(DEFORMABLE, "young_modulus = 1e9", "young_modulus = 1e308"),
                             "run", ["[deformable]", "young_modulus = 1e+308"]),
     "overlapping_tetrahedron_in_a_volume_mesh": (MESH_FILE_CASE, "run",
@@ -98,12 +100,21 @@ ABSURD_CASES = {
     "pack_that_includes_itself": ('format_version = 1\npack = "a.toml"\n[simulation]\n'
                                   'end_time = 0.01\n', "run",
                                   ["a.toml -> ", "b.toml -> ", "includes itself"]),
+    "fluid_box_to_1e308": (_edit(FLUID, "upper = [0.2, 0.02, 0.1]", "upper = [1e308, 0.02, 0.1]"),
+                           "run", ["[fluid]", "upper", "1e+308"]),
+    "wall_point_at_1e308": (_edit(RIGID, "point = [0.0, 0.0, 0.0]", "point = [0.0, 0.0, 1e308]"),
+                            "run", ["[[walls]] entry 1", "point"]),
+    "porous_stone_diameter_1e-308": (FLUME + POROUS.format("[[3.0, 0.0], [4.0, 0.3], [4.0, 0.0]]")
+                                     .replace("stone_diameter = 0.02", "stone_diameter = 1e-308"),
+                                     "run", ["[[porous_zones]] entry 1", "stone_diameter"]),
+    "grid_file_row_at_1e308": (_edit(PLACEMENT, "rows = 3\nunits_per_row = 3",
+                                     'grid_file = "far_grid.csv"'), "place", ["far_grid.csv:3"]),
+    "mesh_file_scale_1e150": (_edit(MESH_FILE_CASE, 'file = "cube.vtu"',
+                                    'file = "good_cube.vtu"\nscale = 1e150'), "run",
+                              ["[[shapes]] 'cube'", "scale", "good_cube.vtu"]),
+    "mesh_file_vertex_at_1e300": (_edit(MESH_FILE_CASE, 'file = "cube.vtu"', 'file = "far.vtu"'),
+                                  "run", ["far.vtu", "from the origin"]),
 }
-
-# Cases that need a check only a run's own set-up reaches (all-deformable cases are checked by
-# riprap check once it builds them; see issue 35's other parts).
-RUN_ONLY = {"joint_penalty_1e308", "young_modulus_1e308"}
-
 
 def _write_inputs(tmp_path):
     """The files the cases name: a cube mesh with one extra tetrahedron inside it (about 1 % more
@@ -117,6 +128,9 @@ def _write_inputs(tmp_path):
     n = len(cube.nodes)
     meshio.write(tmp_path / "cube.vtu", meshio.Mesh(
         np.vstack([cube.nodes, extra]), [("tetra", np.vstack([cube.tets, [[n, n + 1, n + 2, n + 3]]]))]))
+    meshio.write(tmp_path / "good_cube.vtu", meshio.Mesh(cube.nodes, [("tetra", cube.tets)]))
+    meshio.write(tmp_path / "far.vtu", meshio.Mesh(cube.nodes + 1e300, [("tetra", cube.tets)]))
+    (tmp_path / "far_grid.csv").write_text("x,y,z\n1.0,1.0,1.0\n1e308,1.0,1.0\n")
     (tmp_path / "plain.toml").write_text(RIGID)
     pack_tables = RIGID.split("\n", 1)[1]
     (tmp_path / "a.toml").write_text(PACK_HEADER + 'format_version = 1\npack = "b.toml"\n'
@@ -137,8 +151,6 @@ def test_absurd_input_is_refused_by_run_and_check(name, tmp_path, capsys, monkey
     error = capsys.readouterr().err
     _assert_one_named_line(error, phrases)
     assert not (out / "summary.json").exists(), "nothing was simulated"
-    if name in RUN_ONLY:
-        return
     assert main(["check", str(path)]) == 2
     _assert_one_named_line(capsys.readouterr().err, phrases)
 
@@ -228,3 +240,19 @@ def test_a_state_turning_non_finite_stops_with_the_failure_checkpoint(model, tmp
     assert "Traceback" not in error and "did not expect" not in error, error
     assert (out / "failure_checkpoint.npz").is_file(), error
     assert not (out / "summary.json").exists()
+
+
+def test_a_wall_normal_of_1e308_is_a_direction(tmp_path, capsys):
+    """Directions are normalised without squaring (1e308 squared overflows to a zero normal)."""
+    path = tmp_path / "normal.toml"
+    path.write_text(_edit(RIGID, "normal = [0.0, 0.0, 1.0]", "normal = [0.0, 0.0, 1e308]"))
+    assert main(["check", str(path)]) == 0, capsys.readouterr().err
+
+
+def test_a_fluid_step_needing_too_many_contact_sub_steps_stops_the_run():
+    from riprap.coupling.coupled import MAXIMUM_SUBSTEPS, check_substeps
+    from riprap.errors import InstabilityError
+
+    check_substeps(MAXIMUM_SUBSTEPS, 1e-3, 1e-8)
+    with pytest.raises(InstabilityError, match="contact sub-steps"):
+        check_substeps(MAXIMUM_SUBSTEPS + 1, 1e-3, 1e-9)

@@ -10,13 +10,11 @@ import math
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.geometry.meshing import LARGEST_COORDINATE
 
 __all__ = ["LARGEST_COORDINATE", "START_SPEED_LIMIT", "check_body_starts", "check_coordinates",
-           "shape_radius"]
+           "check_grid_starts", "shape_radius"]
 
-#: Largest coordinate (m) anywhere in a case: the earth's radius is 6.4e6 m, and float64 still
-#: resolves 1e-9 m at this distance from the origin, well below any contact overlap.
-LARGEST_COORDINATE = 1.0e7
 
 #: Fastest start speed (m/s) of a body's centroid or of its surface from its spin: ten times the
 #: fastest water of a breaking storm wave; an armour unit dropped from 50 m reaches 31 m/s.
@@ -66,8 +64,18 @@ def check_body_starts(case, radius_of) -> None:
         _check_speed(where, "velocity", grid.velocity)
 
 
+def check_grid_starts(grid) -> None:
+    """Check the rows of a placement grid file (``riprap.io.grid_file.GridPoints``): positions
+    and start velocities, naming the file and line."""
+    for k, line in enumerate(grid.lines):
+        where = f"{grid.source}:{int(line)}"
+        check_coordinates(where, "x, y, z", grid.positions[k])
+        if grid.velocities is not None:
+            _check_speed(where, "velocity", grid.velocities[k])
+
+
 def _check_speed(where: str, key: str, vector) -> None:
-    speed = math.hypot(*vector)
+    speed = math.hypot(*(float(v) for v in vector))
     if not speed <= START_SPEED_LIMIT:
         raise CaseFileError(f"{where}: {key} = {_listed(vector)} m/s starts the body at "
                             f"{speed:.3g} m/s, faster than {START_SPEED_LIMIT:g} m/s, which no "
@@ -77,6 +85,8 @@ def _check_speed(where: str, key: str, vector) -> None:
 def _listed(values) -> str:
     """A vector (or a list of points) as the user typed it: [0, 0, 1e+308], not numpy's repr."""
     values = np.asarray(values, dtype=float)
+    if values.ndim == 0:
+        return f"{float(values):g}"
     if values.ndim > 1:
         return "[" + ", ".join(_listed(row) for row in values) + "]"
     return "[" + ", ".join(f"{float(v):g}" for v in values.reshape(-1)) + "]"

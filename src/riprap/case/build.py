@@ -40,6 +40,13 @@ def build_shape(spec) -> TetMesh:
         mesh = read_mesh(p["file"], mesh_size=mesh_size)
         scale = float(p.get("scale", 1.0))
         if scale != 1.0:
+            from riprap.geometry.meshing import check_body_length
+
+            # the scaled body must be a size riprap meshes: a scale of 1e150 overflows its volume
+            extent = float(np.ptp(mesh.nodes, axis=0).max())
+            with np.errstate(over="ignore", under="ignore"):
+                check_body_length(np.float64(extent) * scale, "scale x the mesh's extent",
+                                  f"mesh_file '{p['file']}' (extent {extent:.4g} m, scale {scale:g})")
             mesh = TetMesh(nodes=mesh.nodes * scale, tets=mesh.tets, name=mesh.name)
         return mesh
     builders = {

@@ -102,9 +102,11 @@ def prepare_placement(case) -> PlacementInputs:
                                    side_wall=_material(case, sl.side_wall_material))
     grid = None
     if pl.grid_file:
+        from riprap.case.body_start import check_grid_starts
         from riprap.io.grid_file import read_grid_file
 
         grid = read_grid_file(case.base_dir / pl.grid_file)
+        check_grid_starts(grid)
     unit = _armour_unit(case)
     check_filter_rule(nominal_diameter=unit.nominal_diameter, dn50=ul.dn50, unit=case.armour.unit,
                       where=case.source)

@@ -55,9 +55,9 @@ def build_waves(case, solver) -> None:
                                 f"gravity is {list(case.simulation.gravity)}")
         try:
             wave = wave_of(spec, level - bottom, case.simulation.end_time, gravity)
+            wave_length = wave.wave_length
         except CaseFileError as error:
             raise CaseFileError(f"{where}: {error}") from None
-        wave_length = wave.wave_length
         boundary = spec.generation == "boundary"
         if boundary and spec.generation_zone:
             raise CaseFileError(f"{where}: generation_zone = {spec.generation_zone:g} m is given with "

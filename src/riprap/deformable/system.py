@@ -27,6 +27,10 @@ from riprap.errors import CaseFileError
 from riprap.geometry.meshing import boundary_tet_heights
 from riprap.geometry.tetmesh import TetMesh
 
+# A stable step below this (s) comes from a key in the wrong unit, not from a mesh: a millimetre
+# element of the stiffest concrete takes about 1e-7 s.
+_SMALLEST_STABLE_STEP = 1e-20
+
 
 class DeformableSystem:
     """Deformable bodies in contact with each other and with half-space walls.
@@ -467,7 +471,7 @@ class DeformableSystem:
         damping = max(b.material.viscous_time_constant for b in self.bodies)
         step = stable_step_for(math.hypot(omega_elements, omega_contact), damping,
                                self.mass_damping)
-        if not (math.isfinite(step) and step > 0.0):
+        if not (math.isfinite(step) and step > _SMALLEST_STABLE_STEP):
             raise CaseFileError(self._unstable_step_cause(step, omega_elements, omega_contact,
                                                           damping))
         self._stable_time_step = step
@@ -475,13 +479,13 @@ class DeformableSystem:
 
     def _unstable_step_cause(self, step: float, omega_elements: float, omega_contact: float,
                              damping: float) -> str:
-        """Which [deformable] key made the stable step ``step`` zero, infinite or not a number."""
+        """Which [deformable] key made the stable step ``step`` absurdly small, infinite or not a
+        number."""
         omega = math.hypot(omega_elements, omega_contact)
-        joints = [b.joint_frequency() for b in self.bodies if hasattr(b, "joint_frequency")]
+        jointed = [b for b in self.bodies if hasattr(b, "joint_frequency")]
         material = self.bodies[0].material
-        if joints and not math.isfinite(max(joints)):
-            penalty = self.bodies[[hasattr(b, "joint_frequency") for b in self.bodies].index(True)
-                                  ].joint_material.joint_penalty
+        if not all(math.isfinite(b.joint_frequency()) for b in jointed):
+            penalty = jointed[0].joint_material.joint_penalty
             cause = f"joint_penalty = {penalty:g} Pa/m makes the joints infinitely stiff"
         elif (not math.isfinite(omega_elements) or omega_elements == 0.0
               or not math.isfinite(damping)):

@@ -54,6 +54,9 @@ MIN_ACCEPTED_QUALITY = 0.05
 # grains to caisson-sized units) lies outside this range.
 MIN_BODY_LENGTH = 1e-5
 MAX_BODY_LENGTH = 1e4
+#: Largest coordinate (m) anywhere in a case or mesh file: the earth's radius is 6.4e6 m, and
+#: float64 still resolves 1e-9 m at this distance from the origin, well below any contact overlap.
+LARGEST_COORDINATE = 1.0e7
 
 # A shape is refused before meshing if its estimated tetrahedron count exceeds this: 2e6
 # tetrahedra take minutes and gigabytes in gmsh, and contact on them would be hopeless.

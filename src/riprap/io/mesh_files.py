@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import MeshError
-from riprap.geometry.meshing import tetrahedralize_surface
+from riprap.geometry.meshing import (LARGEST_COORDINATE, MAX_BODY_LENGTH, MIN_BODY_LENGTH,
+                                      tetrahedralize_surface)
 from riprap.geometry.surface_checks import check_closed_surface
 from riprap.geometry.tetmesh import TetMesh
 
@@ -98,7 +99,30 @@ def _check_indices(cells: np.ndarray, n_points: int, first_cell: int, what: tupl
     )
 
 
+# A mesh file may be in another unit than metres (a shape's scale converts it): its sizes are
+# checked against riprap's body sizes widened by this factor, the scaled body against them exactly.
+_FILE_UNITS = 1.0e3
+
+
 def _check_finite_points(points: np.ndarray, used: np.ndarray, path: Path, one_based: bool) -> None:
+    _check_finite(points, used, path, one_based)
+    # Sizes and places the numerics can carry: a body 1e300 m across overflows its inertia, one
+    # 1e-300 m across or 1e300 m from the origin has tetrahedra of no volume in float64. The file
+    # may be in millimetres (a shape's scale converts it), hence the factor.
+    corners = points[used]
+    farthest = float(np.abs(corners).max(initial=0.0))
+    if farthest > _FILE_UNITS * LARGEST_COORDINATE:
+        raise MeshError(f"mesh file '{path}': a vertex lies {farthest:.3g} from the origin, beyond "
+                        f"{_FILE_UNITS * LARGEST_COORDINATE:g} (even in millimetres); move the body "
+                        "near the origin (bodies are placed by their centroid)")
+    extent = float(np.ptp(corners, axis=0).max()) if len(corners) else 0.0
+    if not MIN_BODY_LENGTH / _FILE_UNITS <= extent <= MAX_BODY_LENGTH * _FILE_UNITS:
+        raise MeshError(f"mesh file '{path}': the body is {extent:.3g} across, outside the sizes "
+                        f"riprap meshes ({MIN_BODY_LENGTH:g} m to {MAX_BODY_LENGTH:g} m, in any "
+                        "unit a shape's scale converts from); write the file in metres")
+
+
+def _check_finite(points: np.ndarray, used: np.ndarray, path: Path, one_based: bool) -> None:
     bad = used[~np.isfinite(points[used]).all(axis=1)]
     if bad.size:
         offset = 1 if one_based else 0

@@ -558,5 +558,6 @@ class DeformableModel(Model):
                    if s.fracturing_bodies else {})}
 
     def failure_advice(self, good: dict) -> str:
-        return ("An element inverted: the time step may be too long for the contact penalty, or "
-                "the loads too large for the mesh; see units.csv and the last frames.")
+        return ("An element inverted or a node's state became non-finite: the time step may be "
+                "too long for the contact penalty, or the loads or start velocities too large for "
+                "the mesh; see units.csv and the last frames.")

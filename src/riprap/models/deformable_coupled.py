@@ -132,5 +132,5 @@ class DeformableCoupledModel(CoupledModel):
         return fields
 
     def failure_advice(self, good: dict) -> str:
-        return (super().failure_advice(good) + " An element that inverted: " +
+        return (super().failure_advice(good) + " For the deformable bodies: " +
                 self.stresses.failure_advice(good))

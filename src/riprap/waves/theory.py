@@ -35,6 +35,11 @@ def wave_number(period: float, depth: float, gravity: float = GRAVITY) -> float:
         raise CaseFileError(f"waves: period ({period!r} s) and depth ({depth!r} m) must be positive")
     omega = 2.0 * math.pi / period
     deep = omega * omega / gravity
+    if not (math.isfinite(deep) and deep * depth > 1e-200):
+        # omega^2 underflows to 0 (or overflows) for a period near 1e308 (or 1e-308) s
+        raise CaseFileError(f"waves: period = {period:g} s makes no wave in water {depth:g} m deep "
+                            "(its frequency squared is not a float64 number); give the period in "
+                            "seconds")
     k = deep / math.tanh((deep * depth) ** 0.75) ** (2.0 / 3.0)
     for _ in range(50):
         t = math.tanh(k * depth)
