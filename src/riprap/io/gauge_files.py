@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_gauges_csv", "gauges_png", "write_waves_report"]
+__all__ = ["write_gauges_csv", "read_gauges_csv", "gauges_png", "write_waves_report"]
 
 
 def write_gauges_csv(path, gauges) -> Path:
@@ -18,6 +18,45 @@ def write_gauges_csv(path, gauges) -> Path:
     np.savetxt(path, table, delimiter=",", header=",".join(["time_s"] + gauges.columns),
                comments="", fmt="%.9g")
     return path
+
+
+def read_gauges_csv(path):
+    """(times (s), ``{column: values}``) of a ``gauges.csv``, or None when there is no such file.
+    A file that is not one names the file and the line (CaseFileError)."""
+    from riprap.errors import CaseFileError
+
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as error:
+        raise CaseFileError(f"{path}: cannot read the gauge records ({error}); run the case "
+                            "again, or move the file away to analyse without them") from None
+    header = lines[0].strip().split(",") if lines else []
+    if not header or header[0] != "time_s" or len(set(header)) != len(header):
+        raise CaseFileError(f"{path}: line 1 is not the header of a riprap gauges.csv ('time_s' "
+                            "and one column per gauge reading); move the file away to analyse "
+                            "without the gauge records")
+    rows = []
+    for number, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        try:
+            row = [float(value) for value in line.split(",")]
+        except ValueError:
+            row = []
+        if len(row) != len(header) or not np.isfinite(row[0]):
+            raise CaseFileError(f"{path}, line {number}: expected {len(header)} numbers "
+                                f"({', '.join(header[:3])}...), got '{line[:60]}'; the file is "
+                                "corrupt")
+        rows.append(row)
+    table = np.array(rows, dtype=float).reshape(-1, len(header))
+    if np.any(np.diff(table[:, 0]) <= 0.0):
+        number = int(np.flatnonzero(np.diff(table[:, 0]) <= 0.0)[0]) + 3
+        raise CaseFileError(f"{path}, line {number}: the time does not increase; the file is "
+                            "corrupt")
+    return table[:, 0], {name: table[:, k] for k, name in enumerate(header) if k}
 
 
 def gauges_png(path, gauges, report=None) -> Path:

@@ -1,0 +1,175 @@
+"""Pictures of a flume test for ``report.html`` (matplotlib, PNG): the waves (spectra beside the
+target, run-up and overtopping records) and the stability (profiles of the section before and
+after, each unit's displacement and rocking). Each figure is drawn whatever the run gave: what
+could not be computed is written in the panel instead of a curve, so the report never shows an
+empty frame."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["spectra_figure", "gauge_record_figure", "profiles_figure", "unit_damage_figure"]
+
+
+def _pyplot():
+    from riprap.io.analysis_figures import _pyplot as pyplot
+
+    return pyplot()
+
+
+def _save(figure, path) -> Path:
+    from riprap.io.analysis_figures import _save as save
+
+    return save(figure, Path(path), formats=("png",))[0]
+
+
+def _say(axes, text: str) -> None:
+    """What a panel could not show, in the panel."""
+    axes.text(0.5, 0.5, text, transform=axes.transAxes, ha="center", va="center", fontsize=8,
+              wrap=True, color="0.3")
+
+
+def spectra_figure(path, spectra: list[dict], target: dict | None, target_density) -> Path:
+    """Each surface gauge's measured variance density (``gauge_spectra``) beside the target's
+    (``target_density``: (frequencies, density), or None for a regular wave, drawn as a line at
+    its frequency)."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(figsize=(7.5, 3.6))
+    if target_density is not None:
+        frequencies, density = target_density
+        axes.plot(frequencies, density, color="black", linestyle="--", linewidth=1.4,
+                  label=(f"target JONSWAP Hm0 {target['height_m']:g} m, Tp {target['period_s']:g} s,"
+                         f" gamma {target.get('peak_enhancement', 3.3):g}"))
+    elif target:
+        axes.axvline(1.0 / target["period_s"], color="black", linestyle="--",
+                     label=f"target: regular, H {target['height_m']:g} m, T {target['period_s']:g} s")
+    missing = []
+    for spectrum in spectra:
+        if "reason" in spectrum:
+            missing.append(f"{spectrum['name']}: not computed ({spectrum['reason']})")
+            continue
+        axes.plot(spectrum["frequencies_Hz"], spectrum["density_m2_s"], linewidth=1.0,
+                  label=f"measured at {spectrum['name']}")
+    if target:
+        axes.set_xlim(0.0, 3.0 / target["period_s"])
+    if missing:
+        _say(axes, "\n".join(missing[:6]))
+    axes.set_xlabel("frequency (Hz)")
+    axes.set_ylabel("variance density (m$^2$ s)")
+    axes.set_title("Surface gauges: spectra over their analysis windows", fontsize=10)
+    if axes.get_legend_handles_labels()[0]:
+        axes.legend(fontsize=7)
+    figure.tight_layout()
+    return _save(figure, path)
+
+
+def gauge_record_figure(path, times, records: dict, entries: dict, *, ylabel: str, title: str,
+                        lines: tuple = ()) -> Path:
+    """One panel per gauge: its record (``records``: name -> values at ``times``), its analysis
+    window shaded (``entries``: name -> its ``waves_report.json`` entry) and the levels of
+    ``lines`` ((key, label) of the entry, e.g. R2%) drawn across."""
+    plt = _pyplot()
+    names = list(records) or ["-"]
+    figure, axes = plt.subplots(len(names), 1, figsize=(7.5, 1.9 * len(names) + 0.8),
+                                squeeze=False)
+    for axis, name in zip(axes[:, 0], names):
+        values = records.get(name)
+        entry = entries.get(name) if isinstance(entries.get(name), dict) else {}
+        if values is None or times is None or len(times) < 2:
+            _say(axis, f"{name}: no record (gauges.csv missing or too short)")
+            continue
+        axis.plot(times, values, linewidth=0.8, color="tab:blue")
+        start = entry.get("analysed_from_s")
+        if isinstance(start, (int, float)) and start < times[-1]:
+            axis.axvspan(start, times[-1], color="0.92", zorder=0, label="analysis window")
+        elif isinstance(start, (int, float)):
+            _say(axis, f"the analysis window opens at t = {start:.3g} s, after the record's end "
+                       f"({times[-1]:.3g} s)")
+        for key, label in lines:
+            level = entry.get(key)
+            if isinstance(level, (int, float)) and np.isfinite(level):
+                axis.axhline(level, color="crimson", linewidth=0.8, linestyle=":",
+                             label=f"{label} {level:.3g}")
+        axis.set_title(name, fontsize=8, loc="left")
+        axis.set_ylabel(ylabel, fontsize=8)
+        if axis.get_legend_handles_labels()[0]:
+            axis.legend(fontsize=7, loc="upper left")
+    axes[-1, 0].set_xlabel("time (s)")
+    figure.suptitle(title, fontsize=10)
+    figure.tight_layout()
+    return _save(figure, path)
+
+
+def profiles_figure(path, layer: dict) -> Path:
+    """The section's armour surface before and after (``layer["damage_profiles"]``), the eroded
+    area between them filled."""
+    plt = _pyplot()
+    figure, axes = plt.subplots(figsize=(7.5, 3.4))
+    profiles = layer.get("damage_profiles")
+    if not isinstance(profiles, dict):
+        _say(axes, "not computed: "
+                   f"{layer.get('displacement_reference', 'no reference state to compare with')}")
+    else:
+        x = np.asarray(profiles["x_m"], dtype=float)
+        before = np.asarray(profiles["before_z_m"], dtype=float)
+        after = np.asarray(profiles["after_z_m"], dtype=float)
+        axes.plot(x, before, color="0.3", linewidth=1.2, label="before (frame 0)")
+        axes.plot(x, after, color="tab:red", linewidth=1.2, linestyle="--",
+                  label=f"after (t = {layer.get('time_s', float('nan')):g} s)")
+        axes.fill_between(x, before, after, where=np.nan_to_num(after) < np.nan_to_num(before),
+                          color="tab:red", alpha=0.3, label="eroded area A_e")
+        axes.set_aspect("equal", adjustable="datalim")
+        axes.legend(fontsize=7)
+    axes.set_xlabel("x along the flume (m)")
+    axes.set_ylabel("z (m)")
+    s = layer.get("damage_level_s")
+    axes.set_title("Armour surface, averaged across the flume"
+                   + (f": A_e = {layer['eroded_area_m2']:.3g} m$^2$, S = {s:.2f}"
+                      if isinstance(s, (int, float)) else ""), fontsize=10)
+    figure.tight_layout()
+    return _save(figure, path)
+
+
+def unit_damage_figure(path, units: dict, layer: dict) -> Path:
+    """Per unit: displacement over D_n (bars, with the moved and displaced thresholds), its
+    rocking events, and the largest fluid force over its submerged weight where recorded."""
+    plt = _pyplot()
+    with_force = "max_fluid_force_over_submerged_weight" in units
+    figure, axes = plt.subplots(2 + with_force, 1, figsize=(7.5, 2.2 * (2 + with_force) + 0.6),
+                                sharex=True, squeeze=False)
+    axes = axes[:, 0]
+    ids = np.asarray(units["unit_id"])
+    displacement = np.asarray(units.get("displacement_over_dn", np.full(len(ids), np.nan)),
+                              dtype=float)
+    if np.isfinite(displacement).any():
+        axes[0].bar(ids, displacement, color="tab:orange")
+        for key, colour, label in (("moved_threshold_over_dn", "0.5", "moved"),
+                                   ("damage_threshold_over_dn", "crimson", "displaced")):
+            if isinstance(layer.get(key), (int, float)):
+                axes[0].axhline(layer[key], color=colour, linewidth=0.8, linestyle="--",
+                                label=f"{label}: > {layer[key]:g} D$_n$")
+        axes[0].legend(fontsize=7)
+    else:
+        _say(axes[0], f"no displacements: {layer.get('displacement_reference', 'no reference')}")
+    axes[0].set_ylabel("displacement (D$_n$)", fontsize=8)
+    events = np.asarray(units.get("rocking_events", np.full(len(ids), np.nan)), dtype=float)
+    if np.isfinite(events).any():
+        axes[1].bar(ids, events, color="tab:purple")
+    else:
+        _say(axes[1], "rocking not counted (no frames before this one)")
+    axes[1].set_ylabel(f"rocking events\n(> {layer.get('rocking_angle_deg', 2.0):g} deg and back)",
+                       fontsize=8)
+    if with_force:
+        ratio = np.asarray(units["max_fluid_force_over_submerged_weight"], dtype=float)
+        if np.isfinite(ratio).any():
+            axes[2].bar(ids, ratio, color="tab:blue")
+            axes[2].axhline(1.0, color="crimson", linewidth=0.8, linestyle="--")
+        else:
+            _say(axes[2], "no fluid forces recorded")
+        axes[2].set_ylabel("largest fluid force /\nsubmerged weight", fontsize=8)
+    axes[-1].set_xlabel("unit")
+    figure.suptitle("Each unit: displacement, rocking" + (", fluid load" if with_force else ""),
+                    fontsize=10)
+    figure.tight_layout()
+    return _save(figure, path)
