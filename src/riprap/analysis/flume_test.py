@@ -8,7 +8,10 @@ units that rock.
   an irregular sea, the wave's frequency for a regular one.
 - Fluid force: the largest magnitude of the fluid's force on each unit over the run (the fluid
   steps between frames included, ``body_forces.csv``), when, and over the unit's submerged weight
-  (rho_s - rho_w) V g: above 1 the water could lift a unit that nothing else held.
+  (rho_s - rho_w) V g. It is the water's whole force, buoyancy included: a submerged unit in still
+  water carries 1 / Delta = rho_w / (rho_s - rho_w) of its submerged weight (0.71 for concrete of
+  2400 kg/m^3 in fresh water), and the water alone lifts it once the upward part exceeds its
+  weight, 1 + 1 / Delta submerged weights.
 """
 from __future__ import annotations
 
@@ -79,11 +82,17 @@ def gauge_spectra(records: FlumeRecords) -> list[dict]:
         duration = float(records.times[chosen][-1] - start) if chosen.any() else 0.0
         period = (records.target or {}).get("period_s")
         needed = 2.0 * period if period else 0.0
+        if not chosen.any():
+            end = float(records.times[-1]) if len(records.times) else 0.0
+            spectra.append({"name": name, "reason": (
+                f"record too short: the run ended at t = {end:.3g} s, before the wave train "
+                f"reached the gauge (t = {start:.3g} s)")})
+            continue
         if chosen.sum() < 8 or duration < needed:
             spectra.append({"name": name, "reason": (
-                f"record too short: {duration:.3g} s after the wave train's arrival at "
-                f"t = {start:.3g} s ({int(chosen.sum())} samples), two periods "
-                f"({needed:.3g} s) and 8 samples needed")})
+                f"record too short: {duration:.3g} s ({int(chosen.sum())} samples) after the "
+                f"wave train's arrival at t = {start:.3g} s; two periods ({needed:.3g} s) and "
+                "8 samples needed")})
             continue
         try:
             frequencies, density = _spectrum_of(records.times[chosen], eta[chosen])

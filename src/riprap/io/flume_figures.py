@@ -25,9 +25,10 @@ def _save(figure, path) -> Path:
 
 
 def _say(axes, text: str) -> None:
-    """What a panel could not show, in the panel."""
-    axes.text(0.5, 0.5, text, transform=axes.transAxes, ha="center", va="center", fontsize=8,
-              wrap=True, color="0.3")
+    """What a panel could not show, in the panel's place (its empty frame hidden)."""
+    axes.set_axis_off()
+    axes.text(0.5, 0.5, text, transform=axes.transAxes, ha="center", va="center", fontsize=9,
+              wrap=True, color="0.3", bbox={"facecolor": "white", "edgecolor": "0.8"})
 
 
 def spectra_figure(path, spectra: list[dict], target: dict | None, target_density) -> Path:
@@ -54,7 +55,10 @@ def spectra_figure(path, spectra: list[dict], target: dict | None, target_densit
     if target:
         axes.set_xlim(0.0, 3.0 / target["period_s"])
     if missing:
-        _say(axes, "\n".join(missing[:6]))
+        names = [s["name"] for s in spectra if "reason" in s]
+        axes.text(0.98, 0.55, f"measured: not computed at {', '.join(names[:8])}\n(the report "
+                  "says why)", transform=axes.transAxes, ha="right", va="center", fontsize=8,
+                  color="0.3", bbox={"facecolor": "white", "edgecolor": "0.8"})
     axes.set_xlabel("frequency (Hz)")
     axes.set_ylabel("variance density (m$^2$ s)")
     axes.set_title("Surface gauges: spectra over their analysis windows", fontsize=10)
@@ -71,21 +75,31 @@ def gauge_record_figure(path, times, records: dict, entries: dict, *, ylabel: st
     ``lines`` ((key, label) of the entry, e.g. R2%) drawn across."""
     plt = _pyplot()
     names = list(records) or ["-"]
-    figure, axes = plt.subplots(len(names), 1, figsize=(7.5, 1.9 * len(names) + 0.8),
+    # a record too short to draw leaves a line of text, not a panel's height of blank paper
+    height = 1.9 if times is not None and len(times) >= 2 else 0.5
+    figure, axes = plt.subplots(len(names), 1, figsize=(7.5, height * len(names) + 0.8),
                                 squeeze=False)
     for axis, name in zip(axes[:, 0], names):
         values = records.get(name)
         entry = entries.get(name) if isinstance(entries.get(name), dict) else {}
-        if values is None or times is None or len(times) < 2:
-            _say(axis, f"{name}: no record (gauges.csv missing or too short)")
+        if values is None or times is None:
+            _say(axis, f"{name}: no record (the run folder has no gauges.csv)")
+            continue
+        if len(times) < 2:
+            opens = entry.get("analysed_from_s")
+            _say(axis, f"{name}: {len(times)} sample(s) in gauges.csv, up to t = "
+                       f"{times[-1] if len(times) else 0.0:.3g} s: the run is too short to draw"
+                       + (f" (the analysis window opens at t = {opens:.3g} s)"
+                          if isinstance(opens, (int, float)) else ""))
             continue
         axis.plot(times, values, linewidth=0.8, color="tab:blue")
         start = entry.get("analysed_from_s")
         if isinstance(start, (int, float)) and start < times[-1]:
             axis.axvspan(start, times[-1], color="0.92", zorder=0, label="analysis window")
         elif isinstance(start, (int, float)):
-            _say(axis, f"the analysis window opens at t = {start:.3g} s, after the record's end "
-                       f"({times[-1]:.3g} s)")
+            axis.text(0.5, 0.9, f"the analysis window opens at t = {start:.3g} s, after the "
+                                f"record's end ({times[-1]:.3g} s): nothing analysed",
+                      transform=axis.transAxes, ha="center", va="top", fontsize=8, color="0.3")
         for key, label in lines:
             level = entry.get(key)
             if isinstance(level, (int, float)) and np.isfinite(level):
@@ -144,6 +158,9 @@ def unit_damage_figure(path, units: dict, layer: dict) -> Path:
                               dtype=float)
     if np.isfinite(displacement).any():
         axes[0].bar(ids, displacement, color="tab:orange")
+        k = int(np.nanargmax(displacement))
+        axes[0].text(0.01, 0.95, f"largest: unit {ids[k]}, {displacement[k]:.3g} D$_n$",
+                     transform=axes[0].transAxes, ha="left", va="top", fontsize=8)
         for key, colour, label in (("moved_threshold_over_dn", "0.5", "moved"),
                                    ("damage_threshold_over_dn", "crimson", "displaced")):
             if isinstance(layer.get(key), (int, float)):
@@ -154,8 +171,10 @@ def unit_damage_figure(path, units: dict, layer: dict) -> Path:
         _say(axes[0], f"no displacements: {layer.get('displacement_reference', 'no reference')}")
     axes[0].set_ylabel("displacement (D$_n$)", fontsize=8)
     events = np.asarray(units.get("rocking_events", np.full(len(ids), np.nan)), dtype=float)
-    if np.isfinite(events).any():
+    if np.nansum(events) > 0:
         axes[1].bar(ids, events, color="tab:purple")
+    elif np.isfinite(events).any():
+        _say(axes[1], f"no unit rocked (0 of {len(ids)})")
     else:
         _say(axes[1], "rocking not counted (no frames before this one)")
     axes[1].set_ylabel(f"rocking events\n(> {layer.get('rocking_angle_deg', 2.0):g} deg and back)",
@@ -164,7 +183,14 @@ def unit_damage_figure(path, units: dict, layer: dict) -> Path:
         ratio = np.asarray(units["max_fluid_force_over_submerged_weight"], dtype=float)
         if np.isfinite(ratio).any():
             axes[2].bar(ids, ratio, color="tab:blue")
-            axes[2].axhline(1.0, color="crimson", linewidth=0.8, linestyle="--")
+            delta = (layer.get("flume_test") or {}).get("relative_density")
+            if isinstance(delta, (int, float)) and delta > 0:
+                # the force includes buoyancy: its still-water share, and what lifts a unit
+                axes[2].axhline(1.0 / delta, color="0.5", linewidth=0.8, linestyle="--",
+                                label=f"buoyancy, submerged: 1/Delta = {1.0 / delta:.2f}")
+                axes[2].axhline(1.0 + 1.0 / delta, color="crimson", linewidth=0.8,
+                                linestyle="--", label=f"lifts its weight: {1.0 + 1.0 / delta:.2f}")
+                axes[2].legend(fontsize=7)
         else:
             _say(axes[2], "no fluid forces recorded")
         axes[2].set_ylabel("largest fluid force /\nsubmerged weight", fontsize=8)

@@ -134,9 +134,7 @@ def waves_section(analysis) -> str:
     else:
         aim = "The case names no target wave."
     surface = _entries(report, "gauges")
-    gauge_rows = [[html.escape(name)] + [value_or_reason(entry, key, fmt)
-                                         for key, _, fmt in _GAUGE_COLUMNS]
-                  for name, entry in surface.items()]
+    gauge_rows = [_gauge_row(name, entry) for name, entry in surface.items()]
     parts = ["<h2 id='waves'>Waves</h2>",
              f"<p>{html.escape(aim)} Records: <code>gauges.csv</code>, analysis: "
              "<code>waves_report.json</code> in the run folder. Each record is analysed from the "
@@ -154,6 +152,22 @@ def waves_section(analysis) -> str:
              "<h3>Overtopping</h3>", _overtopping_table(report),
              "<img src='waves_overtopping.png' alt='overtopping records'>"]
     return "".join(parts)
+
+
+def _gauge_row(name: str, entry, columns=_GAUGE_COLUMNS, placed: int = 2) -> list[str]:
+    """A gauge's cells (``columns``: (key, heading, format), the first ``placed`` of them where
+    it stands and what it analysed): where none of the others was computed, one cell that says why
+    across their columns, not the same words in each."""
+    where = [value_or_reason(entry, key, fmt) for key, _, fmt in columns[:placed]]
+    statistics = [key for key, _, _ in columns[placed:]]
+    if isinstance(entry, dict) and any(_number(entry.get(key)) is not None for key in statistics):
+        return [html.escape(name)] + where + [value_or_reason(entry, key, fmt)
+                                              for key, _, fmt in columns[placed:]]
+    reason = html.escape(next((r for r in (_reason(entry, key, "") for key in statistics) if r),
+                              "not in waves_report.json"))
+    return ([html.escape(name)] + where[:-1]
+            + [f"{where[-1]}</td><td colspan='{len(statistics)}' style='text-align:left'>"
+               f"<span class='missing'>not computed: {reason}</span>"])
 
 
 def _reflection_table(report: dict) -> str:
@@ -179,40 +193,46 @@ def _reflection_table(report: dict) -> str:
                    "reflection coefficient Kr"], rows)
 
 
+_RUN_UP_COLUMNS = (("x_m", "from x (m)", "{:.2f}"), ("to_x_m", "to x (m)", "{:.2f}"),
+                   ("analysed_from_s", "analysed from (s)", "{:.1f}"),
+                   ("run_up_waves", "waves", "{:.0f}"), ("R2%_m", "R2% above SWL (m)", "{:.3f}"),
+                   ("R_max_m", "R max (m)", "{:.3f}"))
+_OVERTOPPING_COLUMNS = (("x_m", "x (m)", "{:.2f}"), ("analysed_from_s", "analysed from (s)", "{:.1f}"),
+                        ("duration_s", "over (s)", "{:.1f}"),
+                        ("volume_m3_per_m", "volume (m^3/m)", "{:.4g}"),
+                        ("q_m3_s_per_m", "mean q (m^3/s per m)", "{:.4g}"),
+                        ("q_l_s_per_m", "mean q (l/s per m)", "{:.4g}"))
+
+
 def _run_up_table(report: dict) -> str:
-    rows = [[html.escape(name), value_or_reason(e, "x_m", "{:.2f}"),
-             value_or_reason(e, "to_x_m", "{:.2f}"), value_or_reason(e, "analysed_from_s", "{:.1f}"),
-             value_or_reason(e, "run_up_waves", "{:.0f}"), value_or_reason(e, "R2%_m", "{:.3f}"),
-             value_or_reason(e, "R_max_m", "{:.3f}")]
-            for name, e in _entries(report, "run_up").items()]
+    rows = [_gauge_row(name, e, _RUN_UP_COLUMNS, 3) for name, e in _entries(report, "run_up").items()]
     if not rows:
         return "<p class='missing'>not computed: the run has no run-up gauge.</p>"
-    return _table(["gauge", "from x (m)", "to x (m)", "analysed from (s)", "waves",
-                   "R2% above SWL (m)", "R max (m)"], rows)
+    return _table(["gauge"] + [h for _, h, _ in _RUN_UP_COLUMNS], rows)
 
 
 def _overtopping_table(report: dict) -> str:
-    rows = [[html.escape(name), value_or_reason(e, "x_m", "{:.2f}"),
-             value_or_reason(e, "analysed_from_s", "{:.1f}"),
-             value_or_reason(e, "duration_s", "{:.1f}"),
-             value_or_reason(e, "volume_m3_per_m", "{:.4g}"),
-             value_or_reason(e, "q_m3_s_per_m", "{:.4g}"),
-             value_or_reason(e, "q_l_s_per_m", "{:.4g}")]
+    rows = [_gauge_row(name, e, _OVERTOPPING_COLUMNS, 2)
             for name, e in _entries(report, "overtopping").items()]
     if not rows:
         return "<p class='missing'>not computed: the run has no overtopping gauge.</p>"
-    return _table(["gauge", "x (m)", "analysed from (s)", "over (s)", "volume (m^3/m)",
-                   "mean q (m^3/s per m)", "mean q (l/s per m)"], rows)
+    return _table(["gauge"] + [h for _, h, _ in _OVERTOPPING_COLUMNS], rows)
 
 
 def _row(label: str, value: str) -> str:
-    return f"<tr><th class='name'>{html.escape(label)}</th><td>{value}</td></tr>"
+    return (f"<tr><th class='name' style='min-width:20em'>{html.escape(label)}</th>"
+            f"<td style='text-align:left'>{value}</td></tr>")
 
 
 def _format(value, fmt: str, reason: str) -> str:
     number = _number(value)
     return (html.escape(fmt.format(number)) if number is not None
             else f"<span class='missing'>not computed: {html.escape(reason)}</span>")
+
+
+def _still_water_ratio(test: dict) -> float:
+    """Buoyancy over submerged weight of a submerged unit: rho_w / (rho_s - rho_w) = 1 / Delta."""
+    return 1.0 / test["relative_density"]
 
 
 def stability_section(analysis) -> str:
@@ -223,14 +243,18 @@ def stability_section(analysis) -> str:
     if getattr(analysis, "flume", None) is None or not isinstance(test, dict):
         return ""
     layer, units = analysis.layer, analysis.units
-    no_height = test.get("note", "no incident wave height")
+    no_height = ("no surface gauge has a record after the wave train's arrival (see Waves)"
+                 if "stability_number" not in test else "")
     hudson = test.get("hudson") if isinstance(test.get("hudson"), dict) else {}
     cubes = test.get("van_der_meer_cubes")
     rows = [_row("incident wave height at the toe, Hm0 (m)",
                  _format(test.get("Hm0_m"), "{:.3f}", no_height)
-                 + f" <span class='note'>({html.escape(str(test.get('wave_height_source')))})</span>"),
-            _row("mean period Tz (s), waves", _format(test.get("Tz_s"), "{:.2f}", no_height)
-                 + ", " + _format(test.get("waves"), "{:.0f}", no_height)),
+                 + (f" <span class='note'>({html.escape(str(test.get('wave_height_source')))})"
+                    "</span>" if not no_height else "")),
+            _row("mean period Tz (s), waves",
+                 _format(test.get("Tz_s"), "{:.2f}", no_height) + ", "
+                 + _format(test.get("waves"), "{:.0f}", no_height) if not no_height else
+                 _format(None, "", no_height)),
             _row("relative density Delta, Dn (m)", f"{test['relative_density']:.3f}, "
                  f"{test['nominal_diameter_m']:.3f}"),
             _row("stability number Ns = Hm0 / (Delta Dn)",
@@ -242,8 +266,8 @@ def stability_section(analysis) -> str:
                          f"{hudson['ratio']:.2f}; {html.escape(hudson['meaning'])})"))
     else:
         rows.append(_row("Hudson", "<span class='missing'>not computed: "
-                         + html.escape(no_height if "stability_number" not in test else
-                                       f"no K_D retrieved for {test['unit']} units") + "</span>"))
+                         + html.escape(no_height or f"no K_D retrieved for {test['unit']} units")
+                         + "</span>"))
     if isinstance(cubes, dict):
         rows.append(_row("Van der Meer (1988), cubes: N_od predicted",
                          f"{cubes['N_od']:.2f} ({html.escape(cubes['meaning'])})"))
@@ -275,8 +299,12 @@ def stability_section(analysis) -> str:
         k = int(np.nanargmax(ratio))
         rows.append(_row("largest fluid force on a unit / its submerged weight",
                          f"{ratio[k]:.2f} (unit {k}, {units['max_fluid_force_N'][k]:.4g} N at "
-                         f"t = {units['max_fluid_force_time_s'][k]:.3g} s; <code>units.csv</code>: "
-                         "max_fluid_force_*)"))
+                         f"t = {units['max_fluid_force_time_s'][k]:.3g} s; every unit in "
+                         "<code>units.csv</code>, max_fluid_force_*). The force is the water's "
+                         "whole force, buoyancy included: in still water a submerged unit carries "
+                         f"{_still_water_ratio(test):.2f} of its submerged weight (rho_w / (rho_s - "
+                         f"rho_w)); the water alone lifts it once the upward part exceeds its "
+                         f"weight, {_still_water_ratio(test) + 1.0:.2f} submerged weights."))
     return ("<h2 id='stability'>Stability</h2>"
             f"<table>{''.join(rows)}</table>"
             "<p class='note'>Hudson's and Van der Meer's numbers are for the waves measured here "
