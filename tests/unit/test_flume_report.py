@@ -1,5 +1,5 @@
-"""The flume test in the report (issue 35): `riprap analyse` of a flume run writes report.html with a
-waves and a stability section and their pictures; runs in water record contacts as dry runs do;
+"""The flume test in the report (issue 35): `riprap analyse` of a flume run writes report.html with
+a waves and a stability section and their pictures; runs in water record contacts as dry runs do;
 units.csv has each unit's largest fluid force; displacements are coloured on a fixed scale in D_n;
 no histogram panel is drawn empty; what could not be computed is said; a broken gauges.csv or
 body_forces.csv is refused naming the file and the line, with nothing written.
@@ -150,6 +150,30 @@ def test_a_broken_file_of_the_run_is_refused_naming_it(flume_run, tmp_path, caps
     assert not (out / "report.html").exists() and not (out / "units.csv").exists()
 
 
+def test_a_restart_onto_an_older_body_forces_file_is_refused_before_it_runs(
+        flume_run, tmp_path, capsys, monkeypatch):
+    from riprap.io.body_forces import BODY_FORCE_COLUMNS
+
+    monkeypatch.setenv("RIPRAP_SMOKE", "1")
+    older = ",".join(BODY_FORCE_COLUMNS[:-2])
+    def older_file(text):
+        rows = [",".join(line.split(",")[:-2]) for line in text.splitlines()[1:]]
+        return "\n".join([older] + rows) + "\n"
+
+    copy = _broken_copy(flume_run, tmp_path, "body_forces.csv", older_file)
+    before = (copy / "body_forces.csv").read_text()
+    capsys.readouterr()
+    assert main(["run", str(EXAMPLES / "10_breakwater_test" / "case.toml"), "--out", str(copy),
+                 "--quiet", "--restart", str(copy / "checkpoint.npz")]) == 2
+    err = capsys.readouterr().err
+    # smoke mode says so on stderr too; the refusal is the one other line
+    lines = [line for line in err.splitlines() if line.strip() and "SMOKE MODE" not in line]
+    assert len(lines) == 1 and lines[0].startswith("riprap: error:"), err
+    assert "body_forces.csv: its columns" in lines[0], err
+    assert "Traceback" not in err
+    assert (copy / "body_forces.csv").read_text() == before
+
+
 def test_a_restart_refuses_a_body_forces_file_of_other_columns(tmp_path):
     from riprap.io.body_forces import BodyForceTable
 
@@ -282,3 +306,28 @@ def test_the_steps_before_a_frame_are_equal_not_a_sliver():
     assert min(steps) == pytest.approx(max(steps), rel=1e-9)     # no sliver: 4 equal steps
     assert step_towards(stable, 1e-4) == 1e-4                       # the last bit as it is
     assert step_towards(0.0, 1.0) == 0.0 and step_towards(float("inf"), 1.0) == 1.0
+
+
+def test_a_gauge_record_of_the_target_sea_gives_the_target_spectrum(tmp_path):
+    """A record made of the case's own JONSWAP sea: its measured spectrum, over the analysis
+    window only, has the target's Hm0 and peak; what lies before the window is left out."""
+    from riprap.analysis.flume_test import FlumeRecords, gauge_spectra, target_spectrum
+    from riprap.io.flume_figures import spectra_figure
+    from riprap.waves.theory import IrregularWave
+
+    sea = IrregularWave(significant_height=1.2, peak_period=4.0, depth=2.0, duration=400.0, seed=3)
+    times = np.arange(0.0, 420.0, 0.05)
+    eta = np.array([sea.elevation(0.0, t) for t in times])
+    eta[times < 20.0] = 5.0                     # before the window: nothing to do with the sea
+    target = {"type": "irregular", "height_m": 1.2, "period_s": 4.0, "peak_enhancement": 3.3}
+    records = FlumeRecords(waves_report={"gauges": {"g1": {"analysed_from_s": 20.0}}},
+                           times=times, columns={"g1_eta_m": eta}, target=target)
+    (spectrum,) = gauge_spectra(records)
+    frequencies, density = spectrum["frequencies_Hz"], spectrum["density_m2_s"]
+    m0 = float(np.sum(density) * (frequencies[1] - frequencies[0]))
+    assert 4.0 * math.sqrt(m0) == pytest.approx(1.2, rel=0.05)
+    assert frequencies[np.argmax(density)] == pytest.approx(0.25, abs=0.03)
+    grid = np.linspace(0.0, 0.75, 600)
+    path = spectra_figure(tmp_path / "spectra.png", [spectrum], target,
+                          (grid, target_spectrum(target, grid)))
+    assert path.read_bytes().startswith(PNG_MAGIC)

@@ -68,6 +68,11 @@ def _add_flume_test(path, analysis) -> LayerAnalysis:
     if waves is None:
         return analysis
     unit = int(bodies[0]) if len(bodies) else 0
+    # the density the run's waves report was written with, where it says (the case's otherwise)
+    recorded = waves.get("water_density_kg_m3")
+    if (isinstance(recorded, (int, float)) and not isinstance(recorded, bool)
+            and np.isfinite(recorded) and recorded > 0):
+        water_density = float(recorded)
     analysis.layer["flume_test"] = flume_stability(
         waves, analysis.layer, unit_kind=layer.unit_kind, nominal_diameter=layer.nominal_diameter,
         armour_density=float(densities[unit]), water_density=water_density,

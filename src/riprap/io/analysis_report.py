@@ -11,6 +11,8 @@ In the output folder (every column and unit in ``docs/outputs.md``):
   ``underlayer.vtu`` the rocks;
 - ``stereonet.png``/``.svg``, ``layer_<field>.png``, ``slope_<field>.png``/``.svg``,
   ``histograms.png``/``.svg``;
+- of a flume run, ``waves_*.png`` and ``stability_*.png`` and the report's Waves and Stability
+  sections first (:mod:`riprap.io.flume_report`);
 - ``report.html``: the summary table, the layer measured against design (:data:`DESIGN_TOLERANCES`),
   the pictures, the units that moved most since the reference state (frame 0 of a run), the units
   with the smallest factors of safety and what those factors mean, on one page.

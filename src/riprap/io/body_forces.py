@@ -49,18 +49,16 @@ class BodyForceTable:
 
 def read_peak_fluid_forces(path, n_bodies: int, until: float = math.inf) -> dict | None:
     """Each body's largest fluid force over the run up to time ``until`` (N) and its time (s),
-    from ``path`` (a ``body_forces.csv``): ``{"force_N": (n_bodies,), "time_s": (n_bodies,)}``, NaN for a body
-    without a row; None when there is no such file. A file of an older riprap (no peak columns)
+    from ``path`` (a ``body_forces.csv``): ``{"force_N": (n_bodies,), "time_s": (n_bodies,)}``,
+    NaN for a body without a row; None when there is no such file. A file of an older riprap (no peak columns)
     gives the largest force at its rows' times. A row that cannot be read is a CaseFileError
     naming the file and the line."""
+    from riprap.io.case_text import read_text_file
+
     path = Path(path)
     if not path.is_file():
         return None
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError) as error:
-        raise CaseFileError(f"{path}: cannot read the body forces ({error}); run the case again, "
-                            "or move the file away to analyse without the fluid forces") from None
+    lines = read_text_file(path, what="body forces table", extension=".csv").splitlines()
     header = tuple(lines[0].strip().split(",")) if lines else ()
     if header not in (BODY_FORCE_COLUMNS, _OLDER_COLUMNS):
         raise CaseFileError(f"{path}: line 1 is not the header of a riprap body_forces.csv "

@@ -40,11 +40,13 @@ def spectra_figure(path, spectra: list[dict], target: dict | None, target_densit
     if target_density is not None:
         frequencies, density = target_density
         axes.plot(frequencies, density, color="black", linestyle="--", linewidth=1.4,
-                  label=(f"target JONSWAP Hm0 {target['height_m']:g} m, Tp {target['period_s']:g} s,"
-                         f" gamma {target.get('peak_enhancement', 3.3):g}"))
+                  label=(f"target JONSWAP Hm0 {target['height_m']:g} m, "
+                         f"Tp {target['period_s']:g} s, "
+                         f"gamma {target.get('peak_enhancement', 3.3):g}"))
     elif target:
         axes.axvline(1.0 / target["period_s"], color="black", linestyle="--",
-                     label=f"target: regular, H {target['height_m']:g} m, T {target['period_s']:g} s")
+                     label=f"target: regular, H {target['height_m']:g} m, "
+                           f"T {target['period_s']:g} s")
     missing = []
     for spectrum in spectra:
         if "reason" in spectrum:

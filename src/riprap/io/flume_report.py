@@ -49,7 +49,8 @@ def value_or_reason(entry, key: str, fmt: str = "{:.3g}",
     """The entry's ``key`` formatted, or "not computed: <reason>" (HTML-escaped)."""
     value = _number(entry.get(key)) if isinstance(entry, dict) else None
     if value is None:
-        return f"<span class='missing'>not computed: {html.escape(_reason(entry, key, default))}</span>"
+        reason = html.escape(_reason(entry, key, default))
+        return f"<span class='missing'>not computed: {reason}</span>"
     return html.escape(fmt.format(value))
 
 
@@ -197,7 +198,8 @@ _RUN_UP_COLUMNS = (("x_m", "from x (m)", "{:.2f}"), ("to_x_m", "to x (m)", "{:.2
                    ("analysed_from_s", "analysed from (s)", "{:.1f}"),
                    ("run_up_waves", "waves", "{:.0f}"), ("R2%_m", "R2% above SWL (m)", "{:.3f}"),
                    ("R_max_m", "R max (m)", "{:.3f}"))
-_OVERTOPPING_COLUMNS = (("x_m", "x (m)", "{:.2f}"), ("analysed_from_s", "analysed from (s)", "{:.1f}"),
+_OVERTOPPING_COLUMNS = (("x_m", "x (m)", "{:.2f}"),
+                        ("analysed_from_s", "analysed from (s)", "{:.1f}"),
                         ("duration_s", "over (s)", "{:.1f}"),
                         ("volume_m3_per_m", "volume (m^3/m)", "{:.4g}"),
                         ("q_m3_s_per_m", "mean q (m^3/s per m)", "{:.4g}"),
@@ -205,7 +207,8 @@ _OVERTOPPING_COLUMNS = (("x_m", "x (m)", "{:.2f}"), ("analysed_from_s", "analyse
 
 
 def _run_up_table(report: dict) -> str:
-    rows = [_gauge_row(name, e, _RUN_UP_COLUMNS, 3) for name, e in _entries(report, "run_up").items()]
+    rows = [_gauge_row(name, e, _RUN_UP_COLUMNS, 3)
+            for name, e in _entries(report, "run_up").items()]
     if not rows:
         return "<p class='missing'>not computed: the run has no run-up gauge.</p>"
     return _table(["gauge"] + [h for _, h, _ in _RUN_UP_COLUMNS], rows)
@@ -302,7 +305,8 @@ def stability_section(analysis) -> str:
                          f"t = {units['max_fluid_force_time_s'][k]:.3g} s; every unit in "
                          "<code>units.csv</code>, max_fluid_force_*). The force is the water's "
                          "whole force, buoyancy included: in still water a submerged unit carries "
-                         f"{_still_water_ratio(test):.2f} of its submerged weight (rho_w / (rho_s - "
+                         f"{_still_water_ratio(test):.2f} of its submerged weight "
+                         "(rho_w / (rho_s - "
                          f"rho_w)); the water alone lifts it once the upward part exceeds its "
                          f"weight, {_still_water_ratio(test) + 1.0:.2f} submerged weights."))
     return ("<h2 id='stability'>Stability</h2>"

@@ -24,15 +24,12 @@ def read_gauges_csv(path):
     """(times (s), ``{column: values}``) of a ``gauges.csv``, or None when there is no such file.
     A file that is not one names the file and the line (CaseFileError)."""
     from riprap.errors import CaseFileError
+    from riprap.io.case_text import read_text_file
 
     path = Path(path)
     if not path.is_file():
         return None
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError) as error:
-        raise CaseFileError(f"{path}: cannot read the gauge records ({error}); run the case "
-                            "again, or move the file away to analyse without them") from None
+    lines = read_text_file(path, what="gauge records table", extension=".csv").splitlines()
     header = lines[0].strip().split(",") if lines else []
     if not header or header[0] != "time_s" or len(set(header)) != len(header):
         raise CaseFileError(f"{path}: line 1 is not the header of a riprap gauges.csv ('time_s' "
