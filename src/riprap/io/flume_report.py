@@ -148,9 +148,10 @@ def waves_section(analysis) -> str:
              "<img src='waves_spectra.png' alt='spectra of the surface gauges against the target'>",
              _spectra_note(analysis),
              "<h3>Incident and reflected waves</h3>", _reflection_table(report),
-             "<h3>Run-up</h3>", _run_up_table(report),
+             "<h3>Run-up</h3>", _gauge_table(report, "run_up", _RUN_UP_COLUMNS, 3, "run-up"),
              "<img src='waves_run_up.png' alt='run-up records'>",
-             "<h3>Overtopping</h3>", _overtopping_table(report),
+             "<h3>Overtopping</h3>",
+             _gauge_table(report, "overtopping", _OVERTOPPING_COLUMNS, 2, "overtopping"),
              "<img src='waves_overtopping.png' alt='overtopping records'>"]
     return "".join(parts)
 
@@ -206,20 +207,12 @@ _OVERTOPPING_COLUMNS = (("x_m", "x (m)", "{:.2f}"),
                         ("q_l_s_per_m", "mean q (l/s per m)", "{:.4g}"))
 
 
-def _run_up_table(report: dict) -> str:
-    rows = [_gauge_row(name, e, _RUN_UP_COLUMNS, 3)
-            for name, e in _entries(report, "run_up").items()]
+def _gauge_table(report: dict, key: str, columns, placed: int, kind: str) -> str:
+    """The table of the ``key`` gauges of ``report`` (run-up, overtopping), or why there is none."""
+    rows = [_gauge_row(name, e, columns, placed) for name, e in _entries(report, key).items()]
     if not rows:
-        return "<p class='missing'>not computed: the run has no run-up gauge.</p>"
-    return _table(["gauge"] + [h for _, h, _ in _RUN_UP_COLUMNS], rows)
-
-
-def _overtopping_table(report: dict) -> str:
-    rows = [_gauge_row(name, e, _OVERTOPPING_COLUMNS, 2)
-            for name, e in _entries(report, "overtopping").items()]
-    if not rows:
-        return "<p class='missing'>not computed: the run has no overtopping gauge.</p>"
-    return _table(["gauge"] + [h for _, h, _ in _OVERTOPPING_COLUMNS], rows)
+        return f"<p class='missing'>not computed: the run has no {kind} gauge.</p>"
+    return _table(["gauge"] + [h for _, h, _ in columns], rows)
 
 
 def _row(label: str, value: str) -> str:
