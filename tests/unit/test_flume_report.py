@@ -52,13 +52,14 @@ def test_the_report_of_a_flume_run_has_the_waves_and_stability_sections(flume_ru
     page = (analysis / "report.html").read_text()
     for heading in ("<h2 id='waves'>Waves</h2>", "<h2 id='stability'>Stability</h2>",
                     "Spectra, measured against the target", "Incident and reflected waves",
-                    "Run-up", "Overtopping", "Profiles of the section, before and after"):
+                    "Run-up", "Overtopping", "Profiles of the section, before and after",
+                    "Contacts under wave load, frame by frame"):
         assert heading in page, heading
     # the waves come before the stability, both before the layer's own summary
     assert page.index("id='waves'") < page.index("id='stability'") < page.index("<h2>Summary")
     pictures = _images(page)
     for name in ("waves_spectra.png", "waves_run_up.png", "waves_overtopping.png",
-                 "stability_profiles.png", "stability_units.png"):
+                 "stability_profiles.png", "stability_units.png", "stability_contacts.png"):
         assert name in pictures, name
     for name in pictures:       # every picture the page shows is there and not empty
         data = (analysis / name).read_bytes()
@@ -331,3 +332,27 @@ def test_a_gauge_record_of_the_target_sea_gives_the_target_spectrum(tmp_path):
     path = spectra_figure(tmp_path / "spectra.png", [spectrum], target,
                           (grid, target_spectrum(target, grid)))
     assert path.read_bytes().startswith(PNG_MAGIC)
+
+
+def test_the_units_contacts_are_read_frame_by_frame(tmp_path):
+    from riprap.io.frame_contacts import read_unit_contacts_per_frame
+    from riprap.io.vtk import ParaViewSeries
+
+    points = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    triangles = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
+    owners = np.array([0, 0, 1, 2])                  # three bodies, the first with two faces
+    with_fields = ParaViewSeries(tmp_path / "new", "bodies")
+    for time, scale in ((0.0, 1.0), (1.0, 2.0)):
+        with_fields.add(time, points=points, cells=triangles, cell_type="triangle", cell_data={
+            "body_id": owners, "coordination_number": scale * np.array([3, 3, 4, 5]),
+            "max_contact_force": scale * np.array([10.0, 10.0, 20.0, 30.0]),
+            "factor_of_safety_sliding": np.array([1.5, 1.5, 1e30, 2.0])})
+    contacts = read_unit_contacts_per_frame(tmp_path / "new", [2, 0])
+    assert contacts["time_s"].tolist() == [0.0, 1.0]
+    assert contacts["coordination_number"].tolist() == [[5, 3], [10, 6]]
+    assert contacts["max_contact_force"][1].tolist() == [60.0, 20.0]
+    assert read_unit_contacts_per_frame(tmp_path / "new", [2, 0], until=0.5)["time_s"].size == 1
+    older = ParaViewSeries(tmp_path / "old", "bodies")     # a coupled run before issue 35
+    older.add(0.0, points=points, cells=triangles, cell_type="triangle",
+              cell_data={"body_id": owners})
+    assert read_unit_contacts_per_frame(tmp_path / "old", [0]) is None

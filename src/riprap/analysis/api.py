@@ -45,6 +45,7 @@ def _add_flume_test(path, analysis) -> LayerAnalysis:
     from riprap.analysis.stability_report import flume_stability
     from riprap.io.analysis_input import is_run_folder, load_run_case, load_waves_report
     from riprap.io.body_forces import read_peak_fluid_forces
+    from riprap.io.frame_contacts import read_unit_contacts_per_frame
     from riprap.io.gauge_files import read_gauges_csv
 
     if not is_run_folder(path):
@@ -79,8 +80,9 @@ def _add_flume_test(path, analysis) -> LayerAnalysis:
         slope_cot=layer.slope.cotangent)
     gauges = read_gauges_csv(Path(path) / "gauges.csv")
     times, columns = gauges if gauges is not None else (None, {})
+    contacts = read_unit_contacts_per_frame(path, bodies, until=state.time)
     return replace(analysis, flume=FlumeRecords(waves_report=waves, times=times, columns=columns,
-                                                target=_target(case)))
+                                                target=_target(case), contacts=contacts))
 
 
 def _target(case) -> dict | None:

@@ -37,12 +37,15 @@ class FlumeRecords:
     """What a flume run left for its report: ``waves_report`` (``waves_report.json``, or None),
     the gauge records (``gauges.csv``: ``times``, ``columns``; None without one) and the target
     sea of the case (``target``: ``type`` "irregular"/"regular", ``height_m`` (Hm0 or H),
-    ``period_s`` (Tp or T), ``peak_enhancement``; None without waves)."""
+    ``period_s`` (Tp or T), ``peak_enhancement``; None without waves) and the units' contacts
+    frame by frame (``contacts``: ``riprap.io.frame_contacts.read_unit_contacts_per_frame``; None
+    where the frames do not carry them)."""
 
     waves_report: dict | None = None
     times: np.ndarray | None = None
     columns: dict = field(default_factory=dict)
     target: dict | None = None
+    contacts: dict | None = None
 
     def series(self, suffix: str) -> dict:
         """``{gauge name: values}`` of the gauges whose columns end with ``suffix``."""

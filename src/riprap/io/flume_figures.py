@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["spectra_figure", "gauge_record_figure", "profiles_figure", "unit_damage_figure"]
+__all__ = ["spectra_figure", "gauge_record_figure", "profiles_figure", "unit_damage_figure",
+           "contacts_figure"]
 
 
 def _pyplot():
@@ -199,5 +200,41 @@ def unit_damage_figure(path, units: dict, layer: dict) -> Path:
     axes[-1].set_xlabel("unit")
     figure.suptitle("Each unit: displacement, rocking" + (", fluid load" if with_force else ""),
                     fontsize=10)
+    figure.tight_layout()
+    return _save(figure, path)
+
+
+def contacts_figure(path, contacts: dict | None) -> Path:
+    """The units' contacts frame by frame (``FlumeRecords.contacts``): coordination numbers (mean,
+    smallest and largest over the units), the largest contact force on a unit, and the factors of
+    safety against sliding (smallest and median; drawn up to the report's display cap)."""
+    from riprap.io.analysis_figures import FACTOR_OF_SAFETY_DISPLAY_CAP as cap
+
+    plt = _pyplot()
+    figure, axes = plt.subplots(3, 1, figsize=(7.5, 6.6), sharex=True)
+    if contacts is None or not len(contacts["time_s"]):
+        for axis in axes:
+            axis.set_axis_off()
+        _say(axes[1], "not computed: the run's frames carry no contacts (a coupled run written "
+                      "before issue 35)")
+        return _save(figure, path)
+    time = contacts["time_s"]
+    coordination = contacts["coordination_number"]
+    axes[0].fill_between(time, coordination.min(axis=1), coordination.max(axis=1), color="0.85",
+                         label="smallest to largest")
+    axes[0].plot(time, coordination.mean(axis=1), marker=".", color="tab:purple", label="mean")
+    axes[0].set_ylabel("coordination\nnumber", fontsize=8)
+    axes[0].legend(fontsize=7)
+    axes[1].plot(time, contacts["max_contact_force"].max(axis=1) / 1e3, marker=".",
+                 color="tab:blue")
+    axes[1].set_ylabel("largest contact\nforce on a unit (kN)", fontsize=8)
+    safety = np.minimum(contacts["factor_of_safety_sliding"], cap)
+    axes[2].plot(time, safety.min(axis=1), marker=".", color="tab:red", label="smallest")
+    axes[2].plot(time, np.median(safety, axis=1), marker=".", color="tab:green", label="median")
+    axes[2].set_ylim(0.0, cap * 1.05)
+    axes[2].set_ylabel(f"sliding factor of\nsafety (<= {cap:g} drawn)", fontsize=8)
+    axes[2].legend(fontsize=7)
+    axes[2].set_xlabel("time (s)")
+    figure.suptitle(f"The {coordination.shape[1]} units' contacts, frame by frame", fontsize=10)
     figure.tight_layout()
     return _save(figure, path)

@@ -101,7 +101,9 @@ def write_flume_figures(out: Path, analysis) -> dict:
                "stability_profiles": figures.profiles_figure(out / "stability_profiles.png",
                                                              analysis.layer),
                "stability_units": figures.unit_damage_figure(out / "stability_units.png",
-                                                             analysis.units, analysis.layer)}
+                                                             analysis.units, analysis.layer),
+               "stability_contacts": figures.contacts_figure(out / "stability_contacts.png",
+                                                             records.contacts)}
     return {key: str(path) for key, path in written.items()}
 
 
@@ -311,4 +313,11 @@ def stability_section(analysis) -> str:
             "<h3>Profiles of the section, before and after</h3>"
             "<img src='stability_profiles.png' alt='armour profiles before and after'>"
             "<h3>Each unit</h3>"
-            "<img src='stability_units.png' alt='displacement, rocking and fluid load per unit'>")
+            "<img src='stability_units.png' alt='displacement, rocking and fluid load per unit'>"
+            "<h3>Contacts under wave load, frame by frame</h3>"
+            "<img src='stability_contacts.png' alt='coordination numbers, contact forces and "
+            "factors of safety of the units over the run'>"
+            "<p class='note'>From every frame of <code>bodies.pvd</code> (its "
+            "<code>coordination_number</code>, <code>max_contact_force</code>, "
+            "<code>factor_of_safety_sliding</code> per body); the tables above are of the frame "
+            "analysed (<code>riprap analyse RUN --frame N</code> for another).</p>")
