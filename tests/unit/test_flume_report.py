@@ -356,3 +356,23 @@ def test_the_units_contacts_are_read_frame_by_frame(tmp_path):
     older.add(0.0, points=points, cells=triangles, cell_type="triangle",
               cell_data={"body_id": owners})
     assert read_unit_contacts_per_frame(tmp_path / "old", [0]) is None
+
+
+def test_the_stability_report_passes_over_values_left_null():
+    """A waves report of a run too short (values null, or H3's reason fields beside them) gives no
+    stability number rather than an error; a pair that was computed is used beside one that was
+    not."""
+    from riprap.analysis.stability_report import flume_stability
+
+    def stability(report):
+        return flume_stability(report, {"units_displaced": []}, unit_kind="core_loc_like",
+                               nominal_diameter=0.563, armour_density=2400.0,
+                               water_density=1000.0, slope_cot=1.33)
+
+    empty = stability({"gauges": {"g1": {"Hm0_m": None, "Hm0_m_reason": "too short"}},
+                       "reflection": [{"incident_Hm0_m": None}], "reflection_three_gauge": None})
+    assert "stability_number" not in empty and "no stability number" in empty["note"]
+    mixed = stability({"gauges": {"g1": {"Hm0_m": 1.1, "Tz_s": None, "waves": 12}},
+                       "reflection": [{"incident_Hm0_m": None}, {"incident_Hm0_m": 0.98}]})
+    assert mixed["Hm0_m"] == 0.98 and mixed["Tz_s"] is None and mixed["waves"] == 12
+    assert mixed["stability_number"] == pytest.approx(0.98 / (1.4 * 0.563))
