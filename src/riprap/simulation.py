@@ -694,18 +694,10 @@ class Simulation:
 
     def contact_statistics(self) -> dict:
         """Per body: coordination number, largest contact force (N) and factor of safety against
-        sliding (:mod:`riprap.analysis.unit_contacts`; inf where nothing pushes a body sideways)."""
-        from riprap.analysis.unit_contacts import (pair_friction, sliding_factor_of_safety,
-                                                   unit_contacts)
+        sliding (:func:`riprap.analysis.unit_contacts.solver_contact_statistics`)."""
+        from riprap.analysis.unit_contacts import solver_contact_statistics
 
-        s = self.solver
-        contacts = s.contacts
-        stats = unit_contacts(s.n_bodies, contacts)
-        friction = pair_friction(contacts, [m.friction_coefficient for m in s.materials],
-                                 s.material_index_of_body, s.wall_materials)
-        return {"coordination_number": stats.coordination_number,
-                "max_contact_force": stats.max_contact_force,
-                "factor_of_safety_sliding": sliding_factor_of_safety(s.n_bodies, contacts, friction)}
+        return solver_contact_statistics(self.solver)
 
     def _write_frame(self, series, contact_series, time: float | None = None) -> None:
         """One frame of the rigid bodies and their contacts, at ``time`` (default the rigid
@@ -727,12 +719,7 @@ class Simulation:
                               "coordination_number": statistics["coordination_number"][owners],
                               "max_contact_force": statistics["max_contact_force"][owners],
                               "factor_of_safety_sliding": safety[owners]})
-        c = s.contacts
-        contact_series.add(time, points=c.points, cells=np.arange(len(c)).reshape(-1, 1),
-                           cell_type="vertex",
-                           point_data={"normal_force": c.normal_forces,
-                                       "tangential_force": c.tangential_forces,
-                                       "body_i": c.body_i, "body_j": c.body_j})
+        contact_series.add_contacts(time, s.contacts)
 
     def write_picture(self, path, *, show_fixed: bool = False, planes=None, view=(25, -60),
                       title: str | None = None) -> Path:

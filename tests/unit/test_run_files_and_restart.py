@@ -318,19 +318,3 @@ def test_gauge_records_read_back_exactly_and_broken_ones_are_named(tmp_path):
         path.write_text("time_s,a_eta_m,up_level_m\n" + body)
         with pytest.raises(CaseFileError, match=phrase):
             read_gauges_csv(path)
-
-
-def test_body_forces_are_read_back_and_broken_ones_are_named(tmp_path):
-    from riprap.errors import CaseFileError
-    from riprap.io.body_forces import BODY_FORCE_COLUMNS, BodyForceTable, read_body_forces
-
-    table = BodyForceTable(tmp_path / "body_forces.csv")
-    table.append([",".join(["0", "0.5"] + ["1.25"] * 15), ",".join(["1", "0.5"] + ["-2"] * 15)])
-    data = read_body_forces(table.path, n_bodies=2)
-    assert list(data["body"]) == [0, 1] and list(data["pressure_force_z_N"]) == [1.25, -2.0]
-    with pytest.raises(CaseFileError, match="body_forces.csv:3: body = 1: expected a whole body "
-                                            "number from 0 to 0"):
-        read_body_forces(table.path, n_bodies=1)
-    table.path.write_text(",".join(BODY_FORCE_COLUMNS[:-1]) + "\n")
-    with pytest.raises(CaseFileError, match="body_forces.csv:1: columns"):
-        read_body_forces(table.path)

@@ -7,7 +7,10 @@
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
+
+import numpy as np
 
 from riprap.analysis.layer_analysis import LayerAnalysis, analyse_layer
 from riprap.errors import CaseFileError
@@ -27,7 +30,7 @@ def analyse(path, *, out=None, frame: int = -1) -> LayerAnalysis:
     if out is not None:
         prepare_output_folder(out)
     analysis = analyse_layer(load_layer_state(path, frame=frame))
-    _add_flume_test(waves, analysis)
+    analysis = _add_flume_test(path, waves, analysis)
     if out is not None:
         from riprap.io.analysis_report import write_analysis
 
@@ -35,21 +38,68 @@ def analyse(path, *, out=None, frame: int = -1) -> LayerAnalysis:
     return analysis
 
 
-def _add_flume_test(waves: dict | None, analysis) -> None:
-    """A run of a flume test (``waves``: its ``waves_report.json``, or None): the layer summary
-    gets ``flume_test``, the damage beside the design formulas for the measured waves."""
+def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:
+    """A run in water: the units get their largest fluid force (``body_forces.csv``); a flume
+    test's (``waves_report.json`` beside its frames) layer summary gets ``flume_test``, the damage
+    beside the design formulas for the measured waves, and the analysis its wave records for the
+    report (``riprap.analysis.flume_test``)."""
+    from riprap.analysis.flume_test import FlumeRecords, fluid_force_columns
     from riprap.analysis.stability_report import flume_stability
+    from riprap.io.analysis_input import is_run_folder, load_run_case
+    from riprap.io.body_forces import read_peak_fluid_forces
+    from riprap.io.frame_contacts import read_unit_contacts_per_frame
+    from riprap.io.gauge_files import read_gauges_csv
 
-    if waves is None:
-        return
+    if not is_run_folder(path):
+        return analysis
+    case = load_run_case(path)
+    if case.fluid is None:
+        return analysis
     state = analysis.state
     layer = state.layer
-    unit = int(layer.unit_bodies[0]) if len(layer.unit_bodies) else 0
-    density = state.materials[int(state.material_of_body[unit])].density
+    water_density = float(case.fluid.water_density)
+    bodies = np.asarray(layer.unit_bodies, dtype=np.int64)
+    densities = np.array([state.materials[int(m)].density for m in state.material_of_body])
+    peaks = read_peak_fluid_forces(Path(path) / "body_forces.csv", state.n_bodies,
+                                   until=state.time)
+    if peaks is not None:
+        analysis.units.update(fluid_force_columns(
+            peaks, bodies, volumes=(state.masses() / densities)[bodies],
+            armour_densities=densities[bodies], water_density=water_density,
+            gravity=float(np.linalg.norm(state.gravity))))
+    if waves is None:
+        return analysis
+    unit = int(bodies[0]) if len(bodies) else 0
+    # the density the run's waves report was written with, where it says (the case's otherwise)
+    recorded = waves.get("water_density_kg_m3")
+    if (isinstance(recorded, (int, float)) and not isinstance(recorded, bool)
+            and np.isfinite(recorded) and recorded > 0):
+        water_density = float(recorded)
     analysis.layer["flume_test"] = flume_stability(
         waves, analysis.layer, unit_kind=layer.unit_kind, nominal_diameter=layer.nominal_diameter,
-        armour_density=density, water_density=float(waves.get("water_density_kg_m3", 1025.0)),
+        armour_density=float(densities[unit]), water_density=water_density,
         slope_cot=layer.slope.cotangent)
+    gauges = read_gauges_csv(Path(path) / "gauges.csv")
+    times, columns = gauges if gauges is not None else (None, {})
+    contacts = read_unit_contacts_per_frame(path, bodies, until=state.time)
+    return replace(analysis, flume=FlumeRecords(waves_report=waves, times=times, columns=columns,
+                                                target=_target(case), contacts=contacts))
+
+
+def _target(case) -> dict | None:
+    """The case's sea for the report: irregular (Hm0, Tp, gamma) or regular (H, T)."""
+    spec = case.waves
+    if spec is None:
+        return None
+    parameters = spec.parameters
+    if "significant_height" in parameters:
+        return {"type": "irregular", "height_m": float(parameters["significant_height"]),
+                "period_s": float(parameters["peak_period"]),
+                "peak_enhancement": float(parameters.get("peak_enhancement", 3.3))}
+    if "height" in parameters and "period" in parameters:
+        return {"type": "regular", "height_m": float(parameters["height"]),
+                "period_s": float(parameters["period"])}
+    return None
 
 
 def _labels(paths, labels):

@@ -68,6 +68,9 @@ class LayerAnalysis:
         Magnitudes of every contact force between two units / a unit and the underlayer (N).
     state : LayerState
         The state analysed.
+    flume : FlumeRecords or None
+        A flume run's wave records and target (``riprap.analysis.flume_test``), for the report's
+        waves section; None for a pack or a run without waves.
     """
 
     units: dict
@@ -75,6 +78,7 @@ class LayerAnalysis:
     unit_unit_forces: np.ndarray
     unit_underlayer_forces: np.ndarray
     state: object
+    flume: object = None
 
     def body_values(self, column: str, fill: float = np.nan) -> np.ndarray:
         """A column of ``units`` spread over all bodies (``fill`` for the underlayer)."""
@@ -296,7 +300,11 @@ def _profile_damage(state) -> dict:
                        + np.asarray(state.reference_positions)[body])[faces])
     along = np.clip((xs - slope.toe[0]) / slope.tangent[0], 0.0, slope.length)
     face = slope.toe[2] + along * slope.tangent[2]
-    eroded = eroded_area(profile_from_surfaces(np.concatenate(before), xs, ys, face),
-                         profile_from_surfaces(np.concatenate(now), xs, ys, face), spacing)
+    profile_before = profile_from_surfaces(np.concatenate(before), xs, ys, face)
+    profile_now = profile_from_surfaces(np.concatenate(now), xs, ys, face)
+    eroded = eroded_area(profile_before, profile_now, spacing)
+    # the profiles themselves, for the report's picture of S (and for a reader's own checks)
     return {"eroded_area_m2": eroded, "damage_level_s": damage_level_s(eroded, dn),
-            "profile_spacing_m": spacing}
+            "profile_spacing_m": spacing,
+            "damage_profiles": {"x_m": xs.tolist(), "before_z_m": profile_before.tolist(),
+                                "after_z_m": profile_now.tolist()}}

@@ -25,18 +25,28 @@ HUDSON_TRUNK_STABILITY = {"core_loc_like": 16.0, "accropode_like": 15.0, "xbloc_
                           "tetrapod": 8.0, "cube": None, "antifer_cube": None}
 
 
+def _finite(value) -> bool:
+    """A number the report can use (a null, a string or NaN of a run too short is not)."""
+    return (isinstance(value, (int, float)) and not isinstance(value, bool)
+            and math.isfinite(value))
+
+
 def _incident(waves_report: dict):
-    """(incident Hm0, Tz, waves, where it was read) at the toe."""
-    # null: a figure the run could not compute (written for NaN)
-    gauges = [g for g in waves_report.get("gauges", {}).values() if g.get("Hm0_m") is not None]
-    period = gauges[0].get("Tz_s") if gauges else None
-    waves = gauges[0].get("waves") if gauges else None
+    """(incident Hm0, Tz, waves, where it was read) at the toe; values the waves report left
+    null (not computed) are passed over."""
+    gauges = waves_report.get("gauges", {})
+    gauges = [g for g in (gauges.values() if isinstance(gauges, dict) else [])
+              if isinstance(g, dict) and _finite(g.get("Hm0_m"))]
+    period = gauges[0].get("Tz_s") if gauges and _finite(gauges[0].get("Tz_s")) else None
+    waves = gauges[0].get("waves") if gauges and _finite(gauges[0].get("waves")) else None
     # three gauges first (Mansard & Funke: no singular spacings, less noise), then pairs
     for key, method in (("reflection_three_gauge", "Mansard-Funke, mean of the gauge triples"),
                         ("reflection", "Goda-Suzuki, mean of the gauge pairs")):
-        heights = [height for height in (e.get("incident_Hm0_m", e.get("incident_height_m"))
-                                         for e in waves_report.get(key, []))
-                   if height is not None]
+        entries = waves_report.get(key, [])
+        heights = [e.get("incident_Hm0_m", e.get("incident_height_m"))
+                   for e in (entries if isinstance(entries, list) else [])
+                   if isinstance(e, dict)]
+        heights = [h for h in heights if _finite(h)]
         if heights:
             return sum(heights) / len(heights), period, waves, f"incident ({method})"
     if gauges:

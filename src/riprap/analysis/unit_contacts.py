@@ -96,3 +96,17 @@ def sliding_factor_of_safety(n_bodies: int, contacts, friction_coefficient) -> n
         np.add.at(mobilised, side, tangential[rows])
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(mobilised > 0, strength / np.where(mobilised > 0, mobilised, 1.0), np.inf)
+
+
+def solver_contact_statistics(solver) -> dict:
+    """Per body of a ``SolidSolver`` as it is now: coordination number, largest contact force (N)
+    and factor of safety against sliding (inf where nothing pushes a body sideways), as a frame of
+    ``bodies.pvd`` records them, dry or in water."""
+    contacts = solver.contacts
+    stats = unit_contacts(solver.n_bodies, contacts)
+    friction = pair_friction(contacts, [m.friction_coefficient for m in solver.materials],
+                             solver.material_index_of_body, solver.wall_materials)
+    return {"coordination_number": stats.coordination_number,
+            "max_contact_force": stats.max_contact_force,
+            "factor_of_safety_sliding": sliding_factor_of_safety(solver.n_bodies, contacts,
+                                                                 friction)}

@@ -8,8 +8,8 @@
 - ``slope_<field>``: the layer seen square onto the face (s up the slope, y across), each unit as
   the outline of its footprint on the face, coloured by a per-unit value, with the underlayer's
   extent drawn in grey;
-- ``histograms``: coordination numbers, contact forces (unit-unit and unit-underlayer) and
-  factors of safety.
+- ``histograms``: coordination numbers, contact forces (unit-unit and unit-underlayer),
+  factors of safety and displacements, each panel only where there are values to count.
 
 A field with no finite value (the contact fields of a run that recorded no contacts, the
 displacement of a pack on its own) is not drawn (:func:`drawn_fields`).
@@ -26,7 +26,8 @@ import numpy as np
 
 __all__ = ["stereonet_figure", "layer_view_png", "slope_view_figure", "histogram_figure",
            "comparison_stereonets", "comparison_histograms", "colour_scale", "drawn_fields",
-           "PER_UNIT_FIELDS", "FACTOR_OF_SAFETY_DISPLAY_CAP"]
+           "histogram_panels", "PER_UNIT_FIELDS", "FACTOR_OF_SAFETY_DISPLAY_CAP",
+           "DISPLACEMENT_DISPLAY_RANGE_DN"]
 
 #: Per-unit fields drawn on the layer, with their colour-bar labels and colour maps.
 PER_UNIT_FIELDS = {
@@ -41,6 +42,9 @@ PER_UNIT_FIELDS = {
 #: hundreds when the overturning moment is small, and 5 leaves room to tell 1, 1.5 and 2 apart
 #: on the colour scale.
 FACTOR_OF_SAFETY_DISPLAY_CAP = 5.0
+#: Displacements are coloured from 0 to this many D_n (the darkest colour: a unit displaced out of
+#: its place, riprap.analysis.layer_analysis.DISPLACED_THRESHOLD_DN), not to the largest value.
+DISPLACEMENT_DISPLAY_RANGE_DN = 1.0
 _DOTS_PER_INCH = 150
 
 
@@ -80,12 +84,16 @@ def drawn_fields(units: dict) -> list[str]:
 def colour_scale(column: str, values) -> tuple[str, float, float]:
     """Colour map, lowest and highest value of the colour scale of a per-unit ``column``.
 
-    Factors of safety: 0 to :data:`FACTOR_OF_SAFETY_DISPLAY_CAP`; other fields: their finite
+    Factors of safety: 0 to :data:`FACTOR_OF_SAFETY_DISPLAY_CAP`; displacements in D_n: 0 to
+    :data:`DISPLACEMENT_DISPLAY_RANGE_DN`, whatever the largest (so that a hair's move is not
+    drawn in the colour of a displaced unit); other fields: their finite
     range over ``values`` (one unit wide if all are equal), displacements from 0. Every figure of
     one field uses this, so a colour means the same value in the 3D view and the face view."""
     _, colour_map = PER_UNIT_FIELDS.get(column, (column, "viridis"))
     if column.startswith("factor_of_safety"):
         return colour_map, 0.0, FACTOR_OF_SAFETY_DISPLAY_CAP
+    if column == "displacement_over_dn":
+        return colour_map, 0.0, DISPLACEMENT_DISPLAY_RANGE_DN
     values = np.asarray(values, dtype=float)
     finite = values[np.isfinite(values)]
     low, high = (float(finite.min()), float(finite.max())) if len(finite) else (0.0, 1.0)
@@ -222,51 +230,108 @@ def slope_view_figure(path, analysis, column: str) -> list[Path]:
     return _save(figure, Path(path))
 
 
-def _histogram_axes(axes, analysis, label=None, colour=None):
-    units = analysis.units
-    coordination = np.asarray(units["coordination_number"], dtype=float)
-    coordination = coordination[np.isfinite(coordination)]
-    if not len(coordination) and len(units["coordination_number"]):
-        for axis in axes:
-            axis.text(0.5, 0.5, "no contacts recorded", transform=axis.transAxes, ha="center")
-    low, high = (int(coordination.min()), int(coordination.max())) if len(coordination) else (0, 0)
-    bins = np.arange(low, high + 2) - 0.5
-    axes[0].hist(coordination, bins=bins, color=colour, alpha=0.6 if label else 0.9,
-                 edgecolor="black", linewidth=0.4, label=label)
-    axes[0].set_xlabel("coordination number")
-    axes[0].set_ylabel("units")
-    forces = [analysis.unit_unit_forces, analysis.unit_underlayer_forces]
-    positive = np.concatenate(forces)
-    positive = positive[positive > 0]
-    if len(positive):
-        edges = np.geomspace(positive.min(), positive.max() * 1.0001, 25)
-        names = ("unit-unit", "unit-underlayer")
-        for k, values in enumerate(forces):
-            values = values[values > 0]
+def _coordination_values(analysis) -> np.ndarray:
+    values = np.asarray(analysis.units["coordination_number"], dtype=float)
+    return values[np.isfinite(values)]
+
+
+def _positive_forces(analysis) -> list[np.ndarray]:
+    return [np.asarray(f, dtype=float)[np.asarray(f, dtype=float) > 0]
+            for f in (analysis.unit_unit_forces, analysis.unit_underlayer_forces)]
+
+
+def _safety_values(analysis) -> np.ndarray:
+    values = _display_values("factor_of_safety", analysis.units["factor_of_safety"])
+    return values[~np.isnan(values)]
+
+
+def _displacement_values(analysis) -> np.ndarray:
+    values = np.asarray(analysis.units.get("displacement_over_dn", []), dtype=float)
+    return values[np.isfinite(values)]
+
+
+def _coordination_panel(axis, analyses, labels, colours):
+    values = [_coordination_values(a) for a in analyses]
+    joined = np.concatenate(values)
+    bins = np.arange(int(joined.min()), int(joined.max()) + 2) - 0.5
+    for data, label, colour in zip(values, labels, colours):
+        axis.hist(data, bins=bins, color=colour, alpha=0.6 if label else 0.9, edgecolor="black",
+                  linewidth=0.4, label=label)
+    axis.set_xlabel("coordination number")
+    axis.set_ylabel("units")
+
+
+def _force_panel(axis, analyses, labels, colours):
+    forces = [_positive_forces(a) for a in analyses]
+    joined = np.concatenate([np.concatenate(f) for f in forces])
+    edges = np.geomspace(joined.min(), joined.max() * 1.0001, 25)
+    for (unit_unit, underlayer), label, colour in zip(forces, labels, colours):
+        for k, (values, name) in enumerate(((unit_unit, "unit-unit"),
+                                            (underlayer, "unit-underlayer"))):
             if len(values):
-                axes[1].hist(values, bins=edges, histtype="step", linewidth=1.4,
-                             linestyle="-" if k == 0 else "--", color=colour,
-                             label=f"{label + ': ' if label else ''}{names[k]}")
-        axes[1].set_xscale("log")
-        axes[1].legend(fontsize=7)
-    axes[1].set_xlabel("contact force (N)")
-    axes[1].set_ylabel("contacts")
-    fos = _display_values("factor_of_safety", units["factor_of_safety"])
-    fos = fos[~np.isnan(fos)]
-    axes[2].hist(fos, bins=np.linspace(0.0, FACTOR_OF_SAFETY_DISPLAY_CAP, 26), color=colour,
-                 alpha=0.6 if label else 0.9, edgecolor="black", linewidth=0.4, label=label)
-    axes[2].axvline(1.0, color="crimson", linewidth=1.0)
-    axes[2].set_xlabel(f"factor of safety (>= {FACTOR_OF_SAFETY_DISPLAY_CAP:g} in the last bin)")
-    axes[2].set_ylabel("units")
+                axis.hist(values, bins=edges, histtype="step", linewidth=1.4,
+                          linestyle="-" if k == 0 else "--", color=colour,
+                          label=f"{label + ': ' if label else ''}{name}")
+    axis.set_xscale("log")
+    axis.legend(fontsize=7)
+    axis.set_xlabel("contact force (N)")
+    axis.set_ylabel("contacts")
+
+
+def _safety_panel(axis, analyses, labels, colours):
+    for analysis, label, colour in zip(analyses, labels, colours):
+        axis.hist(_safety_values(analysis), bins=np.linspace(0.0, FACTOR_OF_SAFETY_DISPLAY_CAP, 26),
+                  color=colour, alpha=0.6 if label else 0.9, edgecolor="black", linewidth=0.4,
+                  label=label)
+    axis.axvline(1.0, color="crimson", linewidth=1.0)
+    axis.set_xlabel(f"factor of safety (>= {FACTOR_OF_SAFETY_DISPLAY_CAP:g} in the last bin)")
+    axis.set_ylabel("units")
+
+
+def _displacement_panel(axis, analyses, labels, colours):
+    for analysis, label, colour in zip(analyses, labels, colours):
+        values = np.minimum(_displacement_values(analysis), DISPLACEMENT_DISPLAY_RANGE_DN)
+        axis.hist(values, bins=np.linspace(0.0, DISPLACEMENT_DISPLAY_RANGE_DN, 21), color=colour,
+                  alpha=0.6 if label else 0.9, edgecolor="black", linewidth=0.4, label=label)
+    axis.set_xlabel(f"displacement since the reference state (D_n; >= "
+                    f"{DISPLACEMENT_DISPLAY_RANGE_DN:g} in the last bin)")
+    axis.set_ylabel("units")
+
+
+#: The histogram panels: (what it needs to have values, how it is drawn). A panel is drawn only
+#: where some layer has values for it (no empty frames: a run without contacts has no
+#: coordination numbers, a pack no displacements).
+_HISTOGRAM_PANELS = (
+    (lambda a: _coordination_values(a).size > 0, _coordination_panel),
+    (lambda a: sum(f.size for f in _positive_forces(a)) > 0, _force_panel),
+    (lambda a: _safety_values(a).size > 0, _safety_panel),
+    (lambda a: _displacement_values(a).size > 0, _displacement_panel),
+)
+
+
+def histogram_panels(analyses) -> list:
+    """The panels of :data:`_HISTOGRAM_PANELS` that some of ``analyses`` has values for."""
+    return [draw for has, draw in _HISTOGRAM_PANELS if any(has(a) for a in analyses)]
+
+
+def _histograms(path, analyses, labels, colours) -> list[Path]:
+    panels = histogram_panels(analyses)
+    if not panels:
+        return []
+    plt = _pyplot()
+    figure, axes = plt.subplots(1, len(panels), figsize=(4.4 * len(panels), 3.6), squeeze=False)
+    for axis, draw in zip(axes[0], panels):
+        draw(axis, analyses, labels, colours)
+    if labels[0]:
+        axes[0, 0].legend(fontsize=7)
+    figure.tight_layout()
+    return _save(figure, Path(path))
 
 
 def histogram_figure(path, analysis) -> list[Path]:
-    """Coordination numbers, contact forces and factors of safety (PNG and SVG)."""
-    plt = _pyplot()
-    figure, axes = plt.subplots(1, 3, figsize=(13.0, 3.6))
-    _histogram_axes(axes, analysis)
-    figure.tight_layout()
-    return _save(figure, Path(path))
+    """Coordination numbers, contact forces, factors of safety and displacements, each panel
+    only where the layer has values for it (PNG and SVG; nothing when it has none)."""
+    return _histograms(path, [analysis], [None], [None])
 
 
 def comparison_stereonets(path, analyses, labels) -> list[Path]:
@@ -285,13 +350,8 @@ def comparison_stereonets(path, analyses, labels) -> list[Path]:
 
 
 def comparison_histograms(path, analyses, labels) -> list[Path]:
-    """Histograms of several layers overlaid (PNG and SVG)."""
-    plt = _pyplot()
-    figure, axes = plt.subplots(1, 3, figsize=(13.0, 3.6))
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for k, (analysis, label) in enumerate(zip(analyses, labels)):
-        _histogram_axes(axes, analysis, label=label, colour=colours[k % len(colours)])
-    axes[0].legend(fontsize=7)
-    axes[2].legend(fontsize=7)
-    figure.tight_layout()
-    return _save(figure, Path(path))
+    """Histograms of several layers overlaid (PNG and SVG; the panels any of them has values
+    for)."""
+    colours = _pyplot().rcParams["axes.prop_cycle"].by_key()["color"]
+    return _histograms(path, list(analyses), list(labels),
+                       [colours[k % len(colours)] for k in range(len(analyses))])

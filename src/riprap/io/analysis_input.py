@@ -10,8 +10,9 @@
   fitted exactly (the rotation that carries the stored mesh's surface nodes onto the frame's,
   Kabsch 1976, Acta Cryst. A32: 922), and the same frame of ``contacts.pvd`` gives the contacts
   with their forces. Frame 0 of ``bodies.pvd`` is the reference the units' displacements are
-  measured from. A coupled run (``fluid.pvd`` beside) writes no ``contacts.pvd``: its state has
-  no contacts and says so (``contacts_recorded`` False).
+  measured from. A coupled run (``fluid.pvd`` beside) writes ``contacts.pvd`` as a dry run does;
+  one written by an older riprap has none: its state has no contacts and says so
+  (``contacts_recorded`` False).
 """
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ from riprap.errors import CaseFileError
 from riprap.io.json_files import read_json_object
 
 __all__ = ["load_layer_state", "load_pack_state", "load_run_state", "is_run_folder",
-           "load_waves_report"]
+           "load_waves_report", "load_run_case"]
 
 
 def _pack_folder(path: Path) -> tuple[Path, Path]:
@@ -342,6 +343,13 @@ def load_waves_report(run_folder) -> dict | None:
     from riprap.io.waves_report_file import read_waves_report
 
     return read_waves_report(run_folder)
+
+
+def load_run_case(run_folder):
+    """The case a run folder's run ran (its ``summary.json``'s ``case_file``), loaded."""
+    from riprap.case.load import load_case
+
+    return load_case(_run_case_file(Path(run_folder)))
 
 
 def _run_case_file(run_folder: Path) -> Path:

@@ -11,6 +11,8 @@ In the output folder (every column and unit in ``docs/outputs.md``):
   ``underlayer.vtu`` the rocks;
 - ``stereonet.png``/``.svg``, ``layer_<field>.png``, ``slope_<field>.png``/``.svg``,
   ``histograms.png``/``.svg``;
+- of a flume run, ``waves_*.png`` and ``stability_*.png`` and the report's Waves and Stability
+  sections first (:mod:`riprap.io.flume_report`);
 - ``report.html``: the summary table, the layer measured against design (:data:`DESIGN_TOLERANCES`),
   the pictures, the units that moved most since the reference state (frame 0 of a run), the units
   with the smallest factors of safety and what those factors mean, on one page.
@@ -236,6 +238,7 @@ th.name { text-align: left; font-weight: normal; } th.detail { padding-left: 2.2
 td.inside { color: #1a7f37; font-weight: bold; } td.outside { color: #b42318; font-weight: bold; }
 .figures { display: flex; flex-wrap: wrap; gap: 1em; } .figures img { max-width: 34em; }
 img.wide { max-width: 100%; } .note { color: #555; font-size: 0.85em; }
+h3 { font-size: 1em; margin-top: 1.2em; } .missing { color: #9a6700; font-style: italic; }
 """
 
 
@@ -323,10 +326,10 @@ def _factor_of_safety_notes(layer: dict, units: dict) -> str:
 def _no_contacts_note(layer: dict) -> str:
     if layer.get("contacts_recorded", True):
         return ""
-    return ("<p class='outside'><b>This run recorded no contacts</b> (a coupled run writes no "
-            "<code>contacts.pvd</code>): coordination numbers, contact forces and factors of "
-            "safety are not known here and are left empty (NaN in <code>units.csv</code>). "
-            "Analyse the pack, or a dry run from it, for them.</p>")
+    return ("<p class='outside'><b>This run recorded no contacts</b> (coupled runs written "
+            "before issue 35 have no <code>contacts.pvd</code>): coordination numbers, contact forces "
+            "and factors of safety are not known here and are left empty (NaN in "
+            "<code>units.csv</code>). Run the case again for them.</p>")
 
 
 def _factor_of_safety_section(layer: dict, units: dict) -> str:
@@ -364,9 +367,17 @@ def _displacement_section(layer: dict, units: dict, count: int = 10) -> str:
             "orientation to the present one, about whatever axis.</p>")
 
 
+def _distributions(out: Path) -> str:
+    # no picture when no panel had values to count (histogram_figure)
+    if not (out / "histograms.svg").is_file():
+        return ""
+    return "<h2>Distributions</h2><img class='wide' src='histograms.svg' alt='histograms'>"
+
+
 def write_analysis(out, analysis) -> dict:
     """Every file of one analysed layer in ``out``; returns ``{what: path}``."""
     from riprap.io import analysis_figures as figures
+    from riprap.io.flume_report import write_flume_figures
     from riprap.io.layer_file import write_contact_table
 
     out = Path(out)
@@ -390,14 +401,19 @@ def write_analysis(out, analysis) -> dict:
                                                                 analysis, column))
         figures.slope_view_figure(out / f"slope_{column}.png", analysis, column)
         outputs[f"slope_{column}"] = str(out / f"slope_{column}.png")
-    figures.histogram_figure(out / "histograms.png", analysis)
-    outputs["histograms"] = str(out / "histograms.png")
+    if figures.histogram_figure(out / "histograms.png", analysis):
+        outputs["histograms"] = str(out / "histograms.png")
+    else:       # nothing to count: no picture, nor an earlier analysis's left in the folder
+        for suffix in ("png", "svg"):
+            (out / f"histograms.{suffix}").unlink(missing_ok=True)
+    outputs.update(write_flume_figures(out, analysis))
     outputs["report"] = str(_write_report(out, analysis))
     return outputs
 
 
 def _write_report(out: Path, analysis) -> Path:
     from riprap.io.analysis_figures import PER_UNIT_FIELDS, drawn_fields
+    from riprap.io.flume_report import stability_section, waves_section
 
     layer, units = analysis.layer, analysis.units
     histogram = ", ".join(f"{k}: {v}" for k, v in layer["coordination_number_histogram"].items())
@@ -416,6 +432,7 @@ def _write_report(out: Path, analysis) -> Path:
         "<a href='contacts.csv'>contacts.csv</a>, <a href='layer_summary.json'>layer_summary.json</a>; "
         "ParaView: <code>layer.vtu</code>, <code>underlayer.vtu</code>.</p>"
         f"{_no_contacts_note(layer)}"
+        f"{waves_section(analysis)}{stability_section(analysis)}"
         f"<h2>Summary</h2>{_summary_table([layer], ['this layer'])}"
         f"<h2>Measured against design</h2>{_verdict_table(layer)}"
         "<p class='note'>Design values: the unit's design table (<code>layer.json</code>, "
@@ -430,7 +447,7 @@ def _write_report(out: Path, analysis) -> Path:
         "<h2>Orientation of the nose axes</h2><div class='figures'>"
         "<img src='stereonet.svg' alt='stereonet of the nose axes'></div>"
         f"{fields}"
-        "<h2>Distributions</h2><img class='wide' src='histograms.svg' alt='histograms'>"
+        f"{_distributions(out)}"
         f"{_displacement_section(layer, units)}"
         f"{_factor_of_safety_section(layer, units)}"
         "<p class='note'>Definitions. Coordination number: bodies and walls a unit touches. Largest "
@@ -456,7 +473,7 @@ def write_comparison(out, analyses, labels) -> dict:
     for analysis, label in zip(analyses, labels):
         outputs[label] = write_analysis(out / label, analysis)
     figures.comparison_stereonets(out / "comparison_stereonets.png", analyses, labels)
-    figures.comparison_histograms(out / "comparison_histograms.png", analyses, labels)
+    histograms = figures.comparison_histograms(out / "comparison_histograms.png", analyses, labels)
     write_json(out / "comparison.json", {label: a.layer for label, a in zip(labels, analyses)})
     faces = "".join(f"<figure><img src='{html.escape(label)}/slope_max_contact_force_N.svg' "
                     f"alt='{html.escape(label)}'><figcaption>{html.escape(label)}</figcaption></figure>"
@@ -467,7 +484,8 @@ def write_comparison(out, analyses, labels) -> dict:
     body = (f"<ul>{sources}</ul><h2>Summary</h2>"
             f"{_summary_table([a.layer for a in analyses], list(labels))}"
             "<h2>Nose axes</h2><img class='wide' src='comparison_stereonets.svg' alt='stereonets'>"
-            "<h2>Distributions</h2><img class='wide' src='comparison_histograms.svg' alt='histograms'>"
+            + ("<h2>Distributions</h2><img class='wide' src='comparison_histograms.svg' "
+               "alt='histograms'>" if histograms else "") +
             f"<h2>Largest contact force, face view</h2><div class='figures'>{faces}</div>")
     path = out / "comparison.html"
     path.write_text(_page("riprap armour layer comparison", body), encoding="utf-8")

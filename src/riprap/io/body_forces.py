@@ -1,20 +1,29 @@
 """``body_forces.csv`` of a coupled run: at every frame, one row per body with its position,
 velocity and the forces on it (N): the fluid's, split into pressure and viscous (with advection)
-parts, and the contacts'. Appended frame by frame and flushed, so a killed run keeps every row
-written; a restart appends."""
+parts, and the contacts'; and the largest fluid force on the body over the fluid steps since its
+previous row, with its time (``peak_fluid_force_N``, ``peak_fluid_force_time_s``: an impact lasts
+a few fluid steps, far less than the frames' interval). Appended frame by frame and flushed, so a
+killed run keeps every row written; a restart appends. :func:`read_peak_fluid_forces` reads back
+each body's largest fluid force for ``riprap analyse``."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
+import numpy as np
+
+from riprap.errors import CaseFileError
 from riprap.io.output_folder import naming_the_file
 
-__all__ = ["BODY_FORCE_COLUMNS", "BodyForceTable", "read_body_forces"]
+__all__ = ["BODY_FORCE_COLUMNS", "BodyForceTable", "read_peak_fluid_forces"]
 
 BODY_FORCE_COLUMNS = ("body", "time_s", "x_m", "y_m", "z_m", "vx_m_per_s", "vy_m_per_s",
                       "vz_m_per_s", "pressure_force_x_N", "pressure_force_y_N",
                       "pressure_force_z_N", "viscous_force_x_N", "viscous_force_y_N",
                       "viscous_force_z_N", "contact_force_x_N", "contact_force_y_N",
-                      "contact_force_z_N")
+                      "contact_force_z_N", "peak_fluid_force_N", "peak_fluid_force_time_s")
+#: The columns of the files riprap wrote before the peak force was recorded (still read).
+_OLDER_COLUMNS = BODY_FORCE_COLUMNS[:-2]
 
 
 class BodyForceTable:
@@ -22,7 +31,15 @@ class BodyForceTable:
 
     def __init__(self, path, *, append: bool = False):
         self.path = Path(path)
-        if not (append and self.path.is_file()):
+        if append and self.path.is_file():
+            with open(self.path, encoding="utf-8", errors="replace") as stream:
+                header = tuple(stream.readline().strip().split(","))
+            if header != BODY_FORCE_COLUMNS:
+                raise CaseFileError(
+                    f"{self.path}: its columns are not those this riprap writes (an older run's "
+                    "file?); rows appended by the restart would not match them. Run the case "
+                    "again from the start, or move the file away to start a new one")
+        else:
             with naming_the_file(self.path):
                 self.path.write_text(",".join(BODY_FORCE_COLUMNS) + "\n")
 
@@ -32,31 +49,55 @@ class BodyForceTable:
             stream.flush()
 
 
-def read_body_forces(path, n_bodies: int | None = None) -> dict:
-    """``{column: values}`` of a run's ``body_forces.csv``, checked: its header, finite numbers,
-    ``body`` a whole number from 0 (below ``n_bodies`` when given), ``time_s`` >= 0. Rows may
-    repeat a time (a restart appends from its checkpoint). Errors name the file, line, column."""
-    import math
-
-    import numpy as np
-
-    from riprap.errors import CaseFileError
-    from riprap.io.csv_tables import read_number_table
+def read_peak_fluid_forces(path, n_bodies: int, until: float = math.inf) -> dict | None:
+    """Each body's largest fluid force over the run up to time ``until`` (N) and its time (s),
+    from ``path`` (a ``body_forces.csv``): ``{"force_N": (n_bodies,), "time_s": (n_bodies,)}``,
+    NaN for a body without a row; None when there is no such file. A file of an older riprap (no peak columns)
+    gives the largest force at its rows' times. A row that cannot be read is a CaseFileError
+    naming the file and the line."""
+    from riprap.io.case_text import read_text_file
 
     path = Path(path)
-    advice = "run the case again, or restart it from a checkpoint"
-    _, table, lines = read_number_table(path, "body force table", columns=BODY_FORCE_COLUMNS,
-                                 advice=advice)
-    data = {name: table[:, k] for k, name in enumerate(BODY_FORCE_COLUMNS)}
-    body, time = data["body"], data["time_s"]
-    limit = math.inf if n_bodies is None else n_bodies
-    bad = np.flatnonzero((body != np.round(body)) | (body < 0) | (body >= limit) | (time < 0))
-    if bad.size:
-        row = int(bad[0])
-        what = (f"time_s = {time[row]:g}: expected a time >= 0 s" if time[row] < 0 else
-                f"body = {body[row]:g}: expected a whole body number from 0"
-                + (f" to {n_bodies - 1} (the run has {n_bodies} bodies)" if n_bodies is not None
-                   else ""))
-        raise CaseFileError(f"{path}:{lines[row]}: {what}; {advice}")
-    data["body"] = body.astype(np.int64)
-    return data
+    if not path.is_file():
+        return None
+    lines = read_text_file(path, what="body forces table", extension=".csv").splitlines()
+    header = tuple(lines[0].strip().split(",")) if lines else ()
+    if header not in (BODY_FORCE_COLUMNS, _OLDER_COLUMNS):
+        raise CaseFileError(f"{path}: line 1 is not the header of a riprap body_forces.csv "
+                            f"(expected '{','.join(BODY_FORCE_COLUMNS[:3])},...'); move the file "
+                            "away to analyse without the fluid forces")
+    force = np.full(n_bodies, np.nan)
+    when = np.full(n_bodies, np.nan)
+    has_peak = header == BODY_FORCE_COLUMNS
+    for number, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        fields = line.split(",")
+        if len(fields) != len(header):
+            if number == len(lines):
+                break           # the last row of a killed run, cut while it was written
+            raise CaseFileError(f"{path}, line {number}: {len(fields)} values, the header has "
+                                f"{len(header)}; the file is corrupt")
+        try:
+            body = int(fields[0])
+            values = [float(v) for v in fields[1:]]
+        except ValueError:
+            raise CaseFileError(f"{path}, line {number}: '{line[:60]}' is not a row of numbers; "
+                                "the file is corrupt") from None
+        if not 0 <= body < n_bodies:
+            raise CaseFileError(f"{path}, line {number}: body {body}, but the run has {n_bodies} "
+                                "bodies (0.." f"{n_bodies - 1}); the file is not this run's")
+        row = dict(zip(header[1:], values))
+        if row["time_s"] > until:
+            continue
+        now = math.hypot(*(row[f"pressure_force_{a}_N"] + row[f"viscous_force_{a}_N"]
+                           for a in "xyz"))
+        peak, peak_time = ((row["peak_fluid_force_N"], row["peak_fluid_force_time_s"])
+                           if has_peak else (now, row["time_s"]))
+        if not (math.isfinite(peak) and peak >= 0.0):
+            raise CaseFileError(f"{path}, line {number}: fluid force {peak!r} N on body {body} "
+                                "is not a finite number >= 0; the run blew up or the file is "
+                                "corrupt")
+        if not force[body] >= peak:
+            force[body], when[body] = peak, peak_time
+    return {"force_N": force, "time_s": when}

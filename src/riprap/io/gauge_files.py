@@ -21,13 +21,15 @@ def write_gauges_csv(path, gauges) -> Path:
     return path
 
 
-def read_gauges_csv(path) -> tuple[np.ndarray, dict]:
-    """``(times (s), {column: values})`` of a run's ``gauges.csv``, checked: the header starts with
-    ``time_s``, every field is a finite number, the times increase (the file is rewritten whole at
-    every frame). Errors name the file, the line and the column."""
+def read_gauges_csv(path) -> tuple[np.ndarray, dict] | None:
+    """``(times (s), {column: values})`` of a run's ``gauges.csv`` (None where the run wrote none),
+    checked: the header starts with ``time_s``, every field is a finite number, the times increase
+    (the file is rewritten whole at every frame). Errors name the file, the line and the column."""
     from riprap.io.csv_tables import read_number_table
 
     path = Path(path)
+    if not path.is_file():
+        return None
     advice = "run the case again (gauges.csv is rewritten whole at every frame)"
     header, table, lines = read_number_table(path, "gauge table", advice=advice)
     if header[0] != "time_s":

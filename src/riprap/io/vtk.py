@@ -278,6 +278,17 @@ class ParaViewSeries:
             path, points=points, cells=cells, cell_type=cell_type, point_data=point_data,
             cell_data=cell_data))
 
+    def add_contacts(self, time: float, contacts) -> Path:
+        """One frame of contacts (``ContactRecords``): a vertex per touching pair at its contact
+        point, with ``normal_force``, ``tangential_force`` (N, on ``body_i``) and the pair
+        (``body_i``, ``body_j``; ``body_j = -1 - w`` for wall ``w``), which ``riprap analyse``
+        reads back."""
+        return self.add(time, points=contacts.points,
+                        cells=np.arange(len(contacts.body_i)).reshape(-1, 1), cell_type="vertex",
+                        point_data={"normal_force": contacts.normal_forces,
+                                    "tangential_force": contacts.tangential_forces,
+                                    "body_i": contacts.body_i, "body_j": contacts.body_j})
+
     def add_image(self, time: float, *, origin, spacing: float, cells, cell_data) -> Path:
         """Write one frame of a uniform grid (``.vti``, :func:`riprap.io.vti.write_vti`) and list
         it in the ``.pvd``; ``cells`` = (nx, ny, nz), ``cell_data`` arrays of that shape (or with

@@ -4,22 +4,38 @@
 Frames: ``fluid.pvd`` of ``.vti`` files (``water_fraction``, ``pressure`` in Pa, ``velocity`` in
 m/s at cell centres, ``solid``) and free-surface pictures (``free_surface/free_surface_NNNN.png``);
 with bodies also ``bodies.pvd`` at the same times, ``run.pvd`` that opens both together in
-ParaView, and ``body_forces.csv``. The fluid takes the step its Courant number allows, cut to land
-on the scheduled times.
+ParaView, ``contacts.pvd`` (the bodies' contacts, as a dry run writes them) and ``body_forces.csv``
+(with the largest fluid force on each body between its rows). The fluid takes the step its
+Courant number allows, the last ones before a scheduled time made equal to land on it
+(:func:`step_towards`).
 """
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
 from riprap.errors import InstabilityError, RiprapError
 from riprap.models.base import Model
 
-__all__ = ["FluidModel", "CoupledModel"]
+__all__ = ["FluidModel", "CoupledModel", "step_towards"]
 
 # A remaining interval shorter than this fraction of the time is not worth a step of its own.
 _TIME_SLACK = 1e-9
 # A body faster than this (m/s) has blown up even if its numbers are still finite.
 _RUNAWAY_SPEED = 1.0e3
+
+
+def step_towards(stable: float, remaining: float) -> float:
+    """The step to take with ``remaining`` seconds to the next scheduled time (a frame, a
+    checkpoint, the end): the interval split evenly over as many steps of at most ``stable`` as
+    it needs, so that landing on a frame never leaves a sliver of a step. A body's fluid force
+    over a step is its momentum change over dt, and part of that change comes per step, not per
+    second: a sliver step cut to land on a frame read 13 times its neighbours' force, and the
+    frames sampled exactly that step (docs/coupling.md, Peak forces)."""
+    if remaining <= stable or not (stable > 0 and math.isfinite(remaining / stable)):
+        return min(stable, remaining)
+    return remaining / math.ceil(remaining / stable)
 
 
 class FluidModel(Model):
@@ -61,7 +77,7 @@ class FluidModel(Model):
 
     def advance(self, until: float) -> None:
         s = self.solver
-        dt = min(s.stable_time_step(), until - s.time)
+        dt = step_towards(s.stable_time_step(), until - s.time)
         report = s.step(dt)
         self._after_step(dt, report)
 
@@ -189,10 +205,16 @@ class CoupledModel(FluidModel):
     def __init__(self, coupled):
         super().__init__(coupled)
         self._body_series = None
+        self._contact_series = None
+        self._append = False
         self._forces = None
         self._combined = None
         self.substeps = 0
         self.fastest = 0.0
+        # The largest fluid force on each body (N) since the last row of body_forces.csv, and
+        # when: a wave's impact lasts a few fluid steps, far less than the frames' interval.
+        self._peak_force = np.zeros(self.solids.n_bodies)
+        self._peak_time = np.full(self.solids.n_bodies, np.nan)
 
     @property
     def solids(self):
@@ -206,6 +228,15 @@ class CoupledModel(FluidModel):
         self.substeps += self._report.solid_substeps
         self.fastest = max(self.fastest, self._report.max_body_speed)
         self._check_bodies()
+        self._track_peak_forces()
+
+    def _track_peak_forces(self) -> None:
+        """Keep each free body's largest fluid force of the steps since the last row (a fixed
+        body's load is summed only for the outputs, so its rows give the force at their time)."""
+        force = np.linalg.norm(self.solver.fluid_loads[:, :3], axis=1)
+        larger = force > self._peak_force
+        self._peak_force[larger] = force[larger]
+        self._peak_time[larger] = self.time
 
     def _check_bodies(self) -> None:
         """A body whose state is not finite, that moves absurdly fast, or whose centre has left
@@ -234,6 +265,7 @@ class CoupledModel(FluidModel):
         from riprap.io.body_forces import BodyForceTable
 
         super().open_outputs(directory, append=append, paraview=paraview, picture=picture)
+        self._append = append
         if paraview:
             self._body_series = vtk.ParaViewSeries(directory, "bodies", append=append)
             self._combined = vtk.CombinedSeries(directory / "run.pvd",
@@ -253,29 +285,58 @@ class CoupledModel(FluidModel):
 
     def _write_bodies(self) -> None:
         """The bodies' surfaces with velocity, the fluid's force on each body and the contact
-        force, at the fluid frame's time."""
+        force, with the contact statistics a dry run's frames have, at the fluid frame's time;
+        and the frame of ``contacts.pvd`` (the last contact sub-step's contacts), so that
+        ``riprap analyse`` gets coordination numbers, contact forces and factors of safety under
+        wave load as it does dry."""
+        from riprap.analysis.unit_contacts import solver_contact_statistics
+        from riprap.io import vtk
         from riprap.solid.surfaces import surface_arrays
 
         coupled, solids = self.solver, self.solids
         points, triangles, owners = surface_arrays(solids)
         fluid_force = coupled.fluid_loads[:, :3] + coupled.fixed_body_loads[:, :3]
         contact = solids.contact_forces()
+        statistics = solver_contact_statistics(solids)
+        # ParaView colours inf badly; a huge finite number reads as "nothing pushes it sideways".
+        safety = np.minimum(statistics["factor_of_safety_sliding"], 1.0e30)
         self._body_series.add(coupled.time, points=points, cells=triangles, cell_type="triangle",
                               cell_data={"body_id": owners, "velocity": solids.velocities[owners],
                                          "speed": np.linalg.norm(solids.velocities, axis=1)[owners],
+                                         "angular_velocity": solids.angular_velocities[owners],
                                          "fluid_force": fluid_force[owners],
                                          "contact_force": contact[owners],
-                                         "fixed": solids.fixed[owners].astype(np.int64)})
+                                         "fixed": solids.fixed[owners].astype(np.int64),
+                                         "coordination_number":
+                                             statistics["coordination_number"][owners],
+                                         "max_contact_force": statistics["max_contact_force"][owners],
+                                         "factor_of_safety_sliding": safety[owners]})
+        if self._contact_series is None:
+            # opened with the first frame: a run whose bodies write their own frames (deformable
+            # bodies in water) has no such series
+            self._contact_series = vtk.ParaViewSeries(self._directory, "contacts",
+                                                      append=self._append)
+        self._contact_series.add_contacts(coupled.time, solids.contacts)
 
     def _body_force_rows(self) -> list[str]:
         """Rows of ``body_forces.csv`` for the present time (one per body)."""
         coupled, solids = self.solver, self.solids
         contact = solids.contact_forces()
+        pressure, viscous = coupled.pressure_loads[:, :3], coupled.viscous_loads[:, :3]
+        now = np.linalg.norm(pressure + viscous, axis=1)
+        # the largest since the last row, or this row's own force where that is larger (a fixed
+        # body, or the first row)
+        larger = ~(self._peak_force >= now) | np.isnan(self._peak_time)
+        self._peak_force[larger] = now[larger]
+        self._peak_time[larger] = coupled.time
         rows = []
         for b in range(solids.n_bodies):
             values = [coupled.time, *solids.positions[b], *solids.velocities[b],
-                      *coupled.pressure_loads[b, :3], *coupled.viscous_loads[b, :3], *contact[b]]
+                      *pressure[b], *viscous[b], *contact[b], self._peak_force[b],
+                      self._peak_time[b]]
             rows.append(f"{b}," + ",".join(repr(float(v)) for v in values))
+        self._peak_force[:] = 0.0
+        self._peak_time[:] = np.nan
         return rows
 
     def close_outputs(self) -> dict:
@@ -283,6 +344,8 @@ class CoupledModel(FluidModel):
         if self._body_series is not None:
             outputs["bodies"] = str(self._body_series.pvd_path)
             outputs["fluid_and_bodies"] = str(self._combined.path)
+        if self._contact_series is not None:
+            outputs["contacts"] = str(self._contact_series.pvd_path)
         outputs["body_forces"] = str(self._forces.path)
         return outputs
 

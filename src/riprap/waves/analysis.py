@@ -34,7 +34,7 @@ from riprap.waves.theory import GRAVITY, wave_number
 
 __all__ = ["WaveStatistics", "wave_statistics", "ReflectionAnalysis", "separate_incident_reflected",
            "separate_regular_wave", "separate_three_gauges", "harmonic_amplitude",
-           "even_record", "zero_down_crossing_heights"]
+           "even_record", "zero_down_crossing_heights", "variance_density"]
 
 # The band of the Goda-Suzuki split: where the gauge spacing is within this fraction of a wave length.
 _GODA_SUZUKI_BAND = (0.05, 0.45)
@@ -96,6 +96,20 @@ def _spectrum(t, eta):
     density[0] = 0.0
     if n % 2 == 0:
         density[-1] *= 0.5
+    return frequencies, density
+
+
+def variance_density(times, eta, bands: int = 1):
+    """(frequencies (Hz), one-sided variance density (m^2 s)) of the record ``eta`` at ``times``
+    (put on an even grid first), averaged over ``bands`` neighbouring frequencies (a record of a
+    few dozen waves gives a raw spectrum too ragged to read beside a target)."""
+    t, e = even_record(times, eta)
+    frequencies, density = _spectrum(t, e)
+    bands = max(1, int(bands))
+    if bands > 1 and frequencies.size >= bands:
+        count = frequencies.size // bands * bands
+        frequencies = frequencies[:count].reshape(-1, bands).mean(axis=1)
+        density = density[:count].reshape(-1, bands).mean(axis=1)
     return frequencies, density
 
 
