@@ -256,3 +256,23 @@ def test_a_fluid_step_needing_too_many_contact_sub_steps_stops_the_run():
     check_substeps(MAXIMUM_SUBSTEPS, 1e-3, 1e-8)
     with pytest.raises(InstabilityError, match="contact sub-steps"):
         check_substeps(MAXIMUM_SUBSTEPS + 1, 1e-3, 1e-9)
+
+
+def test_a_tetrahedron_on_the_same_side_of_a_face_as_its_neighbour_is_refused():
+    """An extra tetrahedron built on a boundary face but reaching into the body overlaps the one
+    that owns the face: every such mesh is refused naming the file, most of them because the two
+    lie on the same side of the face they share."""
+    from riprap.errors import MeshError
+    from riprap.geometry import shapes
+    from riprap.geometry.tetmesh import TetMesh
+
+    cube = shapes.cube(side=0.1, mesh_size=0.05)
+    face = cube.boundary_faces()[0]
+    reasons = []
+    for node in set(range(len(cube.nodes))) - set(face.tolist()):
+        mesh = TetMesh.from_arrays(cube.nodes, np.vstack([cube.tets, [*face[[0, 2, 1]], node]]),
+                                   name="cube.vtu", fix_orientation=True)
+        with pytest.raises(MeshError, match="cube.vtu") as error:
+            mesh.check()
+        reasons.append("same side" in str(error.value))
+    assert sum(reasons) > len(reasons) // 2
