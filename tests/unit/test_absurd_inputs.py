@@ -26,23 +26,10 @@ BODY_IN_WATER = (_edit(_edit(FLUID, "upper = [0.2, 0.02, 0.1]", "upper = [0.2, 0
                  + '[[materials]]\nname = "foam"\ndensity = 1.0\n[[shapes]]\nname = "c"\n'
                  'type = "cube"\nside = 0.06\n[[bodies]]\nshape = "c"\nmaterial = "foam"\n'
                  'position = [0.1, 0.1, 0.05]\n')
-FLUME = """format_version = 1
-[simulation]
-end_time = 0.01
-[fluid]
-lower = [0.0, 0.0, 0.0]
-upper = [6.0, 0.02, 0.44]
-cells = [300, 1, 22]
-surface_tension = 0.0
-[[water_regions]]
-type = "level"
-level = 0.3
-[waves]
-type = "linear"
-still_water_level = 0.3
-height = 0.04
-period = 1.0
-"""
+FLUME = (_edit(_edit(_edit(FLUID, "upper = [0.2, 0.02, 0.1]", "upper = [6.0, 0.02, 0.44]"),
+                     "cells = [20, 2, 10]", "cells = [300, 1, 22]\nsurface_tension = 0.0"),
+               "level = 0.05", "level = 0.3")
+         + '[waves]\ntype = "linear"\nstill_water_level = 0.3\nheight = 0.04\nperiod = 1.0\n')
 IRREGULAR = _edit(FLUME, 'type = "linear"\nstill_water_level = 0.3\nheight = 0.04\nperiod = 1.0',
                   'type = "irregular"\nstill_water_level = 0.3\nsignificant_height = 0.04\n'
                   'peak_period = 1.0')
