@@ -184,7 +184,10 @@ def jonswap_spectrum(frequencies, significant_height: float, peak_period: float,
     m0 = shape.sum() * spacing
     if m0 <= 0:
         raise CaseFileError("waves: the JONSWAP spectrum has no energy over the chosen frequencies")
-    return shape * (significant_height / 4.0) ** 2 / m0
+    # (Hm0 / 4)^2 / m0 scaled in numpy floats: an absurd Hm0 gives inf here (and the flume's
+    # breaking check names it), not Python's OverflowError
+    with np.errstate(over="ignore"):
+        return shape * (np.float64(significant_height) / 4.0) ** 2 / m0
 
 
 #: Most frequency components of an irregular sea: each is summed at every relaxation cell and
