@@ -74,7 +74,7 @@ ABSURD_CASES = {
                                         "peak_period = 1.0\nduration = 1e308"),
                                   "run", ["[waves]", "duration = 1e+308", "components"]),
     "significant_height_1e308": (_edit(IRREGULAR, "significant_height = 0.04",
-                                       "significant_height = 1e308"),
+                                       "significant_height = 1e308\nduration = 20.0"),
                                  "run", ["[waves]", "Hm0 = 1e+308", "breaks"]),
     "joint_penalty_1e308": (DEFORMABLE + "joint_penalty = 1e308\n", "run",
                             ["[deformable]", "joint_penalty = 1e+308", "time step"]),
