@@ -226,9 +226,9 @@ class IrregularWave:
         if components > MAXIMUM_COMPONENTS:
             raise CaseFileError(
                 f"waves: duration = {self.duration:g} s is {self.duration / self.peak_period:.3g} "
-                f"peak periods and would make {components:.3g} frequency components, more than "
-                f"{MAXIMUM_COMPONENTS:,} ({MAXIMUM_COMPONENTS / 2.5:,.0f} peak periods; a storm "
-                "test runs about 1000 waves); give duration in seconds (it defaults to "
+                f"peak periods, at 2.5 frequency components each more than the "
+                f"{MAXIMUM_COMPONENTS:,} riprap sums ({MAXIMUM_COMPONENTS / 2.5:,.0f} peak periods; "
+                "a storm test runs about 1000 waves); give duration in seconds (it defaults to "
                 "[simulation] end_time)")
         spacing = 1.0 / self.duration
         fp = 1.0 / self.peak_period
