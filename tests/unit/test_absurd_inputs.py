@@ -26,23 +26,10 @@ BODY_IN_WATER = (_edit(_edit(FLUID, "upper = [0.2, 0.02, 0.1]", "upper = [0.2, 0
                  + '[[materials]]\nname = "foam"\ndensity = 1.0\n[[shapes]]\nname = "c"\n'
                  'type = "cube"\nside = 0.06\n[[bodies]]\nshape = "c"\nmaterial = "foam"\n'
                  'position = [0.1, 0.1, 0.05]\n')
-FLUME = """format_version = 1
-[simulation]
-end_time = 0.01
-[fluid]
-lower = [0.0, 0.0, 0.0]
-upper = [6.0, 0.02, 0.44]
-cells = [300, 1, 22]
-surface_tension = 0.0
-[[water_regions]]
-type = "level"
-level = 0.3
-[waves]
-type = "linear"
-still_water_level = 0.3
-height = 0.04
-period = 1.0
-"""
+FLUME = (_edit(_edit(_edit(FLUID, "upper = [0.2, 0.02, 0.1]", "upper = [6.0, 0.02, 0.44]"),
+                     "cells = [20, 2, 10]", "cells = [300, 1, 22]\nsurface_tension = 0.0"),
+               "level = 0.05", "level = 0.3")
+         + '[waves]\ntype = "linear"\nstill_water_level = 0.3\nheight = 0.04\nperiod = 1.0\n')
 IRREGULAR = _edit(FLUME, 'type = "linear"\nstill_water_level = 0.3\nheight = 0.04\nperiod = 1.0',
                   'type = "irregular"\nstill_water_level = 0.3\nsignificant_height = 0.04\n'
                   'peak_period = 1.0')
@@ -86,6 +73,9 @@ ABSURD_CASES = {
     "wave_train_duration_1e308": (_edit(IRREGULAR, "peak_period = 1.0",
                                         "peak_period = 1.0\nduration = 1e308"),
                                   "run", ["[waves]", "duration = 1e+308", "components"]),
+    "significant_height_1e308": (_edit(IRREGULAR, "significant_height = 0.04",
+                                       "significant_height = 1e308\nduration = 20.0"),
+                                 "run", ["[waves]", "Hm0 = 1e+308", "breaks"]),
     "joint_penalty_1e308": (DEFORMABLE + "joint_penalty = 1e308\n", "run",
                             ["[deformable]", "joint_penalty = 1e+308", "time step"]),
     "deformable_viscosity_1e20": (DEFORMABLE + "viscosity = 1e20\n", "run",
@@ -256,3 +246,23 @@ def test_a_fluid_step_needing_too_many_contact_sub_steps_stops_the_run():
     check_substeps(MAXIMUM_SUBSTEPS, 1e-3, 1e-8)
     with pytest.raises(InstabilityError, match="contact sub-steps"):
         check_substeps(MAXIMUM_SUBSTEPS + 1, 1e-3, 1e-9)
+
+
+def test_a_tetrahedron_on_the_same_side_of_a_face_as_its_neighbour_is_refused():
+    """An extra tetrahedron built on a boundary face but reaching into the body overlaps the one
+    that owns the face: every such mesh is refused naming the file, most of them because the two
+    lie on the same side of the face they share."""
+    from riprap.errors import MeshError
+    from riprap.geometry import shapes
+    from riprap.geometry.tetmesh import TetMesh
+
+    cube = shapes.cube(side=0.1, mesh_size=0.05)
+    face = cube.boundary_faces()[0]
+    reasons = []
+    for node in set(range(len(cube.nodes))) - set(face.tolist()):
+        mesh = TetMesh.from_arrays(cube.nodes, np.vstack([cube.tets, [*face[[0, 2, 1]], node]]),
+                                   name="cube.vtu", fix_orientation=True)
+        with pytest.raises(MeshError, match="cube.vtu") as error:
+            mesh.check()
+        reasons.append("same side" in str(error.value))
+    assert sum(reasons) > len(reasons) // 2

@@ -184,7 +184,10 @@ def jonswap_spectrum(frequencies, significant_height: float, peak_period: float,
     m0 = shape.sum() * spacing
     if m0 <= 0:
         raise CaseFileError("waves: the JONSWAP spectrum has no energy over the chosen frequencies")
-    return shape * (significant_height / 4.0) ** 2 / m0
+    # (Hm0 / 4)^2 / m0 scaled in numpy floats: an absurd Hm0 gives inf here (and the flume's
+    # breaking check names it), not Python's OverflowError
+    with np.errstate(over="ignore"):
+        return shape * (np.float64(significant_height) / 4.0) ** 2 / m0
 
 
 #: Most frequency components of an irregular sea: each is summed at every relaxation cell and
@@ -223,9 +226,9 @@ class IrregularWave:
         if components > MAXIMUM_COMPONENTS:
             raise CaseFileError(
                 f"waves: duration = {self.duration:g} s is {self.duration / self.peak_period:.3g} "
-                f"peak periods and would make {components:.3g} frequency components, more than "
-                f"{MAXIMUM_COMPONENTS:,} ({MAXIMUM_COMPONENTS / 2.5:,.0f} peak periods; a storm "
-                "test runs about 1000 waves); give duration in seconds (it defaults to "
+                f"peak periods, at 2.5 frequency components each more than the "
+                f"{MAXIMUM_COMPONENTS:,} riprap sums ({MAXIMUM_COMPONENTS / 2.5:,.0f} peak periods; "
+                "a storm test runs about 1000 waves); give duration in seconds (it defaults to "
                 "[simulation] end_time)")
         spacing = 1.0 / self.duration
         fp = 1.0 / self.peak_period
