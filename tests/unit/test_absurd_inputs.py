@@ -23,7 +23,7 @@ from test_cli_bad_inputs import FLUID, PLACEMENT, RIGID, _edit
 # RIGID's one body spinning or placed far away; FLUID with a body, a flume, porous zones.
 BODY_IN_WATER = (_edit(_edit(FLUID, "upper = [0.2, 0.02, 0.1]", "upper = [0.2, 0.2, 0.1]"),
                        "cells = [20, 2, 10]", "cells = [10, 10, 5]")
-                 + '[[materials]]\nname = "foam"\ndensity = 1.0\n[[shapes]]\nname = "c"\n'
+                 + '[[materials]]\nname = "foam"\ndensity = 50.0\n[[shapes]]\nname = "c"\n'
                  'type = "cube"\nside = 0.06\n[[bodies]]\nshape = "c"\nmaterial = "foam"\n'
                  'position = [0.1, 0.1, 0.05]\n')
 FLUME = (_edit(_edit(_edit(FLUID, "upper = [0.2, 0.02, 0.1]", "upper = [6.0, 0.02, 0.44]"),
@@ -56,7 +56,7 @@ ABSURD_CASES = {
     "mesh_size_1e-308": (_edit(RIGID, "side = 0.1", "side = 0.1\nmesh_size = 1e-308"), "run",
                          ["[[shapes]] 'cube'", "mesh_size", "tetrahedra"]),
     "weightless_body_in_water": (BODY_IN_WATER, "run",
-                                 ["[[materials]] 'foam'", "[[bodies]] entry 1", "0.001", "0.3"]),
+                                 ["[[materials]] 'foam'", "[[bodies]] entry 1", "density = 50 kg/m^3", "0.3"]),
     "still_water_level_unlike_the_water": (_edit(FLUME, "still_water_level = 0.3",
                                                  "still_water_level = 0.32"),
                                            "run", ["still_water_level = 0.32", "level = 0.3"]),
@@ -77,11 +77,11 @@ ABSURD_CASES = {
                                        "significant_height = 1e308\nduration = 20.0"),
                                  "run", ["[waves]", "Hm0 = 1e+308", "breaks"]),
     "joint_penalty_1e308": (DEFORMABLE + "joint_penalty = 1e308\n", "run",
-                            ["[deformable]", "joint_penalty = 1e+308", "time step"]),
+                            ["deformable.joint_penalty = 1e+308", "far outside any physical value"]),
     "deformable_viscosity_1e20": (DEFORMABLE + "viscosity = 1e20\n", "run",
-                                  ["[deformable]", "viscosity = 1e+20", "time step"]),
+                                  ["deformable.viscosity = 1e+20", "far outside any physical value"]),
     "young_modulus_1e308": (_edit(DEFORMABLE, "young_modulus = 1e9", "young_modulus = 1e308"),
-                            "run", ["[deformable]", "young_modulus = 1e+308"]),
+                            "run", ["deformable.young_modulus = 1e+308", "far outside any physical value"]),
     "overlapping_tetrahedron_in_a_volume_mesh": (MESH_FILE_CASE, "run",
                                                  ["cube.vtu", "overlapping"]),
     "pack_that_is_a_plain_case": ('format_version = 1\npack = "plain.toml"\n[simulation]\n'
@@ -96,7 +96,7 @@ ABSURD_CASES = {
                             "run", ["[[walls]] entry 1", "point"]),
     "porous_stone_diameter_1e-308": (FLUME + POROUS.format("[[3.0, 0.0], [4.0, 0.3], [4.0, 0.0]]")
                                      .replace("stone_diameter = 0.02", "stone_diameter = 1e-308"),
-                                     "run", ["[[porous_zones]] entry 1", "stone_diameter"]),
+                                     "run", ["stone_diameter = 1e-308", "far outside any physical value"]),
     "grid_file_row_at_1e308": (_edit(PLACEMENT, "rows = 3\nunits_per_row = 3",
                                      'grid_file = "far_grid.csv"'), "place", ["far_grid.csv:3"]),
     "mesh_file_scale_1e150": (_edit(MESH_FILE_CASE, 'file = "cube.vtu"',
