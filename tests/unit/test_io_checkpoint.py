@@ -114,7 +114,7 @@ def test_foreign_npz_is_not_a_checkpoint(tmp_path):
 def test_plain_text_file_is_not_a_checkpoint(tmp_path):
     path = tmp_path / "notes.npz"
     path.write_text("hello")
-    with pytest.raises(CheckpointError, match="notes.npz"):
+    with pytest.raises(CheckpointError, match="notes.npz is not a riprap checkpoint"):
         load_checkpoint(path)
 
 

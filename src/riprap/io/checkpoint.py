@@ -187,6 +187,14 @@ def load_checkpoint(path: str | os.PathLike) -> tuple[dict[str, np.ndarray], dic
             f"checkpoint {path} does not exist; check the path, or start the run from the case "
             "file instead of restarting."
         )
+    with open(path, "rb") as handle:
+        start = handle.read(4)
+    # A checkpoint is a zip archive (np.savez); anything else (a case file, a picture, an empty
+    # file) is named for what it is rather than by numpy's complaint about its bytes.
+    if start and not start.startswith(b"PK"):
+        raise CheckpointError(
+            f"{path} is not a riprap checkpoint (a checkpoint.npz or failure_checkpoint.npz "
+            "written by riprap run); pass one of those with --restart.")
     try:
         # allow_pickle=False: a checkpoint must never execute code when loaded.
         loaded = np.load(path, allow_pickle=False)
