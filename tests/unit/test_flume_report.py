@@ -271,7 +271,7 @@ def test_a_missing_value_of_the_waves_report_says_not_computed_and_why():
 
 
 def test_the_waves_section_reads_a_report_with_holes():
-    from riprap.analysis.flume_test import FlumeRecords
+    from riprap.analysis.flume_test import FlumeRecords, with_derived
     from riprap.io.flume_report import waves_section
 
     report = {"gauges": {"g1": {"x_m": -5.0, "analysed_from_s": 17.0, "Hm0_m": None,
@@ -283,7 +283,7 @@ def test_the_waves_section_reads_a_report_with_holes():
                            columns={"g1_eta_m": np.zeros(11)},
                            target={"type": "irregular", "height_m": 1.2, "period_s": 4.0,
                                    "peak_enhancement": 3.3})
-    page = waves_section(SimpleNamespace(flume=records))
+    page = waves_section(SimpleNamespace(flume=with_derived(records, units={})))
     assert "not computed: run shorter than the analysis window" in page
     assert "1.030" in page                                     # R2% shown
     assert "not computed: no pair of neighbouring surface gauges" in page

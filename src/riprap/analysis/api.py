@@ -43,7 +43,7 @@ def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:
     test's (``waves_report.json`` beside its frames) layer summary gets ``flume_test``, the damage
     beside the design formulas for the measured waves, and the analysis its wave records for the
     report (``riprap.analysis.flume_test``)."""
-    from riprap.analysis.flume_test import FlumeRecords, fluid_force_columns
+    from riprap.analysis.flume_test import FlumeRecords, fluid_force_columns, with_derived
     from riprap.analysis.stability_report import flume_stability
     from riprap.io.analysis_input import is_run_folder, load_run_case
     from riprap.io.body_forces import read_peak_fluid_forces
@@ -82,8 +82,9 @@ def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:
     gauges = read_gauges_csv(Path(path) / "gauges.csv")
     times, columns = gauges if gauges is not None else (None, {})
     contacts = read_unit_contacts_per_frame(path, bodies, until=state.time)
-    return replace(analysis, flume=FlumeRecords(waves_report=waves, times=times, columns=columns,
-                                                target=_target(case), contacts=contacts))
+    records = FlumeRecords(waves_report=waves, times=times, columns=columns, target=_target(case),
+                           contacts=contacts)
+    return replace(analysis, flume=with_derived(records, analysis.units))
 
 
 def _target(case) -> dict | None:

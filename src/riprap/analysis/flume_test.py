@@ -16,7 +16,7 @@ units that rock.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -46,11 +46,39 @@ class FlumeRecords:
     columns: dict = field(default_factory=dict)
     target: dict | None = None
     contacts: dict | None = None
+    #: Filled by :func:`with_derived`: each surface gauge's spectrum or the reason it has none
+    #: (:func:`gauge_spectra`; empty without gauge records), the target's variance density
+    #: ``(frequencies (Hz), density (m^2 s))`` (None unless an irregular sea) and the units that
+    #: rocked (:func:`rocking_share`).
+    spectra: list = field(default_factory=list)
+    target_density: tuple | None = None
+    rocking: dict | None = None
 
     def series(self, suffix: str) -> dict:
         """``{gauge name: values}`` of the gauges whose columns end with ``suffix``."""
         return {name[:-len(suffix)]: values for name, values in self.columns.items()
                 if name.endswith(suffix)}
+
+    def run_up_series(self) -> dict:
+        """``{run-up gauge: highest level above the still water (m)}``."""
+        return self.series(RUN_UP_SUFFIX)
+
+    def overtopping_series(self) -> dict:
+        """``{overtopping gauge: volume over the crest so far (m^3/m)}``."""
+        return self.series(OVERTOPPING_SUFFIX)
+
+
+def with_derived(records: FlumeRecords, units: dict) -> FlumeRecords:
+    """``records`` with what the report shows computed from them (spectra, the target's density,
+    the rocking share of ``units``), so that the report only draws and writes."""
+    target = records.target
+    density = None
+    if target and target.get("type") == "irregular":
+        frequencies = np.linspace(0.0, 3.0 / target["period_s"], 600)
+        density = (frequencies, target_spectrum(target, frequencies))
+    spectra = gauge_spectra(records) if records.times is not None else []
+    return replace(records, spectra=spectra, target_density=density,
+                   rocking=rocking_share(units))
 
 
 def target_spectrum(target: dict, frequencies) -> np.ndarray | None:

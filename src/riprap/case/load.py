@@ -1138,7 +1138,7 @@ def _with_pack(case: Case, pack_path) -> Case:
     first)."""
     import dataclasses
 
-    from riprap.io.pack import PACK_HEADER
+    from riprap.io.case_text import PACK_HEADER
 
     including = Path(case.source).resolve()
     chain = _PACKS_BEING_INCLUDED + [including]

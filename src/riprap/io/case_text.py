@@ -11,7 +11,11 @@ from pathlib import Path
 
 from riprap.errors import CaseFileError
 
-__all__ = ["read_case_text", "read_text_file"]
+__all__ = ["read_case_text", "read_text_file", "PACK_HEADER"]
+
+#: How the first line of every pack file begins: a case that includes a pack (``pack = "..."``)
+#: refuses a file without it, which is a plain case, not a pack written by ``riprap place``.
+PACK_HEADER = "# riprap pack:"  # (riprap/io/pack.py writes it)
 
 
 def read_case_text(path: str | os.PathLike) -> str:

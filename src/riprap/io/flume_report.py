@@ -72,30 +72,22 @@ def _entry_list(report: dict, key: str) -> list:
 
 def write_flume_figures(out: Path, analysis) -> dict:
     """The flume test's pictures in ``out``; ``{what: path}`` (none for a run without waves)."""
-    from riprap.analysis.flume_test import (OVERTOPPING_SUFFIX, RUN_UP_SUFFIX, gauge_spectra,
-                                            target_spectrum)
     from riprap.io import flume_figures as figures
 
     records = getattr(analysis, "flume", None)
     if records is None:
         return {}
     report = records.waves_report or {}
-    target = records.target
-    density = None
-    if target and target.get("type") == "irregular":
-        frequencies = np.linspace(0.0, 3.0 / target["period_s"], 600)
-        density = (frequencies, target_spectrum(target, frequencies))
-    spectra = gauge_spectra(records) if records.times is not None else []
-    written = {"waves_spectra": figures.spectra_figure(out / "waves_spectra.png", spectra, target,
-                                                       density),
+    written = {"waves_spectra": figures.spectra_figure(out / "waves_spectra.png", records.spectra,
+                                                       records.target, records.target_density),
                "waves_run_up": figures.gauge_record_figure(
-                   out / "waves_run_up.png", records.times, records.series(RUN_UP_SUFFIX),
+                   out / "waves_run_up.png", records.times, records.run_up_series(),
                    _entries(report, "run_up"), ylabel="level above SWL (m)",
                    title="Run-up gauges: the highest water level on the face",
                    lines=(("R2%_m", "R2%"), ("R_max_m", "R max"))),
                "waves_overtopping": figures.gauge_record_figure(
                    out / "waves_overtopping.png", records.times,
-                   records.series(OVERTOPPING_SUFFIX), _entries(report, "overtopping"),
+                   records.overtopping_series(), _entries(report, "overtopping"),
                    ylabel="volume (m$^3$/m)",
                    title="Overtopping gauges: the water over the crest, per metre of width"),
                "stability_profiles": figures.profiles_figure(out / "stability_profiles.png",
@@ -108,13 +100,11 @@ def write_flume_figures(out: Path, analysis) -> dict:
 
 
 def _spectra_note(analysis) -> str:
-    from riprap.analysis.flume_test import gauge_spectra
-
     records = getattr(analysis, "flume", None)
     if records.times is None:
         return ("<p class='missing'>not computed: the run folder has no <code>gauges.csv</code> "
                 "to read the spectra from.</p>")
-    missing = [s for s in gauge_spectra(records) if "reason" in s]
+    missing = [s for s in records.spectra if "reason" in s]
     return "".join(f"<p class='missing'>{html.escape(s['name'])}: spectrum not computed: "
                    f"{html.escape(s['reason'])}</p>" for s in missing)
 
@@ -235,8 +225,6 @@ def _still_water_ratio(test: dict) -> float:
 
 def stability_section(analysis) -> str:
     """The stability section of the report (empty for a run without waves)."""
-    from riprap.analysis.flume_test import rocking_share
-
     test = analysis.layer.get("flume_test")
     if getattr(analysis, "flume", None) is None or not isinstance(test, dict):
         return ""
@@ -287,7 +275,7 @@ def stability_section(analysis) -> str:
              _row("eroded area A_e (m^2), damage level S = A_e / Dn^2",
                   _format(layer.get("eroded_area_m2"), "{:.3f}", no_reference) + ", "
                   + _format(layer.get("damage_level_s"), "{:.2f}", no_reference))]
-    share = rocking_share(units)
+    share = analysis.flume.rocking
     rows.append(_row(f"units that rocked (> {layer.get('rocking_angle_deg', 2.0):g} deg and back)",
                      f"{len(share['units_rocking'])} of {share['units']} "
                      f"({100 * share['share']:.0f} %)" if share else

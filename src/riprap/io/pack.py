@@ -38,6 +38,7 @@ import numpy as np
 
 from riprap.case import schema
 from riprap.errors import CaseFileError
+from riprap.io.case_text import PACK_HEADER
 from riprap.geometry.tetmesh import TetMesh
 from riprap.io.mesh_files import write_volume_mesh
 
@@ -46,9 +47,6 @@ __all__ = ["PackBody", "write_pack", "PACK_FILE_NAME", "PACK_HEADER", "SHAPES_FO
 
 #: Name of the case file inside a pack folder.
 PACK_FILE_NAME = "pack.toml"
-#: How the first line of every pack file begins: a case that includes a pack (``pack = "..."``)
-#: refuses a file without it, which is a plain case, not a pack written by ``riprap place``.
-PACK_HEADER = "# riprap pack:"
 #: Sub-folder of a pack holding the shapes' meshes.
 SHAPES_FOLDER = "shapes"
 

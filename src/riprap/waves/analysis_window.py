@@ -87,7 +87,7 @@ class FlumeWindows:
 def flume_windows(wave_source, gauges) -> FlumeWindows | None:
     """The windows of ``gauges`` (a GaugeSet) for the waves of ``wave_source`` (a WaveRelaxation
     or BoundaryWaveMaker); None when the flume makes no waves or has no gauges."""
-    from riprap.waves.report import group_velocity
+    from riprap.waves.theory import group_velocity
 
     wave = getattr(wave_source, "wave", None)
     if wave is None or gauges is None or not gauges.gauges:

@@ -18,16 +18,10 @@ from riprap.errors import CaseFileError
 from riprap.waves.analysis import (separate_incident_reflected, separate_regular_wave,
                                    separate_three_gauges, wave_statistics)
 from riprap.waves.gauges import OVERTOPPING, RUN_UP, SURFACE
+from riprap.waves.theory import group_velocity
 
 __all__ = ["flume_report", "group_velocity", "arrival_time", "run_up_statistics",
            "overtopping_statistics"]
-
-
-def group_velocity(period: float, depth: float, wave_length: float) -> float:
-    """c_g = c/2 (1 + 2kd / sinh(2kd)) (m/s)."""
-    k = 2.0 * math.pi / wave_length
-    c = wave_length / period
-    return 0.5 * c * (1.0 + 2.0 * k * depth / math.sinh(2.0 * k * depth))
 
 
 def arrival_time(wave_source, x: float) -> float:

@@ -20,7 +20,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 
-__all__ = ["wave_number", "wave_length", "LinearWave", "StokesSecondOrderWave", "IrregularWave",
+__all__ = ["wave_number", "wave_length", "group_velocity", "LinearWave", "StokesSecondOrderWave", "IrregularWave",
            "jonswap_spectrum", "ramp"]
 
 GRAVITY = 9.81
@@ -55,6 +55,13 @@ def wave_number(period: float, depth: float, gravity: float = GRAVITY) -> float:
 def wave_length(period: float, depth: float, gravity: float = GRAVITY) -> float:
     """L = 2 pi / k (m) of linear theory."""
     return 2.0 * math.pi / wave_number(period, depth, gravity)
+
+
+def group_velocity(period: float, depth: float, wave_length: float) -> float:
+    """c_g = c/2 (1 + 2kd / sinh(2kd)) (m/s)."""
+    k = 2.0 * math.pi / wave_length
+    c = wave_length / period
+    return 0.5 * c * (1.0 + 2.0 * k * depth / math.sinh(2.0 * k * depth))
 
 
 def ramp(time, ramp_time: float):
