@@ -8,6 +8,8 @@ import pytest
 from riprap.cli import main
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+SMOKE_REFERENCE = json.loads((EXAMPLES.parent / "tests" / "regression"
+                              / "smoke_reference.json").read_text())
 # every folder's case.toml, and the variants beside it (e.g. 04's deformable sphere)
 CASES = sorted(EXAMPLES.glob("*/*.toml"))
 
@@ -38,6 +40,10 @@ def test_example_runs(case, tmp_path):
                  "--quiet"]) == 0
     text = case.read_text()
     assert "riprap run examples/" in text, "each example says how to run it"
+    # the same files as recorded before issue 36's restructuring (tests/regression)
+    out = tmp_path / case.parent.name / case.stem
+    written = sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file())
+    assert written == SMOKE_REFERENCE["files"][f"{case.parent.name}/{case.stem}"]
 
 
 def test_no_missing_examples():
