@@ -10,6 +10,7 @@ that a kernel compiled against an older version of another kernel file is never 
 
 Set ``NUMBA_DISABLE_JIT=1`` to run every kernel as plain Python (slow) for tracebacks and debugging.
 """
+import hashlib
 import os
 
 # OpenMP worker threads that spin while waiting steal the only other core of a small machine from
@@ -26,6 +27,25 @@ os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 import numba  # noqa: E402
 
 
+def kernel_source_hash(package_dir: str, extra_files=(), salt: str = "") -> str:
+    """SHA-256 of every ``.py`` file in a ``kernels`` folder under ``package_dir``, of
+    ``extra_files`` and of ``salt``, in a fixed order: the stamp of numba's on-disk cache.
+
+    It reads riprap's own source files, the one file reading outside ``riprap/io/`` (an exemption
+    named in ``tests/architecture/test_layers.py``): ``_jit`` stands on the ground floor, under
+    ``io``, and every kernel module imports it."""
+    digest = hashlib.sha256(salt.encode())
+    paths = []
+    for root, folders, files in os.walk(package_dir):
+        folders.sort()
+        if os.path.basename(root) == "kernels":
+            paths += [os.path.join(root, name) for name in sorted(files) if name.endswith(".py")]
+    for path in sorted(paths) + [os.path.abspath(p) for p in extra_files]:
+        with open(path, "rb") as stream:
+            digest.update(os.path.relpath(path, package_dir).encode() + b"\0" + stream.read())
+    return digest.hexdigest()
+
+
 def _use_source_stamped_cache() -> None:
     """Put riprap's own cache locators (numba's three file-backed ones, stamped with one hash of
     all kernel sources) in front of numba's; functions outside riprap keep numba's behaviour. numba's locator list is not
@@ -38,8 +58,6 @@ def _use_source_stamped_cache() -> None:
         existing = list(caching.CacheImpl._locator_classes)
     except AttributeError:
         return
-    from riprap.io.source_hash import kernel_source_hash
-
     package_dir = os.path.dirname(os.path.abspath(__file__))
     # numba judges a cached function fresh by its own file's time stamp and size only, but a
     # cached kernel carries compiled copies of the kernels it calls from other files: after one

@@ -96,7 +96,7 @@ def test_restart_in_a_fresh_process_after_another_run_filled_the_cache(tmp_path)
 
 def test_riprap_kernels_are_cached_under_one_stamp_of_all_kernel_sources(tmp_path):
     from riprap._jit import kernel
-    from riprap.io.source_hash import kernel_source_hash
+    from riprap._jit import kernel_source_hash
     from riprap.solid.kernels import integrate
 
     locator = integrate.kick._cache._impl._locator
