@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from riprap.analysis import analyse_layer
-from riprap.io.analysis_input import load_layer_state
+from riprap.workflows.layer_input import load_layer_state
 from riprap.io.analysis_report import write_analysis
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -33,7 +33,7 @@ DEFAULT_PACK = ROOT / "bench" / ".cache" / "coreloc_small"
 
 def _ensure_small_pack() -> Path:
     if not (DEFAULT_PACK / "layer.json").is_file():
-        from riprap.case.build_placement import run_placement
+        from riprap.workflows.place import run_placement
         from riprap.case.load import load_case
 
         print(f"placing examples/coreloc_small.toml into {DEFAULT_PACK} (once) ...", flush=True)

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from riprap.case.build import build_simulation
-from riprap.case.build_placement import run_placement
+from riprap.workflows.place import run_placement
 from riprap.case.load import load_case
 from riprap.solid.kernels.contact import body_pair_potential_force
 from riprap.solid.kernels.reference import reference_body_contact

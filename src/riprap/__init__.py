@@ -10,7 +10,6 @@ The public API, one namespace::
 __version__ = "0.1.0"
 
 from riprap import analysis, deformable, errors, placement
-from riprap.analysis import analyse, compare_layers
 from riprap.case.build import build_simulation
 from riprap.case.load import load_case, parse_case
 from riprap.deformable import DeformableBody, ElasticMaterial
@@ -28,6 +27,7 @@ from riprap.solid import walls
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
 from riprap.solid.solver import ContactRecords, SolidSolver
+from riprap.workflows.analyse import analyse, compare_layers
 
 __all__ = [
     "AIR_20C", "ArmourUnit", "ContactRecords", "DeformableBody", "ElasticMaterial", "deformable", "FluidGrid", "FluidRun", "FluidSolver", "Phase",

@@ -20,14 +20,20 @@ import argparse
 import sys
 from pathlib import Path
 
+import riprap
+from riprap.case.build import SMOKE_END_TIME, build_simulation, smoke_mode
+from riprap.case.build_fluid import build_fluid_run
+from riprap.case.load import load_case
 from riprap.errors import CaseFileError, RiprapError, plain_numbers
+from riprap.io.json_files import read_json_object
+from riprap.io.output_folder import describe_os_error
+from riprap.work_estimate import RiprapWarning
+from riprap.workflows.analyse import analyse, compare_layers
+from riprap.workflows.check import check_case
+from riprap.workflows.place import run_placement
 
 
 def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> int:
-    from riprap.case.build import build_simulation
-    from riprap.case.build_fluid import build_fluid_run
-    from riprap.case.load import load_case
-
     case = load_case(path)
     _say_if_smoke()
     if case.is_placement:
@@ -76,8 +82,6 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
 
 def _say_waves_report(path: Path) -> None:
     """What the flume run's wave analysis could not compute, and its cautions (few waves)."""
-    from riprap.io.json_files import read_json_object
-
     report = read_json_object(path, "waves report", "the run wrote it just now")
     for item in report.get("not_computed", []):
         print(f"riprap: waves: not computed: {item}")
@@ -86,17 +90,12 @@ def _say_waves_report(path: Path) -> None:
 
 
 def _say_if_smoke() -> None:
-    from riprap.case.build import SMOKE_END_TIME, smoke_mode
-
     if smoke_mode():
         print(f"riprap: SMOKE MODE (RIPRAP_SMOKE=1): every run is cut to {SMOKE_END_TIME} s of "
               "simulated time; its figures are not results", file=sys.stderr)
 
 
 def _place_case(path: Path, out: str | None, quiet: bool) -> int:
-    from riprap.case.build_placement import run_placement
-    from riprap.case.load import load_case
-
     case = load_case(path)
     _say_if_smoke()
     print(f"riprap: placement case {path}: {case.armour.unit if case.armour else '?'} units on a "
@@ -121,8 +120,6 @@ def _place_case(path: Path, out: str | None, quiet: bool) -> int:
 
 
 def _analyse(paths: list[Path], out: str | None, frame: int, labels: list[str] | None) -> int:
-    from riprap.analysis import analyse, compare_layers
-
     if len(paths) == 1:
         out = out or str((paths[0] if paths[0].is_dir() else paths[0].parent) / "analysis")
         analysis = analyse(paths[0], out=out, frame=frame)
@@ -178,9 +175,6 @@ def _say_flume_test(flume: dict | None) -> None:
 
 
 def _check(path: Path, out: str | None, restart: str | None = None) -> int:
-    from riprap.case.load import load_case
-    from riprap.case.preflight import check_case
-
     report = check_case(load_case(path), output_directory=out, restart=restart)
     print(f"{path}: valid ({report.description})")
     print(f"  checked: {'; '.join(report.checked)}")
@@ -198,8 +192,6 @@ def _info() -> int:
     import numba
     import numpy
     import scipy
-
-    import riprap
 
     print(f"riprap {riprap.__version__} ({Path(riprap.__file__).parent})")
     print(f"Python {platform.python_version()} ({sys.executable}), {platform.platform()}")
@@ -267,8 +259,6 @@ def _dispatch(args) -> int:
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     """riprap's own warnings as one line each; numpy's RuntimeWarnings are not shown (riprap checks
     that the state stays finite and names the body and time when it does not)."""
-    from riprap.work_estimate import RiprapWarning
-
     if issubclass(category, RiprapWarning):
         print(f"riprap: warning: {plain_numbers(str(message))}", file=sys.stderr)
     elif not issubclass(category, RuntimeWarning):
@@ -290,8 +280,6 @@ def main(argv: list[str] | None = None) -> int:
     except RiprapError as error:
         print(f"riprap: error: {error}", file=sys.stderr)
     except OSError as error:
-        from riprap.io.output_folder import describe_os_error
-
         print(f"riprap: error: {describe_os_error(error)}", file=sys.stderr)
     except MemoryError:
         print("riprap: error: out of memory; use fewer bodies, tetrahedra or cells "

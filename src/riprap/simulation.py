@@ -694,8 +694,8 @@ class Simulation:
 
     def contact_statistics(self) -> dict:
         """Per body: coordination number, largest contact force (N) and factor of safety against
-        sliding (:func:`riprap.analysis.unit_contacts.solver_contact_statistics`)."""
-        from riprap.analysis.unit_contacts import solver_contact_statistics
+        sliding (:func:`riprap.solid.contact_statistics.solver_contact_statistics`)."""
+        from riprap.solid.contact_statistics import solver_contact_statistics
 
         return solver_contact_statistics(self.solver)
 

@@ -192,7 +192,7 @@ def test_frames_of_a_run_started_from_the_pack_are_analysed(pack, tmp_path, monk
 
 
 def test_two_packs_are_compared_side_by_side(pack, tmp_path):
-    from riprap.analysis import compare_layers
+    from riprap.workflows.analyse import compare_layers
 
     other = _copy_pack(pack, tmp_path / "other")
     analyses = compare_layers([pack, other], out=tmp_path / "cmp", labels=["first", "second"])

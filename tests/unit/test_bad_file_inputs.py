@@ -19,7 +19,7 @@ from riprap.errors import CaseFileError, MeshError
 from riprap.geometry import shapes
 from riprap.geometry.armour_units import armour_unit
 from riprap.geometry.tetmesh import TetMesh
-from riprap.io.analysis_input import load_run_state
+from riprap.workflows.layer_input import load_run_state
 from riprap.io.layer_file import (CONTACT_COLUMNS, read_contact_table, read_layer_file,
                                   write_layer_file)
 from riprap.io.mesh_files import read_mesh

@@ -1,4 +1,4 @@
-"""Pack files (riprap.io.pack): written, loaded with load_case, built with build_simulation.
+"""Pack files (riprap.io.pack, checked by riprap.workflows.place.write_checked_pack): written, loaded with load_case, built with build_simulation.
 
 What must round-trip: the world position of every node of every body (1e-12 m: the loader
 re-derives each written mesh's principal frame, whose axes are arbitrary for a cube or a sphere,
@@ -20,7 +20,8 @@ from riprap.errors import CaseFileError
 from riprap.geometry import shapes
 from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.tetmesh import TetMesh
-from riprap.io.pack import PackBody, write_pack
+from riprap.io.pack import PackBody
+from riprap.workflows.place import write_checked_pack as write_pack
 from riprap.simulation import Simulation
 from riprap.solid import walls as wall_builders
 from riprap.solid.materials import Material

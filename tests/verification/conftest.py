@@ -88,7 +88,7 @@ def small_placement(tmp_path_factory):
     """``examples/coreloc_small.toml`` placed in full once per session: (summary, output folder)."""
     from pathlib import Path
 
-    from riprap.case.build_placement import run_placement
+    from riprap.workflows.place import run_placement
     from riprap.case.load import load_case
 
     example = Path(__file__).resolve().parents[2] / "examples" / "coreloc_small.toml"

@@ -16,8 +16,8 @@ Checks and sources:
 import numpy as np
 import pytest
 
-from riprap.analysis import analyse
-from riprap.analysis.unit_contacts import unit_contacts
+from riprap.workflows.analyse import analyse
+from riprap.solid.contact_statistics import unit_contacts
 
 EQUILIBRIUM_TOLERANCE = 0.05
 PAPER_COORDINATION_RANGE = (2, 10)

@@ -19,7 +19,7 @@ import json
 import numpy as np
 import pytest
 
-from riprap.analysis import analyse
+from riprap.workflows.analyse import analyse
 from riprap.cli import main
 from riprap.io.checkpoint import load_checkpoint
 

@@ -5,7 +5,7 @@ where it is (world and slope coordinates, height above the face and above the un
 distance from its design position), what it touches (coordination number: bodies and walls
 touched; how many of them units), the largest contact force it carries (all contacts, with
 units, with the underlayer), its weight, factors of safety against sliding
-(:func:`~riprap.analysis.unit_contacts.sliding_factor_of_safety`) and rocking
+(:func:`~riprap.solid.contact_statistics.sliding_factor_of_safety`) and rocking
 (:func:`~riprap.analysis.rocking.rocking_factor_of_safety`), ``factor_of_safety`` the smaller of
 the two, for each named axis of the unit its world direction, trend and plunge and its point
 on the lower-hemisphere equal-area net, and how far it moved and turned since the reference state
@@ -30,7 +30,7 @@ from riprap.analysis.damage import (damage_level_s, damage_number_nod, displaced
 from riprap.analysis.displacements import DISPLACEMENT_COLUMNS, unit_displacements
 from riprap.analysis.orientations import equal_area_points, lower_hemisphere, trend_plunge
 from riprap.analysis.rocking import rocking_factor_of_safety
-from riprap.analysis.unit_contacts import sliding_factor_of_safety, unit_contacts
+from riprap.solid.contact_statistics import sliding_factor_of_safety, unit_contacts
 from riprap.placement import layer_metrics
 
 __all__ = ["LayerAnalysis", "analyse_layer", "CONTACT_FORCE_PERCENTILES"]

@@ -3,7 +3,7 @@
 A :class:`LayerState` is a snapshot of every body (pose, shape, material, fixed or free), the plane
 walls, the contacts between them with their forces, and the :class:`LayerDescription` that says
 which bodies are armour units, where they were meant to go and how the slope lies. It is made
-from a pack folder or a frame of a run by :mod:`riprap.io.analysis_input`, or directly from a
+from a pack folder or a frame of a run by :mod:`riprap.workflows.layer_input`, or directly from a
 running :class:`riprap.Simulation` by :func:`state_from_simulation`.
 
 Frames. ``rotations[b]`` turns the mesh of the body's shape, as stored in ``meshes``, into the
@@ -17,7 +17,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from riprap.errors import CaseFileError
+from riprap.geometry.mass_properties import mass_properties
 from riprap.placement.slope import Slope
+from riprap.solid.contact_statistics import pair_friction
 
 __all__ = ["LayerDescription", "LayerState", "state_from_simulation"]
 
@@ -70,6 +73,19 @@ class LayerDescription:
     @property
     def n_units(self) -> int:
         return len(self.unit_bodies)
+
+    @classmethod
+    def from_fields(cls, fields: dict) -> "LayerDescription":
+        """The description read from a ``layer.json`` (:func:`riprap.io.layer_file.read_layer_file`
+        gives its fields as plain data); a slope the :class:`Slope` refuses is named with the
+        file and line of its field."""
+        fields = dict(fields)
+        where = fields.pop("slope_source", "layer.json")
+        try:
+            slope = Slope(**fields.pop("slope"))
+        except CaseFileError as error:
+            raise CaseFileError(f"{where}: 'slope': {error}") from None
+        return cls(slope=slope, **fields)
 
     @classmethod
     def for_unit(cls, unit, unit_shape, *, slope, underlayer_top, unit_bodies, rows,
@@ -186,24 +202,18 @@ class LayerState:
 
     def masses(self) -> np.ndarray:
         """Mass of each body (kg)."""
-        from riprap.geometry.mass_properties import mass_properties
-
         volumes = np.array([mass_properties(mesh, density=1.0).volume for mesh in self.meshes])
         density = np.array([m.density for m in self.materials])
         return volumes[self.shape_of_body] * density[self.material_of_body]
 
     def contact_friction(self) -> np.ndarray:
         """Friction coefficient of each contact row (the smaller of the two materials')."""
-        from riprap.analysis.unit_contacts import pair_friction
-
         return pair_friction(self.contacts, [m.friction_coefficient for m in self.materials],
                              self.material_of_body, self.wall_materials)
 
 
 def state_from_simulation(sim, layer: LayerDescription, *, source: str = "simulation") -> LayerState:
     """The current state of a :class:`riprap.Simulation` (its solver's bodies, walls and contacts)."""
-    from riprap.geometry.mass_properties import mass_properties
-
     solver = sim.solver
     meshes = [shape.mesh for shape in solver.shapes]
     names = [None] * len(meshes)

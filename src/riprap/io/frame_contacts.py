@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from riprap.io.analysis_input import read_frame_mesh, read_pvd_frames
+
 __all__ = ["read_unit_contacts_per_frame", "FRAME_CONTACT_FIELDS"]
 
 #: The cell fields of a bodies frame read, in the order of the arrays returned.
@@ -18,15 +20,13 @@ def read_unit_contacts_per_frame(run_folder, unit_bodies, *, until: float = np.i
     ``run_folder``'s ``bodies.pvd`` up to time ``until``, or None when its frames do not carry
     those fields (a coupled run written before issue 35). A frame that cannot be read is a
     CaseFileError naming it (riprap.io.analysis_input)."""
-    from riprap.io.analysis_input import _pvd_frames, _read_frame_mesh
-
     run_folder = Path(run_folder)
     units = np.asarray(unit_bodies, dtype=np.int64)
     times, values = [], {name: [] for name in FRAME_CONTACT_FIELDS}
-    for index, (time, name) in enumerate(_pvd_frames(run_folder / "bodies.pvd")):
+    for index, (time, name) in enumerate(read_pvd_frames(run_folder / "bodies.pvd")):
         if time > until:
             break
-        mesh = _read_frame_mesh(run_folder / name, f"frame {index} of bodies.pvd (t = {time:g} s)")
+        mesh = read_frame_mesh(run_folder / name, f"frame {index} of bodies.pvd (t = {time:g} s)")
         data = mesh.cell_data_dict
         if any(field not in data or "triangle" not in data[field]
                for field in FRAME_CONTACT_FIELDS + ("body_id",)):

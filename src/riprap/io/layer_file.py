@@ -27,6 +27,7 @@ import numpy as np
 from riprap.errors import CaseFileError
 from riprap.io.case_text import read_text_file
 from riprap.io.json_files import strict_loads, write_json
+from riprap.solid.solver import ContactRecords
 
 __all__ = ["LAYER_FILE_NAME", "CONTACTS_FILE_NAME", "LAYER_FORMAT", "LAYER_FORMAT_VERSION",
            "write_layer_file", "read_layer_file", "write_contact_table", "read_contact_table",
@@ -170,13 +171,13 @@ def _field_line(text: str, name: str) -> int | None:
     return text.count("\n", 0, match.start()) + 1 if match else None
 
 
-def read_layer_file(directory, n_bodies: int | None = None):
-    """Read ``layer.json`` of a pack folder into a
-    :class:`~riprap.analysis.layer_state.LayerDescription`; ``n_bodies``: the pack's body count,
-    to check the body indices against."""
-    from riprap.analysis.layer_state import LayerDescription
-    from riprap.placement.slope import Slope
+def read_layer_file(directory, n_bodies: int | None = None) -> dict:
+    """Read ``layer.json`` of a pack folder, every field checked; ``n_bodies``: the pack's body
+    count, to check the body indices against.
 
+    Returns the fields of :class:`~riprap.analysis.layer_state.LayerDescription`
+    (``LayerDescription.from_fields`` builds it) as plain data: numbers, arrays, ``slope`` a dict
+    of its six numbers, and ``slope_source`` the file and line that a slope error names."""
     path = Path(directory) / LAYER_FILE_NAME
     if not path.is_file():
         raise CaseFileError(
@@ -234,17 +235,15 @@ def read_layer_file(directory, n_bodies: int | None = None):
             line = _field_line(text, name) if name else None
             located.append(f"{path}:{line}: {message}" if line else f"{path}: {message}")
         raise CaseFileError.from_problems(located, 20)
-    try:
-        slope = Slope(**{name: float(data["slope"][name]) for name in _SLOPE_FIELDS})
-    except CaseFileError as error:
-        line = _field_line(text, "slope")
-        raise CaseFileError(f"{path}{f':{line}' if line else ''}: 'slope': {error}") from None
-    return LayerDescription(
+    slope_line = _field_line(text, "slope")
+    return dict(
         unit_kind=data["unit_kind"], unit_shape=data["unit_shape"],
         nominal_diameter=float(data["nominal_diameter_m"]), unit_volume=float(data["unit_volume_m3"]),
         unit_height=float(data["unit_height_m"]),
         unit_axes={name: np.asarray(axis, dtype=float) for name, axis in data["unit_axes"].items()},
-        slope=slope, underlayer_top=float(data["underlayer_top_m"]),
+        slope={name: float(data["slope"][name]) for name in _SLOPE_FIELDS},
+        slope_source=f"{path}{f':{slope_line}' if slope_line else ''}",
+        underlayer_top=float(data["underlayer_top_m"]),
         unit_bodies=np.asarray(data["unit_bodies"], dtype=np.int64),
         rows=np.asarray(data["rows"], dtype=np.int64),
         design_positions=np.asarray(data["design_positions"], dtype=float).reshape(-1, 3),
@@ -294,8 +293,6 @@ def read_contact_table(path):
     integer body indices (``body_i >= 0``, ``body_j != body_i``) and finite numbers; errors name
     the file, the line and the column.
     """
-    from riprap.solid.solver import ContactRecords
-
     path = Path(path)
     if not path.is_file():
         raise CaseFileError(

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import datetime
 import difflib
+import importlib.metadata
 import math
 import os
 import re
@@ -38,8 +39,9 @@ import numpy as np
 
 from riprap.case import schema
 from riprap.errors import CaseFileError
-from riprap.io.case_text import PACK_HEADER
 from riprap.geometry.tetmesh import TetMesh
+from riprap.io.case_text import PACK_HEADER
+from riprap.io.contact_history import CONTACT_HISTORY_FILE_NAME, write_contact_history
 from riprap.io.mesh_files import write_volume_mesh
 
 __all__ = ["PackBody", "write_pack", "PACK_FILE_NAME", "PACK_HEADER", "SHAPES_FOLDER",
@@ -225,13 +227,20 @@ def _check_references(shapes: Mapping, materials: Sequence, bodies: Sequence,
         raise error
 
 
-def _header(comment: str, n_bodies: int, n_shapes: int) -> list[str]:
-    import riprap
+def _riprap_version() -> str:
+    """The installed riprap's version (from its package metadata: io stands below the package's
+    ``__init__`` and does not import it)."""
+    try:
+        return importlib.metadata.version("riprap")
+    except importlib.metadata.PackageNotFoundError:      # run from a source tree, not installed
+        return "unknown"
 
+
+def _header(comment: str, n_bodies: int, n_shapes: int) -> list[str]:
     now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
     lines = [
         f"{PACK_HEADER} {n_bodies} bodies, {n_shapes} shapes; written by riprap "
-        f"{riprap.__version__} (riprap.io.pack.write_pack) on {now}",
+        f"{_riprap_version()} (riprap.io.pack.write_pack) on {now}",
         "# Start a run from it with: riprap run pack.toml",
         "# Each shape's mesh (shapes/*.vtu) is in the body's own frame; a body's orientation",
         "# rotates that mesh into the world and its position is the mesh centroid's place (m).",
@@ -300,12 +309,10 @@ def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
     ------
     CaseFileError
         Unknown shape or material names, duplicate material names, no bodies, unknown
-        ``[simulation]`` or ``[output]`` keys, non-finite numbers; or, naming ``pack.toml`` and
-        its line, any value the case schema rejects (the written file is validated before
-        returning).
+        ``[simulation]`` or ``[output]`` keys, non-finite numbers. The written file is not read
+        back here: :func:`riprap.workflows.place.write_checked_pack` does that through the case
+        parser, naming ``pack.toml`` and its line for any value the schema rejects.
     """
-    from riprap.case.load import parse_case
-
     shapes = dict(shapes)
     materials = list(materials)
     bodies = list(bodies)
@@ -317,8 +324,6 @@ def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
     folder = Path(directory)
     (folder / SHAPES_FOLDER).mkdir(parents=True, exist_ok=True)
     if contact_history is not None:
-        from riprap.io.contact_history import CONTACT_HISTORY_FILE_NAME, write_contact_history
-
         write_contact_history(folder / CONTACT_HISTORY_FILE_NAME, contact_history)
         simulation_values["contact_history"] = CONTACT_HISTORY_FILE_NAME
     stems = _file_stems(shapes)
@@ -348,7 +353,4 @@ def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
         _write_atomically(path, text)
     except OSError as error:
         raise CaseFileError(f"{path}: cannot write the pack file: {error.strerror}") from None
-    # Reading it back now turns a value the schema rejects into an error that names this file
-    # and line, instead of a surprise at the next `riprap run`.
-    parse_case(text, source=os.fspath(path), base_dir=folder.resolve())
     return path

@@ -289,7 +289,7 @@ class CoupledModel(FluidModel):
         and the frame of ``contacts.pvd`` (the last contact sub-step's contacts), so that
         ``riprap analyse`` gets coordination numbers, contact forces and factors of safety under
         wave load as it does dry."""
-        from riprap.analysis.unit_contacts import solver_contact_statistics
+        from riprap.solid.contact_statistics import solver_contact_statistics
         from riprap.io import vtk
         from riprap.solid.surfaces import surface_arrays
 

@@ -12,8 +12,17 @@ from pathlib import Path
 
 import numpy as np
 
+from riprap.analysis.flume_test import FlumeRecords, fluid_force_columns, with_derived
 from riprap.analysis.layer_analysis import LayerAnalysis, analyse_layer
+from riprap.analysis.stability_report import flume_stability
 from riprap.errors import CaseFileError
+from riprap.io.analysis_input import is_run_folder, load_waves_report
+from riprap.io.analysis_report import write_analysis, write_comparison
+from riprap.io.body_forces import read_peak_fluid_forces
+from riprap.io.frame_contacts import read_unit_contacts_per_frame
+from riprap.io.gauge_files import read_gauges_csv
+from riprap.io.output_folder import prepare_output_folder
+from riprap.workflows.layer_input import load_layer_state, load_run_case
 
 __all__ = ["analyse", "compare_layers"]
 
@@ -22,9 +31,6 @@ def analyse(path, *, out=None, frame: int = -1) -> LayerAnalysis:
     """Analyse the pack folder (or ``pack.toml``) or run folder ``path``; with ``out``, write
     ``units.csv``, ``report.html``, ``stereonet.png`` and the rest there
     (:mod:`riprap.io.analysis_report`). ``frame``: which frame of a run (-1 the last)."""
-    from riprap.io.analysis_input import load_layer_state, load_waves_report
-    from riprap.io.output_folder import prepare_output_folder
-
     # A broken waves report is refused before any work (and before the output folder is made).
     waves = load_waves_report(path)
     if out is not None:
@@ -32,8 +38,6 @@ def analyse(path, *, out=None, frame: int = -1) -> LayerAnalysis:
     analysis = analyse_layer(load_layer_state(path, frame=frame))
     analysis = _add_flume_test(path, waves, analysis)
     if out is not None:
-        from riprap.io.analysis_report import write_analysis
-
         analysis.layer["outputs"] = write_analysis(out, analysis)
     return analysis
 
@@ -43,13 +47,6 @@ def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:
     test's (``waves_report.json`` beside its frames) layer summary gets ``flume_test``, the damage
     beside the design formulas for the measured waves, and the analysis its wave records for the
     report (``riprap.analysis.flume_test``)."""
-    from riprap.analysis.flume_test import FlumeRecords, fluid_force_columns, with_derived
-    from riprap.analysis.stability_report import flume_stability
-    from riprap.io.analysis_input import is_run_folder, load_run_case
-    from riprap.io.body_forces import read_peak_fluid_forces
-    from riprap.io.frame_contacts import read_unit_contacts_per_frame
-    from riprap.io.gauge_files import read_gauges_csv
-
     if not is_run_folder(path):
         return analysis
     case = load_run_case(path)
@@ -116,10 +113,6 @@ def _labels(paths, labels):
 def compare_layers(paths, *, out, labels=None, frame: int = -1) -> list[LayerAnalysis]:
     """Analyse several packs or runs and put their figures side by side in ``out``
     (``comparison.html``, and each one's files in ``out/<label>/``)."""
-    from riprap.io.analysis_input import load_layer_state
-    from riprap.io.analysis_report import write_comparison
-    from riprap.io.output_folder import prepare_output_folder
-
     paths = list(paths)
     if len(paths) < 2:
         raise CaseFileError(f"compare_layers: give two or more packs or runs, got {len(paths)}")

@@ -11,20 +11,35 @@ Output folder:
 """
 from __future__ import annotations
 
+import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from riprap.analysis.layer_state import LayerDescription
+from riprap.case.body_start import check_grid_starts
 from riprap.case.build import SMOKE_END_TIME, build_material, smoke_mode
+from riprap.case.load import parse_case
 from riprap.case.schema import MAXIMUM_BODY_COUNT
 from riprap.errors import CaseFileError
-from riprap.placement.checks import check_filter_rule, check_row_fits
-from riprap.placement.place import UNIT_SHAPE_NAME, rock_lattice, rock_shapes
-from riprap.work_estimate import RiprapWarning
+from riprap.geometry.armour_units import armour_unit
+from riprap.geometry.rock_grading import RockGrading, rock_library
+from riprap.io.case_text import read_case_text
+from riprap.io.grid_file import read_grid_file
+from riprap.io.layer_file import CONTACTS_FILE_NAME, write_contact_table, write_layer_file
+from riprap.io.output_folder import prepare_output_folder
+from riprap.io.pack import PackBody, write_pack
+from riprap.io.summary import write_json
 from riprap.placement import (PlacementMaterials, Slope, build_underlayer, design_grid,
                               place_units, unit_orientations)
+from riprap.placement.checks import check_filter_rule, check_row_fits
+from riprap.placement.place import (UNIT_SHAPE_NAME, check_generated_positions,
+                                    check_start_positions, free_body_time_step, rock_lattice,
+                                    rock_shapes)
+from riprap.solid.shape import RigidShape
+from riprap.work_estimate import RiprapWarning, check_rigid_run
 
 
 def _material(case, name):
@@ -43,8 +58,6 @@ def _require_tables(case) -> None:
 
 
 def _armour_unit(case):
-    from riprap.geometry.armour_units import armour_unit
-
     spec = case.armour
     given = {name: value for name, value in (("height", spec.height),
                                               ("nominal_diameter", spec.nominal_diameter),
@@ -91,8 +104,6 @@ def prepare_placement(case) -> PlacementInputs:
     """Build the slope, materials, unit mesh and rock shapes of ``case`` and read its grid file:
     every check ``riprap place`` makes before the deposition runs (``riprap check`` runs this)."""
     _require_tables(case)
-    from riprap.geometry.rock_grading import RockGrading, rock_library
-
     sl, ul, pl = case.slope, case.underlayer, case.placement
     slope = Slope(cotangent=sl.cotangent, width=sl.width, length=sl.length, toe_x=sl.toe_x,
                   toe_level=sl.toe_level, toe_stop_distance=sl.toe_stop_distance)
@@ -102,17 +113,12 @@ def prepare_placement(case) -> PlacementInputs:
                                    side_wall=_material(case, sl.side_wall_material))
     grid = None
     if pl.grid_file:
-        from riprap.case.body_start import check_grid_starts
-        from riprap.io.grid_file import read_grid_file
-
         grid = read_grid_file(case.base_dir / pl.grid_file)
         check_grid_starts(grid)
     unit = _armour_unit(case)
     check_filter_rule(nominal_diameter=unit.nominal_diameter, dn50=ul.dn50, unit=case.armour.unit,
                       where=case.source)
     if grid is not None:
-        from riprap.placement.place import check_start_positions
-
         check_start_positions(slope, unit, grid.positions, _unit_orientations(case, slope, grid),
                               grid_lines=grid.lines, release=pl.release)
     else:
@@ -136,10 +142,6 @@ def _check_work(case, materials, rock_shapes, unit, *, rocks: int, units: int) -
     """The work estimates the two runs make when they start (the rocks settling, then every unit
     moving on the fixed rocks), made now with the same time steps, so that a run of months is
     refused before the underlayer is built."""
-    from riprap.placement.place import free_body_time_step
-    from riprap.solid.shape import RigidShape
-    from riprap.work_estimate import check_rigid_run
-
     for table, shapes, material, moving in (
             ("underlayer", rock_shapes, materials.rock.name, rocks),
             ("placement", [RigidShape.from_mesh(unit.mesh, name=UNIT_SHAPE_NAME)],
@@ -160,8 +162,6 @@ def _check_design_grid(case, slope, unit) -> None:
     """The checks ``place_units`` makes of a design grid, before the underlayer run: rows of
     units that fit across the section, rows that stay on the face, no more units than a case may
     have bodies, and no unit wider than the flume (its orientation as the run draws it)."""
-    from riprap.placement.place import check_generated_positions
-
     pl = case.placement
     for key in ("units_per_row", "units_per_alternate_row"):
         if getattr(pl, key) > 0:
@@ -212,9 +212,6 @@ def _unit_orientations(case, slope, grid):
 def run_placement(case, *, output_directory=None, progress: bool = True) -> dict:
     """Build the underlayer and the armour layer of ``case``; returns the summary (also written
     as ``summary.json``)."""
-    from riprap.io.output_folder import prepare_output_folder
-    from riprap.io.summary import write_json
-
     inputs = prepare_placement(case)
     out = prepare_output_folder(output_directory or case.output.directory)
     ul, pl = case.underlayer, case.placement
@@ -277,8 +274,6 @@ def _listed(numbers, most: int = 10) -> str:
 
 def _layer_description(unit, slope, underlayer, result, design_positions):
     """What ``riprap analyse`` needs to know of the layer (written as ``layer.json``)."""
-    from riprap.analysis.layer_state import LayerDescription
-
     sim = result.simulation
     unit_shape = sim.solver.shapes[sim._shape_names[UNIT_SHAPE_NAME]]
     return LayerDescription.for_unit(unit, unit_shape, slope=slope,
@@ -288,9 +283,6 @@ def _layer_description(unit, slope, underlayer, result, design_positions):
 
 
 def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
-    from riprap.io.layer_file import CONTACTS_FILE_NAME, write_contact_table, write_layer_file
-    from riprap.io.pack import PackBody, write_pack
-
     sim = result.simulation
     solver = sim.solver
     names = {index: name for name, index in sim._shape_names.items()}
@@ -303,7 +295,7 @@ def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
                        velocity=tuple(solver.velocities[b]), angular_velocity=tuple(omegas[b]),
                        fixed=bool(solver.fixed[b]))
               for b in range(solver.n_bodies)]
-    pack = write_pack(out, shapes=shapes, materials=materials.all(), bodies=bodies,
+    pack = write_checked_pack(out, shapes=shapes, materials=materials.all(), bodies=bodies,
                       walls=slope.walls(face_material=materials.face.name,
                                         side_material=materials.side_wall.name),
                       simulation={"end_time": case.simulation.end_time,
@@ -319,6 +311,15 @@ def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
         outputs["picture"] = str(_write_layer_picture(out / "final_layer.png", sim, slope,
                                                       n_units=len(result.unit_bodies)))
     return outputs
+
+
+def write_checked_pack(directory, **pack) -> Path:
+    """:func:`riprap.io.pack.write_pack`, then the written ``pack.toml`` read back through the case
+    parser: a value the schema rejects is an error that names the file and line now, instead of a
+    surprise at the next ``riprap run``. Keywords as ``write_pack``'s."""
+    path = write_pack(directory, **pack)
+    parse_case(read_case_text(path), source=os.fspath(path), base_dir=Path(directory).resolve())
+    return path
 
 
 # Seen from above the sea side of the slope, looking at the face, like the 3D views of
@@ -337,4 +338,4 @@ def _write_layer_picture(path: Path, sim, slope, *, n_units: int) -> Path:
     return sim.write_picture(path, show_fixed=True, planes=[face], view=_LAYER_VIEW, title=title)
 
 
-__all__ = ["run_placement"]
+__all__ = ["run_placement", "prepare_placement", "write_checked_pack"]

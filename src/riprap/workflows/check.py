@@ -8,8 +8,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from riprap.case.build import build_simulation
+from riprap.case.build_fluid import build_fluid_run
 from riprap.case.load import Case
+from riprap.errors import CaseFileError
 from riprap.io.output_folder import check_output_folder
+from riprap.workflows.place import PLACEMENT_NOT_CHECKED, prepare_placement
 
 __all__ = ["CheckReport", "check_case"]
 
@@ -29,14 +33,10 @@ def check_case(case: Case, *, output_directory=None, restart=None) -> CheckRepor
     ``restart``: a checkpoint to check a restart from (``riprap run --restart``)."""
     out = output_directory or case.output.directory
     if restart is not None and case.is_placement:
-        from riprap.errors import CaseFileError
-
         raise CaseFileError(f"{case.source}: a placement does not restart (--restart {restart}); "
                             "run 'riprap place' again")
     sim = None
     if case.is_placement:
-        from riprap.case.build_placement import PLACEMENT_NOT_CHECKED, prepare_placement
-
         inputs = prepare_placement(case)
         report = CheckReport(
             f"an armour placement for riprap place: {case.armour.unit} units on a "
@@ -53,8 +53,6 @@ def check_case(case: Case, *, output_directory=None, restart=None) -> CheckRepor
             report.checked.append("design grid: units per row across the section, rows on the "
                                   "face, units inside the side walls")
     elif case.is_fluid:
-        from riprap.case.build_fluid import build_fluid_run
-
         run = sim = build_fluid_run(case, output_directory=out, progress=False)
         cells = "x".join(map(str, case.fluid.cells))
         bodies = f" with {case.body_count} bodies in it" if run.coupled else ""
@@ -67,8 +65,6 @@ def check_case(case: Case, *, output_directory=None, restart=None) -> CheckRepor
             report.checked.append("bodies: meshes, overlaps, inside the fluid box, cells across")
             report.checked.append(_bodies_step(run))
     else:
-        from riprap.case.build import build_simulation
-
         sim = build_simulation(case, output_directory=out, progress=False)
         sim.prepare()
         checked = ["tables and keys", f"{len(case.shapes)} shape meshes", _bodies_step(sim),
