@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from riprap.analysis.surface_heights import highest_surface
 from riprap.errors import CaseFileError
 
 __all__ = ["displaced_units", "damage_number_nod", "rocking_events", "surface_profile",
@@ -87,8 +88,6 @@ def profile_from_surfaces(triangles, xs, ys, floor=None) -> np.ndarray:
     grid ``xs`` x ``ys`` (``ys`` evenly spaced across the flume), averaged across. ``floor`` (one
     height per x, optional): what a point no triangle covers reads (the slope's face under the
     layer); without it such points are left out of the mean, and an x no triangle covers is NaN."""
-    from riprap.analysis.surface_heights import highest_surface
-
     xs, ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
     if xs.size < 2 or ys.size < 1:
         raise CaseFileError("damage: a profile needs at least two x and one y")

@@ -21,6 +21,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.waves.analysis import variance_density
+from riprap.waves.theory import jonswap_spectrum
 
 __all__ = ["FlumeRecords", "gauge_spectra", "target_spectrum", "fluid_force_columns",
            "rocking_share", "SPECTRUM_BANDS", "SURFACE_SUFFIX", "RUN_UP_SUFFIX",
@@ -84,8 +86,6 @@ def with_derived(records: FlumeRecords, units: dict) -> FlumeRecords:
 def target_spectrum(target: dict, frequencies) -> np.ndarray | None:
     """The case's JONSWAP variance density at ``frequencies`` (evenly spaced, Hz), or None when
     the target is not an irregular sea."""
-    from riprap.waves.theory import jonswap_spectrum
-
     if not target or target.get("type") != "irregular":
         return None
     return jonswap_spectrum(frequencies, target["height_m"], target["period_s"],
@@ -135,8 +135,6 @@ def gauge_spectra(records: FlumeRecords) -> list[dict]:
 
 
 def _spectrum_of(times, eta):
-    from riprap.waves.analysis import variance_density
-
     return variance_density(times, eta, bands=SPECTRUM_BANDS)
 
 

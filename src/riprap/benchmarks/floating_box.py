@@ -14,6 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from riprap import FluidGrid, FluidSolver
+from riprap.coupling.coupled import CoupledSolver
+from riprap.geometry import shapes
+from riprap.solid.materials import Material
+from riprap.solid.shape import RigidShape
+from riprap.solid.solver import SolidSolver
+
 __all__ = ["FloatingBoxRun", "run_floating_box"]
 
 TANK = 0.4
@@ -44,13 +51,6 @@ def run_floating_box(cells: int = 32, seconds: float = 3.0, start_above: float =
     """The cube (``CUBE`` m, ``DENSITY_RATIO`` of water's density) in a ``TANK`` m tank of
     ``cells``^3 cells, water ``LEVEL`` m deep, released with its centre ``start_above`` m above
     the level, run for ``seconds``."""
-    from riprap import FluidGrid, FluidSolver
-    from riprap.coupling.coupled import CoupledSolver
-    from riprap.geometry import shapes
-    from riprap.solid.materials import Material
-    from riprap.solid.shape import RigidShape
-    from riprap.solid.solver import SolidSolver
-
     grid = FluidGrid(lower=(0.0, 0.0, 0.0), upper=(TANK,) * 3, cells=(cells,) * 3)
     fluid = FluidSolver(grid, surface_tension=0.0)
     fluid.set_still_water_level(LEVEL)

@@ -14,6 +14,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from riprap.coupling.coupled import CoupledSolver
+from riprap.fluid.grid import FluidGrid
+from riprap.fluid.phases import Phase
+from riprap.fluid.solver import FluidSolver
+from riprap.geometry import shapes
+from riprap.geometry.tetmesh import TetMesh
+from riprap.solid.materials import Material
+from riprap.solid.shape import RigidShape
+from riprap.solid.solver import SolidSolver
+
 __all__ = ["TEN_CATE_E2", "TenCateRun", "run_ten_cate_e2", "compare_with_experiment"]
 
 #: The set-up of case E2 (SI units).
@@ -41,16 +51,6 @@ def run_ten_cate_e2(cells_per_diameter: int, *, end_time: float = 3.0, progress=
     ``shift``: the sphere's start moved off the box's vertical axis by these fractions of a cell
     along x and y (to see how much the result depends on where the cells cut the sphere)."""
     import time
-
-    from riprap.coupling.coupled import CoupledSolver
-    from riprap.fluid.grid import FluidGrid
-    from riprap.fluid.phases import Phase
-    from riprap.fluid.solver import FluidSolver
-    from riprap.geometry import shapes
-    from riprap.geometry.tetmesh import TetMesh
-    from riprap.solid.materials import Material
-    from riprap.solid.shape import RigidShape
-    from riprap.solid.solver import SolidSolver
 
     case = TEN_CATE_E2
     d = case["diameter"]

@@ -13,10 +13,15 @@ from scipy.spatial.transform import Rotation
 
 from riprap.case.body_start import check_body_starts, check_coordinates, shape_radius
 from riprap.case.run_record import RunDefinition
+from riprap.deformable import ElasticMaterial
+from riprap.deformable.joints import JointMaterial
 from riprap.errors import RiprapError
 from riprap.geometry import shapes as builtin_shapes
 from riprap.geometry.armour_units import armour_unit
+from riprap.geometry.meshing import check_body_length
 from riprap.geometry.tetmesh import TetMesh
+from riprap.io.contact_history import ContactHistory, read_contact_history
+from riprap.io.mesh_files import read_mesh
 from riprap.simulation import Simulation
 from riprap.solid import walls as wall_builders
 from riprap.solid.materials import Material
@@ -35,13 +40,9 @@ def build_shape(spec) -> TetMesh:
     p = dict(spec.parameters)
     mesh_size = spec.mesh_size if spec.mesh_size > 0 else None
     if spec.type == "mesh_file":
-        from riprap.io.mesh_files import read_mesh
-
         mesh = read_mesh(p["file"], mesh_size=mesh_size)
         scale = float(p.get("scale", 1.0))
         if scale != 1.0:
-            from riprap.geometry.meshing import check_body_length
-
             # the scaled body must be a size riprap meshes: a scale of 1e150 overflows its volume
             extent = float(np.ptp(mesh.nodes, axis=0).max())
             with np.errstate(over="ignore", under="ignore"):
@@ -112,8 +113,6 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
     place.check_selection()
     add_case_walls(sim, case)
     if settings.contact_history:
-        from riprap.io.contact_history import read_contact_history
-
         history = read_contact_history(settings.contact_history, n_bodies=place.count,
                                        n_walls=len(sim.solver.walls))
         sim.set_contact_history(place.split_history(history))
@@ -155,8 +154,6 @@ class _BodyPlacer:
             sim.deformable_mass_damping = self.spec.mass_damping
 
     def _elastic_material(self, name: str):
-        from riprap.deformable import ElasticMaterial
-
         if name not in self._materials:
             spec = self.spec
             source = next(m for m in self.case.materials if m.name == name)
@@ -171,8 +168,6 @@ class _BodyPlacer:
 
     def _joint_material(self):
         """The joints of ``[deformable] fracture``, every strength and energy checked > 0."""
-        from riprap.deformable.joints import JointMaterial
-
         spec = self.spec
         where = f"{self.case.source}: [deformable] fracture = true"
         if spec.element_type != "tet4":
@@ -226,8 +221,6 @@ class _BodyPlacer:
         """The contact history of the rigid bodies, renumbered as the rigid solver numbers them;
         the resting overlaps of the deformable bodies' contacts go to
         ``sim.deformable_accepted_depths`` (keyed by case body numbers, walls -1 - w)."""
-        from riprap.io.contact_history import ContactHistory
-
         if not self.sim.deformable_bodies:
             return history
         rigid = np.full(self.count, -1, dtype=np.int64)

@@ -4,12 +4,19 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from riprap.case.build import SMOKE_END_TIME, smoke_mode
+from riprap.case.body_start import check_coordinates
+from riprap.case.build import SMOKE_END_TIME, build_simulation, smoke_mode
+from riprap.case.build_waves import build_waves
 from riprap.case.run_record import RunDefinition
+from riprap.coupling.coupled import MINIMUM_DENSITY_RATIO
 from riprap.errors import CaseFileError
 from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.phases import Phase
+from riprap.fluid.porous import PorousZone
 from riprap.fluid.solver import FluidSolver
+from riprap.simulation import Simulation
+from riprap.waves.analysis_window import flume_windows, short_run_warning
+from riprap.work_estimate import RiprapWarning
 
 __all__ = ["build_fluid_run", "build_fluid_solver"]
 
@@ -51,8 +58,6 @@ def build_fluid_solver(case) -> FluidSolver:
         raise CaseFileError(f"{case.source}: a [fluid] case needs at least one [[water_regions]] "
                             "entry (a box of water or a still-water level)")
     if case.waves is not None or case.gauges:
-        from riprap.case.build_waves import build_waves
-
         build_waves(case, solver)
     if not solver.water_volume() > 0.0:
         raise CaseFileError(f"{case.source}: no water is left: the [[obstacles]] cover every cell of "
@@ -64,8 +69,6 @@ def build_fluid_solver(case) -> FluidSolver:
 def _check_fluid_coordinates(case) -> None:
     """Every coordinate of the fluid box, its water, obstacles, porous zones and gauges within
     riprap.case.body_start.LARGEST_COORDINATE: a box reaching 1e308 m overflows its cell size."""
-    from riprap.case.body_start import check_coordinates
-
     check_coordinates(f"{case.source} [fluid]", "lower", case.fluid.lower)
     check_coordinates(f"{case.source} [fluid]", "upper", case.fluid.upper)
     for table, entries in (("water_regions", case.water_regions), ("obstacles", case.obstacles),
@@ -78,8 +81,6 @@ def _check_fluid_coordinates(case) -> None:
 
 
 def _add_porous_zones(case, solver) -> None:
-    from riprap.fluid.porous import PorousZone
-
     zones = []
     for number, spec in enumerate(case.porous_zones):
         p = spec.parameters
@@ -96,8 +97,6 @@ def _check_bodies_not_too_light(case) -> None:
     """Refuse a free body far lighter than the water: the coupling holds the fluid's load over a
     step, which a body much lighter than the water it displaces cannot carry (it sinks where it
     should rise; riprap.coupling.coupled.MINIMUM_DENSITY_RATIO)."""
-    from riprap.coupling.coupled import MINIMUM_DENSITY_RATIO
-
     water = case.fluid.water_density
     entries = [(f"[[bodies]] entry {n + 1}", body.material)
                for n, body in enumerate(case.bodies) if not body.fixed]
@@ -120,9 +119,6 @@ def build_fluid_run(case, *, output_directory=None, progress: bool = True):
     with the ``[simulation]`` end time, output and checkpoint intervals. The coupled model is
     built here, so that its checks (bodies inside the box, wide enough for the cells, not
     overlapping) run before anything else."""
-    from riprap.case.build import build_simulation
-    from riprap.simulation import Simulation
-
     fluid = build_fluid_solver(case)
     if case.body_count > 0:
         _check_bodies_not_too_light(case)
@@ -148,9 +144,6 @@ def _warn_if_too_short_to_analyse(case, simulation) -> None:
     """Say before the run (``riprap check`` and ``riprap run`` both build it here) when it ends
     before the wave analysis can give its results; the run goes on."""
     import warnings
-
-    from riprap.waves.analysis_window import flume_windows, short_run_warning
-    from riprap.work_estimate import RiprapWarning
 
     fluid = simulation.fluid
     text = short_run_warning(flume_windows(fluid.wave_source, fluid.gauges), simulation.end_time,

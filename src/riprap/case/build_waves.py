@@ -9,6 +9,7 @@ from riprap.waves.boundary_generation import BoundaryWaveMaker
 from riprap.waves.checks import check_flume
 from riprap.waves.gauges import Gauge, GaugeSet
 from riprap.waves.relaxation import ABSORPTION, GENERATION, RelaxationZone, WaveRelaxation
+from riprap.waves.stream_function import StreamFunctionWave
 from riprap.waves.theory import IrregularWave, LinearWave, StokesSecondOrderWave
 
 __all__ = ["build_waves", "wave_of"]
@@ -29,8 +30,6 @@ def wave_of(spec, depth: float, end_time: float, gravity: float):
                              depth=depth, duration=p["duration"] or end_time,
                              peak_enhancement=p["peak_enhancement"], seed=p["seed"], gravity=gravity)
     if spec.type == "stream_function":
-        from riprap.waves.stream_function import StreamFunctionWave
-
         return StreamFunctionWave(height=p["height"], period=p["period"], depth=depth,
                                   phase=p["phase"], gravity=gravity)
     kind = StokesSecondOrderWave if spec.type == "stokes2" else LinearWave

@@ -34,8 +34,10 @@ import numpy as np
 from riprap.coupling.kernels import rigid_coupling
 from riprap.coupling.solid_volumes import merge_blocks, rigid_body_half_cell_volumes
 from riprap.errors import CaseFileError, InstabilityError
+from riprap.fluid.kernels.face_speeds import limit_listed_faces, listed_pore_speed
 from riprap.fluid.solver import FluidSolver
 from riprap.solid.solver import SolidSolver
+from riprap.solid.walls import Wall
 
 #: A cell counts as filled by fixed bodies when they hold all but this share of it.
 _FULL_SLACK = 1e-9
@@ -89,8 +91,6 @@ def check_substeps(substeps: int, fluid_step: float, contact_step: float) -> Non
 
 def fluid_box_walls(grid, material: str) -> list:
     """The sides of the fluid box as walls for the bodies (an open top is not a wall)."""
-    from riprap.solid.walls import Wall
-
     walls = []
     for axis in range(3):
         for side, (point, sign) in enumerate(((grid.lower, 1.0), (grid.upper, -1.0))):
@@ -242,8 +242,6 @@ class CoupledSolver:
         water too (``_carriers``)."""
         step = self.fluid.stable_time_step()
         if self._carried is not None:
-            from riprap.fluid.kernels.face_speeds import listed_pore_speed
-
             fluid = self.fluid
             axis, index, values = self._carried
             speed = float(listed_pore_speed(fluid.fraction, axis, index, values, fluid.open_part,
@@ -530,7 +528,6 @@ class CoupledSolver:
         dt, courant = fluid.begin_step(self.stable_time_step() if dt is None else dt)
         if fluid.limit_air_speed and self._carried is not None:
             # the carried air beside the bodies is held to the same cap as the fluid's own faces
-            from riprap.fluid.kernels.face_speeds import limit_listed_faces
 
             axis, index, values = self._carried
             limit_listed_faces(fluid.fraction, axis, index, values, fluid.open_part,

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from riprap.errors import OverlapError
+from riprap.geometry.shapes import box
 
 __all__ = ["add_obstacle_bodies", "name_obstacles_in_overlap"]
 
@@ -23,8 +24,6 @@ def add_obstacle_bodies(simulation, boxes, material: str | None = None) -> list[
     """Add one fixed box body per ``(lower, upper)`` in ``boxes`` to ``simulation`` (a
     :class:`riprap.simulation.Simulation` whose solver is not prepared yet); returns their body
     indices, in the order of ``boxes``. ``material``: default the first material."""
-    from riprap.geometry.shapes import box
-
     solver = simulation.solver
     if not boxes:
         return []

@@ -25,6 +25,7 @@ import math
 from dataclasses import dataclass
 
 from riprap.errors import CaseFileError
+from riprap.solid.materials import damping_ratio_for_restitution
 
 #: Names of the constitutive models, in the integer code order the kernels use.
 CONSTITUTIVE_MODELS = ("neo_hookean_seed", "neo_hookean", "neo_hookean_decoupled")
@@ -93,8 +94,6 @@ class ElasticMaterial:
     @property
     def contact_damping_ratio(self) -> float:
         """Damping ratio of the normal contact dashpot that gives ``restitution``."""
-        from riprap.solid.materials import damping_ratio_for_restitution
-
         return damping_ratio_for_restitution(self.restitution)
 
     @property

@@ -37,8 +37,14 @@ import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.grid import SIDES, FluidGrid
-from riprap.fluid.kernels import momentum
+from riprap.fluid.kernels import momentum, plic
+from riprap.fluid.kernels.face_speeds import largest_pore_speed, limit_air_faces
+from riprap.fluid.kernels.porous_faces import face_speeds_and_viscosities
+from riprap.fluid.kernels.sharp_density import face_densities
+from riprap.fluid.kernels.surface_tension import face_forces
 from riprap.fluid.phases import AIR_20C, WATER_20C, Phase
+from riprap.fluid.porous import PorousMedium
+from riprap.fluid.pressure import PressureSolver
 from riprap.work_estimate import check_fluid_grid
 
 __all__ = ["FluidSolver", "StepReport"]
@@ -98,8 +104,6 @@ class FluidSolver:
                  gravity=(0.0, 0.0, -9.81), courant_number: float = 0.3,
                  pressure_tolerance: float = 1e-8, max_time_step: float = 0.01,
                  surface_tension: float = 0.0728, limit_air_speed: bool = False):
-        from riprap.fluid.pressure import PressureSolver
-
         if not 0.0 < courant_number <= 0.5:
             raise CaseFileError(f"fluid: courant_number = {courant_number!r} must be in (0, 0.5] "
                                 "(the volume-of-fluid sweeps are bounded only up to 0.5)")
@@ -212,8 +216,6 @@ class FluidSolver:
     def add_porous_zones(self, zones) -> None:
         """Porous zones (``riprap.fluid.porous.PorousZone``: a core, filter layers) in the flow;
         ``fraction`` becomes the water fraction of their pore space. Replaces earlier zones."""
-        from riprap.fluid.porous import PorousMedium
-
         self.porous = PorousMedium(self.grid, zones)
         self._open_part = self.porous.porosity
         self.initial_water_volume = None
@@ -242,8 +244,6 @@ class FluidSolver:
         """Largest speed the water moves at: on each face |u| / n of the cells beside it (the
         pore velocity in a porous zone); with ``limit_air_speed`` only on faces that touch water
         (``kernels/face_speeds.py``)."""
-        from riprap.fluid.kernels.face_speeds import largest_pore_speed
-
         return max(largest_pore_speed(self.fraction, q, axis, self._open_part, self.limit_air_speed)
                    for axis, q in enumerate((self.u, self.v, self.w)))
 
@@ -261,8 +261,6 @@ class FluidSolver:
         the air's (1/830 of the water's density), and the next pressure solve gives the air the
         flow that continuity asks for again. The cap keeps the explicit momentum transport of
         the air within its Courant limit. Recorded in ``last_air_limit``."""
-        from riprap.fluid.kernels.face_speeds import limit_air_faces
-
         limit = self.air_speed_limit(dt)
         clipped, largest = 0, 0.0
         for axis, q in enumerate((self.u, self.v, self.w)):
@@ -309,8 +307,6 @@ class FluidSolver:
 
     # ------------------------------------------------------------------ stepping
     def _advect_water(self, dt: float, velocities=None):
-        from riprap.fluid.kernels import plic
-
         u, v, w = velocities or (self.u, self.v, self.w)
         return plic.advect(self.fraction, u, v, w, dt, self.h, self.step_count,
                            porosity=self._open_part, water_inflow_x_low=self.wave_maker is not None)
@@ -425,8 +421,6 @@ class FluidSolver:
         return u, v, w, densities
 
     def _sharp_face_densities(self) -> list:
-        from riprap.fluid.kernels.sharp_density import face_densities
-
         out = []
         for axis, shape in enumerate((self.u.shape, self.v.shape, self.w.shape)):
             density = np.ones(shape)
@@ -439,8 +433,6 @@ class FluidSolver:
         """On porous faces: the predictor's increment scaled by s = n/(1 + c), the friction taken
         implicitly; the factors s / (1 + dt K) wait for the pressure's face coefficients
         (``riprap/fluid/porous.py``)."""
-        from riprap.fluid.kernels.porous_faces import face_speeds_and_viscosities
-
         porous = self.porous
         factors = []
         for axis, (out, old) in enumerate(zip(new_velocities, (self.u, self.v, self.w))):
@@ -498,8 +490,6 @@ class FluidSolver:
     def _add_surface_tension(self, u, v, w, densities, dt) -> None:
         """u* += dt F / rho on the faces, F = sigma kappa grad f (continuum surface force with the
         same face gradient as the pressure: balanced force)."""
-        from riprap.fluid.kernels.surface_tension import face_forces
-
         forces = [np.zeros_like(u), np.zeros_like(v), np.zeros_like(w)]
         face_forces(self.fraction, self.h, self.surface_tension, self.grid.two_dimensional,
                     forces[0], forces[1], forces[2])

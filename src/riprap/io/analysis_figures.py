@@ -24,6 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
+from riprap.io.picture import render_bodies_png
+
 __all__ = ["stereonet_figure", "layer_view_png", "slope_view_figure", "histogram_figure",
            "comparison_stereonets", "comparison_histograms", "colour_scale", "drawn_fields",
            "histogram_panels", "PER_UNIT_FIELDS", "FACTOR_OF_SAFETY_DISPLAY_CAP",
@@ -153,8 +155,6 @@ def stereonet_figure(path, trend, plunge, *, title: str, slope_dip_direction_deg
 
 def layer_view_png(path, analysis, column: str) -> Path:
     """The units in 3D coloured by ``column`` of ``analysis.units`` (PNG)."""
-    from riprap.io.picture import render_bodies_png
-
     state = analysis.state
     bodies = state.layer.unit_bodies
     rocks = np.setdiff1d(np.arange(state.n_bodies), bodies)

@@ -27,7 +27,13 @@ from pathlib import Path
 
 import numpy as np
 
+from riprap.io import analysis_figures as figures
+from riprap.io.analysis_figures import (FACTOR_OF_SAFETY_DISPLAY_CAP, PER_UNIT_FIELDS,
+                                        drawn_fields)
+from riprap.io.flume_report import stability_section, waves_section, write_flume_figures
+from riprap.io.layer_file import write_contact_table
 from riprap.io.summary import write_json
+from riprap.io.vtk import write_vtu
 
 __all__ = ["write_analysis", "write_comparison", "write_units_csv", "design_verdict",
            "SUMMARY_ROWS", "DESIGN_TOLERANCES"]
@@ -35,11 +41,10 @@ __all__ = ["write_analysis", "write_comparison", "write_units_csv", "design_verd
 
 def _factor_of_safety_text(value) -> str:
     """A factor of safety for a table: 3 decimals, "> cap" above the display cap (and for inf)."""
-    from riprap.io.analysis_figures import FACTOR_OF_SAFETY_DISPLAY_CAP as cap
-
     value = float(value)
     if math.isnan(value):
         return "-"
+    cap = FACTOR_OF_SAFETY_DISPLAY_CAP
     return f"> {cap:g}" if value > cap else f"{value:.3f}"
 
 
@@ -166,8 +171,6 @@ def write_units_csv(path, units: dict) -> Path:
 
 
 def _write_paraview(out: Path, analysis) -> dict:
-    from riprap.io.vtk import write_vtu
-
     state = analysis.state
     unit_of_body = np.full(state.n_bodies, -1, dtype=np.int64)
     unit_of_body[state.layer.unit_bodies] = np.arange(len(state.layer.unit_bodies))
@@ -287,8 +290,7 @@ def _count(number: int, one: str, many: str) -> str:
 
 def _factor_of_safety_notes(layer: dict, units: dict) -> str:
     """What the factors of safety of a unit at rest mean, why one can be below 1, and the cap."""
-    from riprap.io.analysis_figures import FACTOR_OF_SAFETY_DISPLAY_CAP as cap
-
+    cap = FACTOR_OF_SAFETY_DISPLAY_CAP
     return (
         "<h2 id='reading-factors-of-safety'>Reading the factors of safety</h2>"
         f"{_units_below_one(layer, units)}"
@@ -376,10 +378,6 @@ def _distributions(out: Path) -> str:
 
 def write_analysis(out, analysis) -> dict:
     """Every file of one analysed layer in ``out``; returns ``{what: path}``."""
-    from riprap.io import analysis_figures as figures
-    from riprap.io.flume_report import write_flume_figures
-    from riprap.io.layer_file import write_contact_table
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     state, layer, units = analysis.state, analysis.layer, analysis.units
@@ -412,9 +410,6 @@ def write_analysis(out, analysis) -> dict:
 
 
 def _write_report(out: Path, analysis) -> Path:
-    from riprap.io.analysis_figures import PER_UNIT_FIELDS, drawn_fields
-    from riprap.io.flume_report import stability_section, waves_section
-
     layer, units = analysis.layer, analysis.units
     histogram = ", ".join(f"{k}: {v}" for k, v in layer["coordination_number_histogram"].items())
     low = layer["units_below_factor_of_safety_1"]
@@ -465,8 +460,6 @@ def _write_report(out: Path, analysis) -> Path:
 
 def write_comparison(out, analyses, labels) -> dict:
     """Each layer's files in ``out/<label>/`` and ``comparison.html`` with the figures side by side."""
-    from riprap.io import analysis_figures as figures
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     outputs = {}

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.io.case_text import read_text_file
 from riprap.io.output_folder import naming_the_file
 
 __all__ = ["BODY_FORCE_COLUMNS", "BodyForceTable", "read_peak_fluid_forces"]
@@ -55,8 +56,6 @@ def read_peak_fluid_forces(path, n_bodies: int, until: float = math.inf) -> dict
     NaN for a body without a row; None when there is no such file. A file of an older riprap (no peak columns)
     gives the largest force at its rows' times. A row that cannot be read is a CaseFileError
     naming the file and the line."""
-    from riprap.io.case_text import read_text_file
-
     path = Path(path)
     if not path.is_file():
         return None

@@ -9,20 +9,19 @@ from pathlib import Path
 
 import numpy as np
 
+from riprap.io import analysis_figures
+from riprap.io.analysis_figures import FACTOR_OF_SAFETY_DISPLAY_CAP
+
 __all__ = ["spectra_figure", "gauge_record_figure", "profiles_figure", "unit_damage_figure",
            "contacts_figure"]
 
 
 def _pyplot():
-    from riprap.io.analysis_figures import _pyplot as pyplot
-
-    return pyplot()
+    return analysis_figures._pyplot()
 
 
 def _save(figure, path) -> Path:
-    from riprap.io.analysis_figures import _save as save
-
-    return save(figure, Path(path), formats=("png",))[0]
+    return analysis_figures._save(figure, Path(path), formats=("png",))[0]
 
 
 def _say(axes, text: str) -> None:
@@ -208,8 +207,7 @@ def contacts_figure(path, contacts: dict | None) -> Path:
     """The units' contacts frame by frame (``FlumeRecords.contacts``): coordination numbers (mean,
     smallest and largest over the units), the largest contact force on a unit, and the factors of
     safety against sliding (smallest and median; drawn up to the report's display cap)."""
-    from riprap.io.analysis_figures import FACTOR_OF_SAFETY_DISPLAY_CAP as cap
-
+    cap = FACTOR_OF_SAFETY_DISPLAY_CAP
     plt = _pyplot()
     figure, axes = plt.subplots(3, 1, figsize=(7.5, 6.6), sharex=True)
     if contacts is None or not len(contacts["time_s"]):

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from riprap.io import flume_figures as figures
+
 __all__ = ["write_flume_figures", "waves_section", "stability_section", "value_or_reason"]
 
 #: Columns of the surface gauges' table: (key in the gauge's entry, heading, format).
@@ -72,8 +74,6 @@ def _entry_list(report: dict, key: str) -> list:
 
 def write_flume_figures(out: Path, analysis) -> dict:
     """The flume test's pictures in ``out``; ``{what: path}`` (none for a run without waves)."""
-    from riprap.io import flume_figures as figures
-
     records = getattr(analysis, "flume", None)
     if records is None:
         return {}

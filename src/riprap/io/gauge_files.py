@@ -7,6 +7,8 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.io.csv_tables import read_number_table
+from riprap.io.json_files import write_json
 
 __all__ = ["write_gauges_csv", "read_gauges_csv", "gauges_png", "write_waves_report"]
 
@@ -25,8 +27,6 @@ def read_gauges_csv(path) -> tuple[np.ndarray, dict] | None:
     """``(times (s), {column: values})`` of a run's ``gauges.csv`` (None where the run wrote none),
     checked: the header starts with ``time_s``, every field is a finite number, the times increase
     (the file is rewritten whole at every frame). Errors name the file, the line and the column."""
-    from riprap.io.csv_tables import read_number_table
-
     path = Path(path)
     if not path.is_file():
         return None
@@ -84,6 +84,4 @@ def gauges_png(path, gauges, report=None) -> Path:
 
 def write_waves_report(path, report: dict) -> Path:
     """``waves_report.json``: standard JSON, a number that could not be computed as ``null``."""
-    from riprap.io.json_files import write_json
-
     return write_json(path, report)

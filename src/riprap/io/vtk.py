@@ -21,6 +21,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 from riprap.io.checkpoint import CheckpointError, _atomic_target
+from riprap.io.vti import write_vti
 
 __all__ = ["write_vtu", "write_contacts_vtu", "ParaViewSeries"]
 
@@ -293,8 +294,6 @@ class ParaViewSeries:
         """Write one frame of a uniform grid (``.vti``, :func:`riprap.io.vti.write_vti`) and list
         it in the ``.pvd``; ``cells`` = (nx, ny, nz), ``cell_data`` arrays of that shape (or with
         a trailing 3 for vectors)."""
-        from riprap.io.vti import write_vti
-
         return self._add_frame(time, "vti", lambda path: write_vti(
             path, origin=origin, spacing=spacing, cells=cells, cell_data=cell_data))
 

@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass
 
 from riprap.waves.gauges import OVERTOPPING, RUN_UP, SURFACE
+from riprap.waves.theory import group_velocity
 
 __all__ = ["GaugeWindow", "FlumeWindows", "flume_windows", "FEW_WAVES", "STATISTICS_PERIODS",
            "SPLIT_PERIODS", "few_waves_caution", "short_run_warning"]
@@ -87,8 +88,6 @@ class FlumeWindows:
 def flume_windows(wave_source, gauges) -> FlumeWindows | None:
     """The windows of ``gauges`` (a GaugeSet) for the waves of ``wave_source`` (a WaveRelaxation
     or BoundaryWaveMaker); None when the flume makes no waves or has no gauges."""
-    from riprap.waves.theory import group_velocity
-
     wave = getattr(wave_source, "wave", None)
     if wave is None or gauges is None or not gauges.gauges:
         return None

@@ -17,6 +17,7 @@ import numpy as np
 from riprap.errors import CaseFileError
 from riprap.waves.analysis import (separate_incident_reflected, separate_regular_wave,
                                    separate_three_gauges, wave_statistics)
+from riprap.waves.analysis_window import few_waves_caution
 from riprap.waves.gauges import OVERTOPPING, RUN_UP, SURFACE
 from riprap.waves.theory import group_velocity
 
@@ -164,8 +165,6 @@ def _too_short(record_end: float, start: float, wave, periods: float) -> str:
 
 def _caution(report: dict, entry: dict, name: str, waves) -> None:
     """A caution on ``entry`` (and in the report's list) for statistics from 1 to 3 waves."""
-    from riprap.waves.analysis_window import few_waves_caution
-
     caution = few_waves_caution(waves)
     if caution is not None:
         entry["caution"] = caution
