@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from riprap.analysis import LayerDescription, analyse
+from riprap.analysis import LayerDescription
+from riprap.workflows.analyse import analyse
 from riprap.errors import CaseFileError
 from riprap.geometry.armour_units import armour_unit
 from riprap.io.layer_file import (CONTACT_COLUMNS, read_contact_table, write_contact_table,

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from riprap.analysis import LayerDescription, analyse
+from riprap.analysis import LayerDescription
+from riprap.workflows.analyse import analyse
 from riprap.analysis.displacements import DISPLACEMENT_COLUMNS, unit_displacements
 from riprap.errors import CaseFileError
 from riprap.geometry.armour_units import armour_unit

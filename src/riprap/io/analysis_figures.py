@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riprap.io.picture import render_bodies_png
+from riprap.io import picture
 
 __all__ = ["stereonet_figure", "layer_view_png", "slope_view_figure", "histogram_figure",
            "comparison_stereonets", "comparison_histograms", "colour_scale", "drawn_fields",
@@ -168,10 +168,11 @@ def layer_view_png(path, analysis, column: str) -> Path:
     title = f"{len(bodies)} units: {label}"
     if len(rocks):
         title += f", on {len(rocks)} underlayer rocks (grey)"
-    return render_bodies_png(path, triangles_world=triangles, body_ids=np.concatenate(owners),
-                             values=analysis.body_values(column), value_label=label,
-                             value_range=(low, high), colour_map=colour_map, grey_bodies=rocks,
-                             title=title, view=(30, -125))
+    return picture.render_bodies_png(path, triangles_world=triangles,
+                                     body_ids=np.concatenate(owners),
+                                     values=analysis.body_values(column), value_label=label,
+                                     value_range=(low, high), colour_map=colour_map,
+                                     grey_bodies=rocks, title=title, view=(30, -125))
 
 
 def _footprints(state, bodies):
