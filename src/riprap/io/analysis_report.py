@@ -298,7 +298,7 @@ def _factor_of_safety_notes(layer: dict, units: dict) -> str:
         "moments on it balance. A factor of safety here is a limit-equilibrium check of one unit "
         "over the contacts it has now, with the forces the layer settled to "
         "(<code>contacts.csv</code>); it does not say that the unit moves.</p>"
-        "<p><b>Sliding</b> (riprap/analysis/unit_contacts.py): the sum of &mu;|N| over the sum "
+        "<p><b>Sliding</b> (riprap/solid/contact_statistics.py): the sum of &mu;|N| over the sum "
         "of |T| over all the unit's contacts. The solver caps each contact's friction force at "
         "&mu;|N|, so for a state riprap computed it is at least 1, and 1 only when every contact "
         "slides; above 1 it says how far the tangential springs are from their Coulomb limit. "
