@@ -1,4 +1,5 @@
-"""Pack files (riprap.io.pack, checked by riprap.workflows.place.write_checked_pack): written, loaded with load_case, built with build_simulation.
+"""Pack files (riprap.io.pack, read back by riprap.workflows.place.write_checked_pack): written,
+loaded with load_case, built with build_simulation.
 
 What must round-trip: the world position of every node of every body (1e-12 m: the loader
 re-derives each written mesh's principal frame, whose axes are arbitrary for a cube or a sphere,
