@@ -228,3 +228,21 @@ def test_stream_function_wave_is_linear_when_small_and_stokes_when_moderate():
     assert abs(div) < 1e-6
     with pytest.raises(CaseFileError, match="too close to breaking"):
         StreamFunctionWave(height=0.4, period=1.2, depth=0.4)
+
+
+def test_every_case_file_wave_type_has_a_theory_and_each_says_what_it_is():
+    """The schema's [waves] type choices are the registry's names (one place to add a theory),
+    and each theory states whether it is regular, how its height is named and whether the
+    Ursell limit applies (the flume checks and the report read these, not the class)."""
+    from riprap.case.schema import key
+    from riprap.waves.theories import WAVE_THEORIES, make_wave
+
+    assert set(key("waves", "type").choices) == set(WAVE_THEORIES)
+    parameters = {"height": 0.1, "period": 2.0, "phase": 0.0, "significant_height": 0.1,
+                  "peak_period": 2.0, "duration": 100.0, "peak_enhancement": 3.3, "seed": 1}
+    expected = {"linear": (True, "H", True), "stokes2": (True, "H", True),
+                "stream_function": (True, "H", False), "irregular": (False, "Hm0", False)}
+    for name in WAVE_THEORIES:
+        wave = make_wave(name, parameters, 1.0, 50.0, 9.81)
+        assert (wave.regular, wave.height_name, wave.ursell_limited) == expected[name]
+        assert wave.wave_length > 0 and np.isfinite(wave.elevation(np.array([0.5]), 1.0)).all()

@@ -16,13 +16,13 @@ from __future__ import annotations
 import math
 
 from riprap.analysis.design_formulas import hudson_stability_number, van_der_meer_cubes_damage
+from riprap.geometry.unit_kinds import UNIT_RECORDS
 
 __all__ = ["flume_stability", "HUDSON_TRUNK_STABILITY"]
 
-#: K_D of a trunk under non-breaking waves per unit kind (armour_design.md §5.2); None: no value
-#: retrieved for it (cubes: Van der Meer's formula instead).
-HUDSON_TRUNK_STABILITY = {"core_loc_like": 16.0, "accropode_like": 15.0, "xbloc_like": 16.0,
-                          "tetrapod": 8.0, "cube": None, "antifer_cube": None}
+#: K_D of a trunk under non-breaking waves per unit kind (armour_design.md §5.2, kept in each
+#: kind's record); None: no value retrieved for it (cubes: Van der Meer's formula instead).
+HUDSON_TRUNK_STABILITY = {record.name: record.hudson_trunk_stability for record in UNIT_RECORDS}
 
 
 def _finite(value) -> bool:

@@ -9,8 +9,7 @@ from riprap.waves.boundary_generation import BoundaryWaveMaker
 from riprap.waves.checks import check_flume
 from riprap.waves.gauges import Gauge, GaugeSet
 from riprap.waves.relaxation import ABSORPTION, GENERATION, RelaxationZone, WaveRelaxation
-from riprap.waves.stream_function import StreamFunctionWave
-from riprap.waves.theory import IrregularWave, LinearWave, StokesSecondOrderWave
+from riprap.waves.theories import make_wave
 
 __all__ = ["build_waves", "wave_of"]
 
@@ -23,18 +22,8 @@ _LEVEL_TOLERANCE_CELLS = 0.25
 
 
 def wave_of(spec, depth: float, end_time: float, gravity: float):
-    """The wave theory object of a ``[waves]`` table."""
-    p = spec.parameters
-    if spec.type == "irregular":
-        return IrregularWave(significant_height=p["significant_height"], peak_period=p["peak_period"],
-                             depth=depth, duration=p["duration"] or end_time,
-                             peak_enhancement=p["peak_enhancement"], seed=p["seed"], gravity=gravity)
-    if spec.type == "stream_function":
-        return StreamFunctionWave(height=p["height"], period=p["period"], depth=depth,
-                                  phase=p["phase"], gravity=gravity)
-    kind = StokesSecondOrderWave if spec.type == "stokes2" else LinearWave
-    return kind(height=p["height"], period=p["period"], depth=depth, phase=p["phase"],
-                gravity=gravity)
+    """The wave theory object of a ``[waves]`` table (``riprap.waves.theories``)."""
+    return make_wave(spec.type, spec.parameters, depth, end_time, gravity)
 
 
 def build_waves(case, solver) -> None:

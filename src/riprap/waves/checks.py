@@ -27,7 +27,7 @@ URSELL_LIMIT = 26.0
 def check_flume(wave, cell_size: float, zones, *, where: str = "waves") -> None:
     """Raise CaseFileError naming the first limit ``wave`` breaks on cells of ``cell_size`` m."""
     height, length, depth = wave.height, wave.wave_length, wave.depth
-    name = "Hm0" if hasattr(wave, "significant_height") else "H"
+    name = wave.height_name
     k = 2.0 * math.pi / length
     if height / cell_size < MINIMUM_CELLS_PER_HEIGHT:
         raise CaseFileError(
@@ -53,7 +53,7 @@ def check_flume(wave, cell_size: float, zones, *, where: str = "waves") -> None:
             f"{where}: {name} = {height:g} m breaks where it is made: the limit in d = {depth:g} m at "
             f"L = {length:.3g} m is {min(miche, 0.78 * depth):.3g} m (Miche 0.142 L tanh(kd) = "
             f"{miche:.3g} m, depth limit 0.78 d = {0.78 * depth:.3g} m)")
-    if name == "H" and not hasattr(wave, "celerity"):      # the stream function holds at any Ursell
+    if wave.ursell_limited:
         ursell = height * length ** 2 / depth ** 3
         if ursell > URSELL_LIMIT:
             raise CaseFileError(

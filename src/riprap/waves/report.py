@@ -115,7 +115,7 @@ def flume_report(gauges, wave_source=None, water_density: float | None = None) -
             report["not_computed"].append(f"{gauge.name}: {what}: "
                                           f"{_too_short(record_end, start, wave, 2)}")
     if wave is not None:
-        regular = not hasattr(wave, "significant_height")
+        regular = wave.regular
         ordered = sorted(surface, key=lambda g: g.position[0])
         for first, second in zip(ordered[:-1], ordered[1:]):
             t1, e1 = windows[second.name]

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -52,6 +53,11 @@ class StreamFunctionWave:
     """A steady nonlinear wave of ``height`` H (m) and ``period`` T (s) in ``depth`` d (m);
     ``terms`` N Fourier terms; ``current`` the mean-current criterion (NO_MASS_TRANSPORT, the
     default for a closed flume, or NO_EULERIAN_CURRENT); ``phase`` as the other theories'."""
+
+    #: Regular; the Fourier solution holds at any Ursell number (up to breaking).
+    regular: ClassVar[bool] = True
+    height_name: ClassVar[str] = "H"
+    ursell_limited: ClassVar[bool] = False
 
     height: float
     period: float

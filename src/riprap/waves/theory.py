@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -77,6 +78,11 @@ def ramp(time, ramp_time: float):
 class LinearWave:
     """A regular linear (Airy) wave of ``height`` H (m, crest to trough) and ``period`` T (s) in
     water of ``depth`` d (m)."""
+
+    #: One wave height and period (the analysis reads H, not Hm0; the Ursell limit applies).
+    regular: ClassVar[bool] = True
+    height_name: ClassVar[str] = "H"
+    ursell_limited: ClassVar[bool] = True
 
     height: float
     period: float
@@ -208,6 +214,11 @@ class IrregularWave:
     spectrum of ``significant_height`` Hm0 (m) and ``peak_period`` Tp (s), random phases drawn
     from ``seed``. The frequencies are evenly spaced over [0.5, 3] / Tp with spacing 1/``duration``
     (so the sea does not repeat within the duration); each amplitude is sqrt(2 S(f) df)."""
+
+    #: A spectrum, read as Hm0 and Tp; each component is linear, far inside the Ursell limit.
+    regular: ClassVar[bool] = False
+    height_name: ClassVar[str] = "Hm0"
+    ursell_limited: ClassVar[bool] = False
 
     significant_height: float
     peak_period: float
