@@ -55,6 +55,7 @@ from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.meshing import (
     MAX_BODY_LENGTH,
     MIN_BODY_LENGTH,
+    _gmsh_session,
     check_body_length,
     check_tetrahedron_estimate,
     mesh_occ_shape,
@@ -208,8 +209,6 @@ def occ_mass_properties(kind: str, *, height: float) -> dict[str, object]:
         ``"inertia_tensor"`` (numpy.ndarray (3, 3), m^5: the inertia tensor about the centroid
         per unit density).
     """
-    from riprap.geometry.meshing import _gmsh_session
-
     kind = _check_kind(kind)
     height = check_body_length(height, "height", f"armour unit '{kind}'")
     with _gmsh_session(f"occ_mass_properties({kind})") as gmsh:
