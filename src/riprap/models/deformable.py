@@ -11,18 +11,15 @@ import numpy as np
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.stresses import principal_stresses, von_mises
 from riprap.errors import InstabilityError, OverlapError, RiprapError
+from riprap.limits import PROGRESS_PERIOD
+from riprap.limits import START_OVERLAP_FRACTION as _START_OVERLAP_FRACTION
 from riprap.models.base import Model
 
 __all__ = ["DeformableModel", "UnitStressRecord"]
 
-# Wall-clock seconds between progress updates.
-_PROGRESS_PERIOD = 0.25
 #: The largest tensile stress of each body is looked for every this many steps (a fixed count, so
 #: that units.csv does not depend on the machine's speed): an impact's peak lasts hundreds of steps.
 RECORD_EVERY_STEPS = 50
-# Bodies may touch but not overlap at the start: a mean overlap above this fraction of the
-# smallest boundary sub-tet height is refused (the rigid bodies' rule).
-_START_OVERLAP_FRACTION = 0.01
 
 
 class UnitStressRecord:
@@ -222,7 +219,7 @@ class DeformableModel(Model):
             raise RiprapError(f"the deformable bodies made {n - (target - system.step_count)} of "
                               f"{n} steps at t = {system.time:.6g} s and stopped; report it")
         elapsed = wallclock.perf_counter() - tick
-        self._chunk = max(1, min(1_000_000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
+        self._chunk = max(1, min(1_000_000, int(n * PROGRESS_PERIOD / max(elapsed, 1e-6))))
 
     def _check_finite(self) -> None:
         """Stop with the failure checkpoint once a node's position or velocity is not finite
