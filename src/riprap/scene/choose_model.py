@@ -1,10 +1,9 @@
-"""Which model runs a scene, and how it is built from it: a table of builders, each saying which
-scenes it serves (by what :meth:`riprap.scene.Scene.holds`). The run loop only asks for "the
-model"; a new model (a second coupling method, a deformable variant, a model spread over several
-processes) is one more entry here, or :func:`register_model` from outside riprap, and no branch in
-the loop.
+"""Which model runs a scene, and how it is built from it: a table of builders keyed by what the
+scene holds (:meth:`riprap.scene.Scene.holds`). The run loop only asks for "the model"; a new
+model (a second coupling method, a deformable variant, a model spread over several processes) is
+one more entry here, or :func:`register_model` from outside riprap, and no branch in the loop.
 
-Exactly one builder must serve a scene: the table's order decides nothing."""
+Exactly one builder serves a scene: the table's order decides nothing."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -23,24 +22,29 @@ from riprap.models.settings import ModelSettings
 from riprap.scene.scene import Scene
 from riprap.work_estimate import check_deformable_run
 
-__all__ = ["MODEL_BUILDERS", "ModelBuilder", "build_model", "register_model"]
+__all__ = ["MODEL_BUILDERS", "ModelBuilder", "build_model", "register_model", "scenes"]
 
 
 @dataclass(frozen=True)
 class ModelBuilder:
-    """``build(scene, settings, restarted)`` makes the model of every scene whose
-    ``holds()`` satisfies ``serves``; ``restarted``: the run continues a checkpoint (its start
-    overlaps are its own, not checked again)."""
+    """``build(scene, settings, restarted)`` makes the model of every scene whose ``holds()``
+    is one of ``serves`` (sets of what a scene holds); ``restarted``: the run continues a
+    checkpoint (its start overlaps are its own, not checked again)."""
 
     name: str
-    serves: Callable[[frozenset], bool]
+    serves: frozenset
     build: Callable[[Scene, ModelSettings, bool], Model]
+
+
+def scenes(*contents) -> frozenset:
+    """The scenes a builder serves, each given by what it holds: ``scenes((), ("fluid",))``."""
+    return frozenset(frozenset(held) for held in contents)
 
 
 def build_model(scene: Scene, settings: ModelSettings, *, restarted: bool) -> Model:
     """The model of ``scene``, built by the one builder that serves it."""
     held = scene.holds()
-    serving = [builder for builder in MODEL_BUILDERS if builder.serves(held)]
+    serving = [builder for builder in MODEL_BUILDERS if held in builder.serves]
     if len(serving) != 1:
         names = ", ".join(builder.name for builder in serving) or "none"
         raise RiprapError(f"a scene holding {sorted(held) or 'nothing'} is served by {names}: "
@@ -49,7 +53,13 @@ def build_model(scene: Scene, settings: ModelSettings, *, restarted: bool) -> Mo
 
 
 def register_model(builder: ModelBuilder) -> None:
-    """Add a model for the scenes ``builder`` serves (none may be served by another already)."""
+    """Add a model for the scenes ``builder`` serves; refused where another serves one of them
+    (replace that builder in :data:`MODEL_BUILDERS` instead)."""
+    for other in MODEL_BUILDERS:
+        if builder.serves & other.serves:
+            taken = sorted(sorted(held) for held in builder.serves & other.serves)
+            raise RiprapError(f"model '{builder.name}': the scenes {taken} are served by "
+                              f"'{other.name}' already")
     MODEL_BUILDERS.append(builder)
 
 
@@ -132,20 +142,19 @@ def _deformable_coupled_model(scene: Scene, settings: ModelSettings,
     return DeformableCoupledModel(coupled, stresses)
 
 
-def _in_flow(held: frozenset) -> bool:
-    return "fluid" in held or "coupled solver" in held
-
-
-#: Every model riprap has, with the scenes it serves (``Scene.holds``: "rigid bodies",
+#: Every model riprap has, with the scenes it serves (what ``Scene.holds()``: "rigid bodies",
 #: "deformable bodies", "fluid", "coupled solver").
 MODEL_BUILDERS: list[ModelBuilder] = [
-    ModelBuilder("rigid", lambda held: not (_in_flow(held) or "deformable bodies" in held),
-                 rigid_model),
-    ModelBuilder("fluid", lambda held: held == {"fluid"}, _fluid_model),
-    ModelBuilder("coupled", lambda held: "deformable bodies" not in held and (
-        "coupled solver" in held or held == {"fluid", "rigid bodies"}), _coupled_model),
-    ModelBuilder("deformable", lambda held: "deformable bodies" in held and not _in_flow(held),
+    ModelBuilder("rigid", scenes((), ("rigid bodies",)), rigid_model),
+    ModelBuilder("fluid", scenes(("fluid",)), _fluid_model),
+    ModelBuilder("coupled", scenes(("fluid", "rigid bodies"), ("coupled solver",),
+                                   ("coupled solver", "rigid bodies")), _coupled_model),
+    ModelBuilder("deformable", scenes(("deformable bodies",), ("deformable bodies", "rigid bodies")),
                  _deformable_model),
-    ModelBuilder("deformable_coupled", lambda held: "deformable bodies" in held and _in_flow(held),
+    # (with a CoupledSolver built by the caller: refused, naming why)
+    ModelBuilder("deformable_coupled",
+                 scenes(("deformable bodies", "fluid"), ("deformable bodies", "fluid", "rigid bodies"),
+                        ("deformable bodies", "coupled solver"),
+                        ("deformable bodies", "coupled solver", "rigid bodies")),
                  _deformable_coupled_model),
 ]
