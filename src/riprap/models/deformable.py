@@ -42,9 +42,10 @@ class UnitStressRecord:
 
 
 class DeformableModel(Model):
-    """The deformable bodies of a :class:`riprap.simulation.Simulation`, joined in a
-    :class:`riprap.deformable.system.DeformableSystem`; with ``rigid`` (the simulation, when it
-    has rigid bodies too) its rigid solver is stepped with the same step, the rigid bodies' poses
+    """The deformable bodies of a scene, joined in a
+    :class:`riprap.deformable.system.DeformableSystem`; with ``rigid`` (a
+    :class:`riprap.models.rigid.RigidModel` of the scene's rigid bodies, when it has some) their
+    solver is stepped with the same step, the rigid bodies' poses
     placed in the system before every step and the contact forces on them handed back as
     external loads."""
 
