@@ -78,7 +78,7 @@ def _fluid_model(scene: Scene, settings: ModelSettings, restarted: bool) -> Flui
 def _coupled_model(scene: Scene, settings: ModelSettings, restarted: bool) -> CoupledModel:
     """The bodies in the flow: a CoupledSolver the caller built (its bodies are the run's), or
     one built here of the scene's fluid and bodies, whose obstacles are fixed bodies too."""
-    if hasattr(scene.fluid, "solids"):
+    if "coupled solver" in scene.holds():
         scene.solver = scene.fluid.solids
         return CoupledModel(scene.fluid)
     # The fluid's obstacles are walls for the bodies too: fixed bodies of the same cells.
@@ -118,7 +118,7 @@ def _deformable_coupled_model(scene: Scene, settings: ModelSettings,
     (``riprap.coupling.deformable_coupled``); the fluid box's sides (all but an open top) and
     the case's walls bound them."""
     solver, fluid = scene.solver, scene.fluid
-    if hasattr(fluid, "solids"):
+    if "coupled solver" in scene.holds():
         raise CaseFileError("deformable bodies cannot join a CoupledSolver built by the caller: "
                             "give the Simulation a FluidSolver")
     if solver.n_bodies > 0:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from riprap.coupling.coupled import _same_plane
+from riprap.coupling.coupled import CoupledSolver, _same_plane
 from riprap.deformable.body import DeformableBody
 from riprap.deformable.joints import FracturingBody, check_crack_resolution
 from riprap.deformable.system import DeformableSystem
@@ -69,14 +69,14 @@ class Scene:
         if self.deformable_bodies:
             held.add("deformable bodies")
         if self.fluid is not None:
-            held.add("coupled solver" if hasattr(self.fluid, "solids") else "fluid")
+            held.add("coupled solver" if isinstance(self.fluid, CoupledSolver) else "fluid")
         return frozenset(held)
 
     @property
     def coupled(self) -> bool:
         """Whether bodies move in a fluid."""
-        return self.fluid is not None and (hasattr(self.fluid, "solids") or self.solver.n_bodies > 0
-                                           or bool(self.deformable_bodies))
+        return self.fluid is not None and bool(self.holds() & {"coupled solver", "rigid bodies",
+                                                                "deformable bodies"})
 
     # ------------------------------------------------------------------ building
     def add_material(self, material: Material) -> None:
