@@ -11,6 +11,7 @@ are the scene's, offered here too so that a run is built in one object.
 """
 from __future__ import annotations
 
+import functools
 import os
 import time as wallclock
 from dataclasses import dataclass, field
@@ -101,6 +102,14 @@ class _OfScene:
 
     def __set__(self, simulation, value) -> None:
         setattr(simulation.scene, self.name, value)
+
+
+def _of_scene(method):
+    """A building call of the run that is its scene's (same signature and documentation)."""
+    @functools.wraps(method)
+    def of_scene(simulation, *args, **kwargs):
+        return method(simulation.scene, *args, **kwargs)
+    return of_scene
 
 
 class Simulation:
@@ -214,41 +223,20 @@ class Simulation:
     #: The former name of ``shape_names`` (read by riprap.case.build_placement).
     _shape_names = _OfScene("shape_names")
 
-    def add_material(self, material) -> None:
-        self.scene.add_material(material)
-
-    def add_shape(self, name: str, mesh) -> None:
-        """:meth:`riprap.scene.Scene.add_shape`."""
-        self.scene.add_shape(name, mesh)
-
-    def shape(self, name: str):
-        return self.scene.shape(name)
-
-    def add_body(self, **body) -> int:
-        """:meth:`riprap.scene.Scene.add_body`; returns the body index."""
-        return self.scene.add_body(**body)
-
-    def add_deformable_body(self, **body) -> int:
-        """:meth:`riprap.scene.Scene.add_deformable_body`; returns its index among the
-        deformable bodies."""
-        return self.scene.add_deformable_body(**body)
-
-    def add_walls(self, walls, *, container_box=None) -> None:
-        self.scene.add_walls(walls, container_box=container_box)
+    add_material = _of_scene(Scene.add_material)
+    add_shape = _of_scene(Scene.add_shape)
+    shape = _of_scene(Scene.shape)
+    add_body = _of_scene(Scene.add_body)
+    add_deformable_body = _of_scene(Scene.add_deformable_body)
+    add_walls = _of_scene(Scene.add_walls)
+    contact_history = _of_scene(Scene.contact_history)
+    set_contact_history = _of_scene(Scene.set_contact_history)
 
     def add_fluid(self, fluid) -> None:
         """:meth:`riprap.scene.Scene.add_fluid`, before the run is prepared."""
         if self._model is not None:
             raise RiprapError("add_fluid: the run is already prepared; add the fluid first")
         self.scene.add_fluid(fluid)
-
-    def contact_history(self):
-        """:meth:`riprap.scene.Scene.contact_history`."""
-        return self.scene.contact_history()
-
-    def set_contact_history(self, history) -> None:
-        """:meth:`riprap.scene.Scene.set_contact_history`."""
-        self.scene.set_contact_history(history)
 
     @property
     def coupled(self) -> bool:
