@@ -23,7 +23,8 @@ def _scenes():
                 yield frozenset(held)
 
 
-@pytest.mark.parametrize("held", list(_scenes()), ids=lambda held: "+".join(sorted(held)) or "empty")
+@pytest.mark.parametrize("held", list(_scenes()),
+                         ids=lambda held: "+".join(sorted(held)) or "empty")
 def test_exactly_one_model_serves_every_scene(held):
     assert len([builder for builder in MODEL_BUILDERS if held in builder.serves]) == 1
 
