@@ -94,14 +94,16 @@ class DeformableModel(Model):
     def prepare(self, *, restarted: bool) -> None:
         self.system.time_step       # chosen now, from the stiffest element and contact
         if self.rigid is not None:
-            self._place_rigid()
+            self.place_rigid()
             if not restarted:
                 self.rigid.check_start_overlaps()
         if not restarted:
             self.check_start_overlaps()
-        self._record_stresses()
+        self.record_stresses()
 
-    def _place_rigid(self, everything: bool = True) -> None:
+    def place_rigid(self, everything: bool = True) -> None:
+        """Put the rigid bodies' poses and velocities in the system (only the moving ones'
+        unless ``everything``)."""
         solver = self.rigid.solver
         self.system.set_rigid_poses(solver.rotation_matrices(), solver.positions,
                                     solver.velocities, solver.angular_velocities,
@@ -122,7 +124,7 @@ class DeformableModel(Model):
             solver.advance(n)
             return
         for _ in range(n):
-            self._place_rigid(everything=False)
+            self.place_rigid(everything=False)
             self.system.step(1)
             self._pass_rigid_loads()
             solver.advance(1)
@@ -215,7 +217,7 @@ class DeformableModel(Model):
             next_record = (system.step_count // RECORD_EVERY_STEPS + 1) * RECORD_EVERY_STEPS
             self._step(min(target, next_record) - system.step_count)
             if system.step_count % RECORD_EVERY_STEPS == 0:
-                self._record_stresses()
+                self.record_stresses()
         if system.step_count < target:
             raise RiprapError(f"the deformable bodies made {n - (target - system.step_count)} of "
                               f"{n} steps at t = {system.time:.6g} s and stopped; report it")
@@ -235,7 +237,8 @@ class DeformableModel(Model):
                 f"(node {node - int(s.node_offsets[k])}, step {s.step_count}); the bodies moved "
                 "more than the step can carry: check the start velocities and the loads")
 
-    def _record_stresses(self) -> None:
+    def record_stresses(self) -> None:
+        """Look for each body's largest tensile stress now (and stop a non-finite state)."""
         self._check_finite()
         before = self.records.stress.max()
         all_sigma_1 = []
@@ -288,7 +291,7 @@ class DeformableModel(Model):
             solver.load_state_arrays(
                 {key[len("rigid_"):]: value for key, value in arrays.items() if key.startswith("rigid_")})
             solver._contacts = None
-            self._place_rigid()
+            self.place_rigid()
 
     def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
         arrays = dict(state)
