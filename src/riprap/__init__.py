@@ -15,14 +15,13 @@ from riprap.case.load import load_case, parse_case
 from riprap.deformable import DeformableBody, ElasticMaterial
 from riprap.fluid.grid import FluidGrid
 from riprap.fluid.phases import AIR_20C, SEA_WATER_20C, WATER_20C, Phase
-from riprap.fluid.run import FluidRun
 from riprap.fluid.solver import FluidSolver
 from riprap.geometry import shapes
 from riprap.geometry.armour_units import ArmourUnit, armour_unit
 from riprap.geometry.rock_grading import RockGrading, rock_library
 from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.tetmesh import TetMesh
-from riprap.simulation import RunSummary, Simulation
+from riprap.simulation import FluidRun, RunSummary, Simulation
 from riprap.solid import walls
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape

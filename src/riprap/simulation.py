@@ -1,14 +1,17 @@
-"""Simulation: the one user-facing run, of rigid bodies, of air and water, or of both coupled.
+"""Simulation: the one run loop, of rigid bodies, of air and water, of both coupled, or of
+deformable bodies.
 
-It builds the bodies (shapes, materials, walls: :class:`riprap.solid.solver.SolidSolver`), takes
-a fluid (:class:`riprap.fluid.solver.FluidSolver`) when one is given, and runs them as one model
-(:mod:`riprap.models`): rigid bodies alone, the fluid alone, or the two coupled
-(:class:`riprap.coupling.coupled.CoupledSolver`). It owns the schedule of periodic work (frames,
-checkpoints, progress, the rest check) and the failure checkpoint; the models own the physics. A
-run that fails writes a checkpoint of the last good state and says what failed, where and when.
+A run holds a scene (:class:`riprap.scene.Scene`: materials, shapes, bodies, walls, a fluid,
+deformable bodies), and the scene's model (:mod:`riprap.models`, chosen by
+:mod:`riprap.scene.choose_model`) is what the loop advances. The loop owns the clock's schedule
+(frames, checkpoints, the end time), restarts, progress, the summary and the failure checkpoint;
+the model owns its physics and its checks. A run that fails writes a checkpoint of the last good
+state and says what failed, where and when. The building calls (``add_body``, ``add_fluid``, ...)
+are the scene's, offered here too so that a run is built in one object.
 """
 from __future__ import annotations
 
+import functools
 import os
 import time as wallclock
 from dataclasses import dataclass, field
@@ -16,29 +19,16 @@ from pathlib import Path
 
 import numpy as np
 
-from riprap.errors import CaseFileError, InstabilityError, OverlapError, RiprapError
-from riprap.work_estimate import (MAX_CHECKPOINTS, MAX_FRAMES, check_deformable_run,
-                                   check_rigid_run, schedule_problems)
-from riprap.geometry.tetmesh import TetMesh
-from riprap.solid.materials import Material
-from riprap.solid.shape import RigidShape
-from riprap.solid.solver import SolidSolver
-from riprap.solid.walls import Wall
+from riprap.errors import CaseFileError, InstabilityError, RiprapError
+from riprap.models import rigid
+from riprap.models.base import Model
+from riprap.models.settings import ModelSettings
+from riprap.scene import DEFAULT_GRAVITY, Scene
+from riprap.scene.choose_model import build_model
+from riprap.work_estimate import MAX_CHECKPOINTS, MAX_FRAMES, schedule_problems
 
-# Bodies may touch but not overlap at the start: a mean overlap depth above this fraction of the
-# smallest boundary sub-tet height is reported (a just-touching placement gives exactly zero).
-_INITIAL_OVERLAP_FRACTION = 0.01
-# A speed above this (m/s) means the explicit scheme has blown up even if numbers are still finite.
-_RUNAWAY_SPEED = 1.0e3
-# Largest allowed dt / (2 sqrt(m_eff / k)) over the contacts actually present (1 is the stability
-# limit of an undamped spring; rotation about the contact lowers the effective mass, hence margin).
-_MAX_STABILITY_RATIO = 0.5
-# A body rests when its net force is below this fraction of its weight (and it is slow).
-_REST_FORCE_RATIO = 0.1
-_MAX_MOTION_PER_STEP = 0.1
-# Gravity above this (m/s^2) is named as the likely cause of a blow-up (a centrifuge model runs
-# at tens of g; more is a typo).
-_ABSURD_GRAVITY = 1000.0
+__all__ = ["FluidRun", "FluidRunSummary", "RunSummary", "Simulation"]
+
 # A run whose clock and step count stay where they are over this many chunks in a row is stuck
 # (a step too small to change the clock): it stops with an error instead of spinning.
 _MOST_CHUNKS_WITHOUT_PROGRESS = 1000
@@ -96,9 +86,41 @@ class RunSummary:
         return {key: value for key, value in self.__dict__.items() if value is not None}
 
 
+
+
+class _OfScene:
+    """An attribute of the run that is its scene's (read and set there)."""
+
+    def __init__(self, name: str | None = None):
+        self.name = name
+
+    def __set_name__(self, owner, name: str) -> None:
+        self.name = self.name or name
+
+    def __get__(self, simulation, owner=None):
+        return self if simulation is None else getattr(simulation.scene, self.name)
+
+    def __set__(self, simulation, value) -> None:
+        setattr(simulation.scene, self.name, value)
+
+
+def _of_scene(method):
+    """A building call of the run that is its scene's (same signature and documentation)."""
+    @functools.wraps(method)
+    def of_scene(simulation, *args, **kwargs):
+        return method(simulation.scene, *args, **kwargs)
+    return of_scene
+
+
 class Simulation:
     """A run: rigid bodies (shapes, materials, bodies, walls), air and water (``fluid``), or
-    bodies in the flow (both), with a clock and outputs.
+    bodies in the flow (both), with a clock and outputs. It holds a scene (:attr:`scene`, which
+    builds) and runs the scene's model (:attr:`model`, which owns the physics).
+
+    ``scene`` (optional, the one positional argument): a :class:`riprap.scene.Scene` built
+    beforehand (then ``gravity``, ``local_damping`` are its own), or a ready
+    :class:`riprap.models.base.Model` to run as it is; by default an empty scene that the
+    ``add_*`` calls fill.
 
     Parameters (keyword-only, SI units; the same names as the ``[simulation]`` and ``[output]``
     tables of a case file)
@@ -137,11 +159,12 @@ class Simulation:
         sub-step inside each fluid step (the fluid's own step follows its Courant number).
     """
 
-    def __init__(self, *, end_time: float, time_step: float = 0.0, time_step_safety: float = 0.2,
-                 gravity=(0.0, 0.0, -9.81), output_interval: float = 0.05,
-                 checkpoint_interval: float = 0.0, local_damping: float = 0.0,
-                 rest_speed: float = 0.0, output_directory="riprap-out", paraview: bool = True,
-                 picture: bool = True, progress: bool = True, rest_kinetic_energy: float = 0.0,
+    def __init__(self, scene=None, *, end_time: float, time_step: float = 0.0,
+                 time_step_safety: float = 0.2, gravity=DEFAULT_GRAVITY,
+                 output_interval: float = 0.05, checkpoint_interval: float = 0.0,
+                 local_damping: float = 0.0, rest_speed: float = 0.0,
+                 output_directory="riprap-out", paraview: bool = True, picture: bool = True,
+                 progress: bool = True, rest_kinetic_energy: float = 0.0,
                  adaptive_time_step: bool = False, fluid=None):
         _require(end_time > 0, "end_time", end_time, "> 0 s")
         _require(time_step >= 0, "time_step", time_step, ">= 0 s (0 = automatic)")
@@ -156,7 +179,6 @@ class Simulation:
             raise CaseFileError(f"simulation.{key} = {value:g}: {message}")
         self.rest_kinetic_energy = float(rest_kinetic_energy)
         self.adaptive_time_step = bool(adaptive_time_step)
-        self._last_stability_ratio = 0.0
         self.end_time = float(end_time)
         self.requested_time_step = float(time_step)
         self.time_step_safety = float(time_step_safety)
@@ -174,317 +196,105 @@ class Simulation:
         # refused. None for a run built in Python: its restarts are not checked.
         self.run_definition = None
         self.progress = bool(progress)
-        if fluid is not None and tuple(np.asarray(gravity, dtype=float)) == (0.0, 0.0, -9.81):
-            gravity = fluid.gravity
-        self.solver = SolidSolver(gravity=gravity, local_damping=local_damping)
-        self._shape_names: dict[str, int] = {}
-        self._meshes: list[TetMesh] = []
-        self.container_box = None
         self._frame_index = 0            # frames written on the schedule (next at index * interval)
         self._checkpoints_written = 0    # periodic checkpoints (next at (count + 1) * interval)
         self._restarted = False
         self._model = None
-        #: The flow the bodies move in (:meth:`add_fluid`), or None for a dry run.
-        self.fluid = None
-        if fluid is not None:
-            self.add_fluid(fluid)
-        # Pairs allowed to overlap at the start, up to a depth (m): a pack's resting contacts.
-        self.accepted_overlaps: dict[tuple[int, int], float] = {}
-        #: Deformable bodies (:meth:`add_deformable_body`) and how they touch.
-        self.deformable_bodies = []
-        self.deformable_contact_penalty = None
-        self.deformable_mass_damping = 0.0
-        # For runs built from a case: the case's number of each deformable and each rigid body,
-        # and the resting overlaps (m) of a pack's contacts that involve deformable bodies.
-        self.deformable_case_index: list[int] = []
-        self.deformable_accepted_depths: dict[tuple[int, int], float] = {}
+        if isinstance(scene, Model):
+            self._model, scene = scene, None
+        if scene is None:
+            scene = Scene(gravity=gravity, local_damping=local_damping, fluid=fluid)
+        elif fluid is not None:
+            scene.add_fluid(fluid)
+        #: What the run holds (:class:`riprap.scene.Scene`); built by the ``add_*`` calls.
+        self.scene = scene
 
-    # ------------------------------------------------------------------ building
-    def add_material(self, material: Material) -> None:
-        self.solver.add_material(material)
+    # ------------------------------------------------------------------ the scene's
+    solver = _OfScene()
+    fluid = _OfScene()
+    container_box = _OfScene()
+    shape_names = _OfScene()
+    accepted_overlaps = _OfScene()
+    deformable_bodies = _OfScene()
+    deformable_contact_penalty = _OfScene()
+    deformable_mass_damping = _OfScene()
+    deformable_case_index = _OfScene()
+    deformable_accepted_depths = _OfScene()
+    #: The former name of ``shape_names`` (read by riprap.case.build_placement).
+    _shape_names = _OfScene("shape_names")
 
-    def add_shape(self, name: str, mesh: TetMesh | RigidShape) -> None:
-        """Add a shape by name: a tetrahedral mesh, or a prepared :class:`RigidShape` (whose frame
-        as built is then its principal frame)."""
-        if name in self._shape_names:
-            raise CaseFileError(f"shape '{name}' defined twice")
-        shape = mesh if isinstance(mesh, RigidShape) else RigidShape.from_mesh(mesh, name=name)
-        self._shape_names[name] = self.solver.add_shape(shape)
-        self._meshes.append(shape.mesh if isinstance(mesh, RigidShape) else mesh)
+    add_material = _of_scene(Scene.add_material)
+    add_shape = _of_scene(Scene.add_shape)
+    shape = _of_scene(Scene.shape)
+    add_body = _of_scene(Scene.add_body)
+    add_deformable_body = _of_scene(Scene.add_deformable_body)
+    add_walls = _of_scene(Scene.add_walls)
+    contact_history = _of_scene(Scene.contact_history)
+    set_contact_history = _of_scene(Scene.set_contact_history)
 
-    def shape(self, name: str) -> RigidShape:
-        return self.solver.shapes[self._shape_index(name)]
-
-    def _shape_index(self, name: str) -> int:
-        if name not in self._shape_names:
-            raise CaseFileError(f"unknown shape '{name}' (defined: {', '.join(self._shape_names)})")
-        return self._shape_names[name]
-
-    def add_body(self, *, shape: str, material: str, position, orientation=(1.0, 0.0, 0.0, 0.0),
-                 velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
-                 fixed: bool = False, frame: str = "shape") -> int:
-        """Add a body; ``position`` is its centroid (m), ``orientation`` a quaternion (w, x, y, z)
-        applied to the shape as built (``frame="shape"``) or to its principal frame
-        (``frame="principal"``, as the solver stores it). Returns the body index."""
-        return self.solver.add_body(shape=self._shape_index(shape),
-                                    material=self.solver.material_index(material),
-                                    position=position, orientation=orientation, velocity=velocity,
-                                    angular_velocity=angular_velocity, fixed=fixed, frame=frame)
-
-    def add_deformable_body(self, *, shape: str, material, position,
-                            orientation=(1.0, 0.0, 0.0, 0.0), velocity=(0.0, 0.0, 0.0),
-                            angular_velocity=(0.0, 0.0, 0.0), element_type: str = "tet4",
-                            name: str | None = None, joints=None) -> int:
-        """Add a deformable body (:class:`riprap.deformable.DeformableBody`) of a shape's mesh:
-        ``material`` an :class:`riprap.deformable.ElasticMaterial`, ``position`` its centroid
-        (m), ``orientation`` a quaternion (w, x, y, z) applied to the mesh as built, ``velocity``
-        and ``angular_velocity`` its initial rigid motion. ``joints``: a
-        :class:`riprap.deformable.joints.JointMaterial` (joints between all its tets), or one with
-        a box ((lower), (upper)) in m at the start, joints only between tets whose centroids lie
-        in it: the body cracks (:class:`riprap.deformable.joints.FracturingBody`). Returns its
-        index among the deformable bodies."""
-        from scipy.spatial.transform import Rotation
-
-        from riprap.deformable.body import DeformableBody
-        from riprap.geometry.mass_properties import mass_properties
-
-        mesh = self._meshes[self._shape_index(shape)]
-        centroid = np.asarray(mass_properties(mesh).centroid, dtype=np.float64)
-        w, x, y, z = (float(v) for v in orientation)
-        rotation = Rotation.from_quat([x, y, z, w]).as_matrix()
-        nodes = (mesh.nodes - centroid) @ rotation.T + np.asarray(position, dtype=np.float64)
-        index = len(self.deformable_bodies)
-        name = name or f"{shape}_{index}"
-        if joints is None:
-            body = DeformableBody(nodes, mesh.tets, material, element_type=element_type, name=name)
-        else:
-            from riprap.deformable.joints import FracturingBody, check_crack_resolution
-
-            if element_type != "tet4":
-                raise CaseFileError(f"deformable body '{name}': joints need element_type 'tet4', "
-                                    f"not {element_type!r}")
-            joint_material, region = joints if isinstance(joints, tuple) else (joints, None)
-            cracking = None
-            if region is not None:
-                centres = nodes[mesh.tets].mean(axis=1)
-                lower, upper = (np.asarray(corner, dtype=np.float64) for corner in region)
-                cracking = np.all((centres >= lower) & (centres <= upper), axis=1)
-            check_crack_resolution(nodes, mesh.tets, name)
-            body = FracturingBody(nodes, mesh.tets, material, joint_material, name=name,
-                                  cracking=cracking)
-        offsets = body.positions - np.asarray(position, dtype=np.float64)
-        body.velocities[:] = np.asarray(velocity, dtype=np.float64) + np.cross(
-            np.asarray(angular_velocity, dtype=np.float64), offsets)
-        self.deformable_bodies.append(body)
-        return index
-
-    def add_walls(self, walls: list[Wall], *, container_box=None) -> None:
-        self.solver.add_walls(walls)
-        if container_box is not None:
-            self.container_box = container_box
-
-    # ------------------------------------------------------------------ running
     def add_fluid(self, fluid) -> None:
-        """Put the run in a flow: a :class:`riprap.fluid.solver.FluidSolver` (the bodies, if any,
-        are coupled to it when the run starts) or a ready
-        :class:`riprap.coupling.coupled.CoupledSolver`."""
+        """:meth:`riprap.scene.Scene.add_fluid`, before the run is prepared."""
         if self._model is not None:
             raise RiprapError("add_fluid: the run is already prepared; add the fluid first")
-        self.fluid = fluid
-
-    @property
-    def model(self):
-        """What the run loop advances (:mod:`riprap.models`), built on first use: the rigid
-        bodies, the fluid, or both coupled."""
-        if self._model is None:
-            self._model = self._build_model()
-        return self._model
+        self.scene.add_fluid(fluid)
 
     @property
     def coupled(self) -> bool:
         """Whether bodies move in a fluid."""
-        return self.fluid is not None and (hasattr(self.fluid, "solids") or self.solver.n_bodies > 0
-                                           or bool(self.deformable_bodies))
+        return self.scene.coupled
 
-    def _build_model(self):
-        from riprap.models.fluid import CoupledModel, FluidModel
-        from riprap.models.rigid import RigidModel
+    # ------------------------------------------------------------------ the model
+    @property
+    def settings(self) -> ModelSettings:
+        """What the model is told of this run's settings."""
+        return ModelSettings(end_time=self.end_time, time_step=self.requested_time_step,
+                             time_step_safety=self.time_step_safety,
+                             adaptive_time_step=self.adaptive_time_step,
+                             rest_speed=self.rest_speed,
+                             rest_kinetic_energy=self.rest_kinetic_energy)
 
-        if self.deformable_bodies:
-            return self._deformable_model()
-        if self.fluid is None:
-            return RigidModel(self)
-        if hasattr(self.fluid, "solids"):            # a CoupledSolver built by the caller
-            self.solver = self.fluid.solids
-            return CoupledModel(self.fluid)
-        if self.solver.n_bodies == 0:
-            return FluidModel(self.fluid)
-        from riprap.coupling.coupled import CoupledSolver
-        from riprap.coupling.obstacles import add_obstacle_bodies, name_obstacles_in_overlap
-
-        # The fluid's obstacles are walls for the bodies too: fixed bodies of the same cells.
-        boxes = getattr(self.fluid, "obstacle_boxes", [])
-        obstacle_bodies = add_obstacle_bodies(self, boxes)
-        try:
-            self._prepare_bodies()
-        except OverlapError as error:
-            raise name_obstacles_in_overlap(error, obstacle_bodies, boxes) from None
-        return CoupledModel(CoupledSolver(self.fluid, self.solver, obstacle_bodies=obstacle_bodies))
-
-    def _deformable_model(self):
-        from riprap.models.deformable import DeformableModel
-
-        if self.fluid is not None:
-            return self._deformable_coupled_model()
-        solver = self.solver
-        if solver.n_bodies > 0:
-            # rigid bodies too: they keep their own solver, stepped with the deformable bodies'
-            # step, and meet the deformable bodies through their surface layers
-            self.build_without_checks()
-        system = self._deformable_system(solver.gravity)
-        step = self.requested_time_step if self.requested_time_step > 0 else system.time_step
-        if solver.n_bodies > 0:
-            step = min(step, solver.time_step)
-            solver.set_time_step(step)
-        system.time_step = step
-        check_deformable_run(end_time=self.end_time, time_step=step, elements=len(system.elements),
-                             rigid_bodies=int((~solver.fixed).sum()) if solver.n_bodies else 0)
-        return DeformableModel(system, rigid=self if solver.n_bodies > 0 else None,
-                               case_numbers=self._case_numbers(),
-                               accepted_depths=self.deformable_accepted_depths)
-
-    def _deformable_system(self, gravity, extra_walls=()):
-        """The deformable bodies joined in one system, with the rigid solver's bodies (built
-        already) as surfaces they touch, its walls, and ``extra_walls`` not already among them
-        (with the deformable bodies' smallest friction coefficient)."""
-        from riprap.coupling.coupled import _same_plane
-        from riprap.deformable.system import DeformableSystem
-
-        solver = self.solver
-        rigid_surfaces = []
-        for b in range(solver.n_bodies):
-            shape = solver.shapes[int(solver.shape_index[b])]
-            material = solver.materials[int(solver.material_index_of_body[b])]
-            mass = np.inf if solver.fixed[b] else float(solver.masses[b])
-            rigid_surfaces.append((shape.mesh.nodes, shape.mesh.tets, material.friction_coefficient,
-                                   mass, material.damping_ratio))
-        walls = [(wall.point, wall.normal,
-                  solver.materials[solver.material_index(wall.material)].friction_coefficient)
-                 for wall in solver.walls]
-        friction = min(b.material.friction_coefficient for b in self.deformable_bodies)
-        walls += [(wall.point, wall.normal, friction) for wall in extra_walls
-                  if not any(_same_plane(wall, other) for other in solver.walls)]
-        return DeformableSystem(self.deformable_bodies, walls=walls,
-                                contact_penalty=self.deformable_contact_penalty, gravity=gravity,
-                                mass_damping=self.deformable_mass_damping,
-                                rigid_surfaces=rigid_surfaces)
-
-    def _deformable_coupled_model(self):
-        """Deformable bodies (and rigid ones, if any) in the flow
-        (``riprap.coupling.deformable_coupled``); the fluid box's sides (all but an open top) and
-        the case's walls bound them."""
-        from riprap.coupling.coupled import _same_plane, fluid_box_walls
-        from riprap.coupling.deformable_coupled import DeformableBodies, DeformableCoupledSolver
-        from riprap.models.deformable import DeformableModel
-        from riprap.models.deformable_coupled import DeformableCoupledModel
-
-        solver = self.solver
-        if hasattr(self.fluid, "solids"):
-            raise CaseFileError("deformable bodies cannot join a CoupledSolver built by the caller: "
-                                "give the Simulation a FluidSolver")
-        if solver.n_bodies > 0:
-            # the sides of the box are walls for the rigid bodies too (unless already there)
-            material = solver.materials[0].name
-            solver.add_walls([wall for wall in fluid_box_walls(self.fluid.grid, material)
-                              if not any(_same_plane(wall, other) for other in solver.walls)])
-            self._prepare_bodies()
-        system = self._deformable_system(self.fluid.gravity,
-                                         extra_walls=fluid_box_walls(self.fluid.grid, ""))
-        if self.requested_time_step > 0:
-            system.time_step = self.requested_time_step
-        check_deformable_run(end_time=self.end_time, time_step=system.time_step,
-                             elements=len(system.elements))
-        coupled = DeformableCoupledSolver(self.fluid, DeformableBodies(
-            system, rigid=solver if solver.n_bodies > 0 else None))
-        stresses = DeformableModel(system, rigid=self if solver.n_bodies > 0 else None,
-                                   case_numbers=self._case_numbers(),
-                                   accepted_depths=self.deformable_accepted_depths)
-        return DeformableCoupledModel(coupled, stresses)
-
-    def _case_numbers(self):
-        """(case number of each deformable body, of each rigid body): their own orders when the
-        run was built in Python."""
-        deformable = list(self.deformable_case_index) or list(range(len(self.deformable_bodies)))
-        taken = set(deformable)
-        rigid = [i for i in range(len(deformable) + self.solver.n_bodies) if i not in taken]
-        return deformable, rigid
+    @property
+    def model(self):
+        """What the run loop advances (:mod:`riprap.models`), built from the scene on first use
+        by the model that serves it (:func:`riprap.scene.choose_model.build_model`)."""
+        if self._model is None:
+            self._model = build_model(self.scene, self.settings, restarted=self._restarted)
+        return self._model
 
     def prepare(self) -> None:
         """Build the model, choose time steps, evaluate initial forces and check the start state
         (nothing overlaps; bodies inside the fluid box and wide enough for its cells)."""
         self.model.prepare(restarted=self._restarted)
 
-    def _prepare_bodies(self) -> None:
-        solver = self.solver
-        if solver._ready:
-            return
-        self.build_without_checks()
-        check_rigid_run(end_time=self.end_time, time_step=solver.time_step,
-                        moving_bodies=int((~solver.fixed).sum()), start_time=solver.time,
-                        setting_the_step=self._body_setting_the_step)
-        if not self._restarted:
-            self.check_start_overlaps()
-
-    def _body_setting_the_step(self, numbered: bool = True) -> str:
-        """The body whose mass and contact stiffness chose the automatic time step, in words
-        (with its number when ``numbered``); "" for a step the user gave."""
-        if self.requested_time_step > 0:
-            return ""
-        solver = self.solver
-        steps = solver.critical_time_steps()
-        if not np.isfinite(steps).any():
-            return ""
-        body = int(np.argmin(steps))
-        shape = solver.shapes[int(solver.shape_index[body])]
-        return ((f"body {body}, " if numbered else "")
-                + f"shape '{shape.name}', Dn = {shape.volume ** (1 / 3):.3g} m, "
-                f"{solver.masses[body]:.3g} kg")
+    # ------------------------------------------------------------------ the rigid bodies now
+    def build_without_checks(self) -> None:
+        """Build the rigid bodies' arrays, choose the time step and evaluate the initial forces,
+        without refusing overlaps (callers that resolve overlaps themselves use
+        ``solver.overlaps``)."""
+        rigid.build_bodies(self.solver, self.settings)
 
     def check_start_overlaps(self) -> None:
-        """Refuse bodies that overlap at the start (beyond the accepted resting contacts of a
-        pack) or occupy the same place."""
-        smallest = min(shape.min_subtet_height for shape in self.solver.shapes)
-        self.solver.check_no_initial_overlap(_INITIAL_OVERLAP_FRACTION * smallest,
-                                             accepted=self.accepted_overlaps)
+        """Refuse rigid bodies that overlap at the start (beyond the accepted resting contacts of
+        a pack) or occupy the same place."""
+        rigid.check_start_overlaps(self.solver, self.accepted_overlaps)
 
-    def contact_history(self):
-        """The current contacts as a :class:`riprap.io.contact_history.ContactHistory` (spring
-        state and overlap depths), to start another run from this state."""
-        from riprap.io.contact_history import ContactHistory
+    def _body_setting_the_step(self, numbered: bool = True) -> str:
+        """:func:`riprap.models.rigid.body_setting_the_step` (read by riprap.placement.place)."""
+        return rigid.body_setting_the_step(self.solver, self.settings, numbered=numbered)
 
-        body_i, body_j, springs = self.solver.contact_history()
-        depths = {(i, j): depth for i, j, depth in self.solver.overlaps(0.0)}
-        return ContactHistory(body_i, body_j, springs,
-                              [depths.get((int(i), int(j)), 0.0) for i, j in zip(body_i, body_j)])
+    def at_rest(self) -> bool:
+        """:func:`riprap.models.rigid.at_rest` of the rigid bodies now."""
+        return rigid.at_rest(self.solver, self.settings)
 
-    def set_contact_history(self, history) -> None:
-        """Start from the contacts of a placed pack (a
-        :class:`riprap.io.contact_history.ContactHistory`): their friction carries over and their
-        overlaps, up to the depths recorded, are accepted at the start."""
-        self.solver.set_initial_contact_history(history.body_i, history.body_j, history.springs)
-        self.accepted_overlaps = history.accepted_depths()
+    def stability_ratio(self) -> float:
+        """:func:`riprap.models.rigid.stability_ratio` of the rigid bodies' contacts now."""
+        return rigid.stability_ratio(self.solver)[0]
 
-    def build_without_checks(self) -> None:
-        """Build the solver's arrays, choose the time step and evaluate the initial forces, without
-        refusing overlaps (callers that resolve overlaps themselves use ``solver.overlaps``)."""
-        solver = self.solver
-        solver._build_arrays()
-        if self.requested_time_step > 0:
-            solver.time_step = self.requested_time_step
-        else:
-            solver.time_step = solver.stable_time_step(self.time_step_safety)
-        solver.finalize()
+    def max_speed(self) -> float:
+        """Largest speed of a free rigid body including rotation at its bounding radius (m/s)."""
+        return rigid.max_speed(self.solver)
 
+    # ------------------------------------------------------------------ running
     def run(self, *, restart_from=None, after_chunk=None) -> RunSummary:
         """Run to ``end_time`` (or rest); write frames, checkpoints, pictures and the summary.
 
@@ -587,99 +397,7 @@ class Simulation:
             self._frame_index = _first_not_reached(model, self._frame_index, self.output_interval,
                                                    MAX_FRAMES, "output_interval")
 
-    def _step_keeps_motion_small(self, time_step: float) -> bool:
-        """No body moves more than _MAX_MOTION_PER_STEP of the smallest boundary sub-tet height in
-        one step, so that a contact cannot go from nothing to a deep overlap in one step."""
-        smallest = min(shape.min_subtet_height for shape in self.solver.shapes)
-        return self.max_speed() * time_step <= _MAX_MOTION_PER_STEP * smallest
-
-    def _check_runaway(self) -> None:
-        speeds = np.linalg.norm(self.solver.velocities, axis=1)
-        if speeds.max(initial=0.0) > _RUNAWAY_SPEED:
-            body = int(np.argmax(speeds))
-            raise InstabilityError(
-                f"body {body} moves at {speeds[body]:.3g} m/s at t = {self.solver.time:.6g} s, "
-                f"faster than any armour unit or rock should ({_RUNAWAY_SPEED:g} m/s)")
-
-    def _blow_up_advice(self, good: dict) -> str:
-        """What to change after a blow-up, judged from the last good state: the time step only
-        where it is the cause, not where gravity or a start velocity is absurd."""
-        s = self.solver
-        smallest = min(shape.min_subtet_height for shape in s.shapes)
-        gravity = float(np.linalg.norm(s.gravity))
-        speeds = np.linalg.norm(np.asarray(good["velocities"]), axis=1)
-        speed = float(speeds[~s.fixed].max(initial=0.0))
-        causes = []
-        if gravity > _ABSURD_GRAVITY:
-            causes.append(f"gravity is {gravity:.3g} m/s^2 (the earth's is 9.81): check "
-                          "[simulation] gravity")
-        if speed * s.time_step > _MAX_MOTION_PER_STEP * smallest:
-            causes.append(f"a body moved {speed * s.time_step:.3g} m per step at {speed:.3g} m/s, "
-                          f"more than a tenth of the thinnest boundary layer of tetrahedra "
-                          f"({smallest:.3g} m), so contacts start too deep: check the start "
-                          "velocities, or lower time_step")
-        if not causes:
-            what = ("set [simulation] time_step below the step used" if self.requested_time_step
-                    else "lower [simulation] time_step_safety (or set a smaller time_step)")
-            causes.append(f"the time step {s.time_step:.3e} s is too large for the contact "
-                          f"stiffness: {what}, or lower contact_penalty")
-        return ("Likely cause: " + "; ".join(causes) + ". After lowering the time step, restart "
-                "from the checkpoint with --restart: the new time step is used from there (any "
-                "other change to the case, such as contact_penalty or gravity, needs a new run).")
-
-    def at_rest(self) -> bool:
-        """Every free body slower than ``rest_speed`` and, under gravity, with a net force below
-        ``_REST_FORCE_RATIO`` of its weight (a body at the top of a bounce is slow but not at rest)."""
-        if self.max_speed() >= self.rest_speed:
-            return False
-        s = self.solver
-        if self.rest_kinetic_energy > 0 and s.kinetic_energy() >= self.rest_kinetic_energy:
-            return False
-        g = float(np.linalg.norm(s.gravity))
-        free = ~s.fixed
-        if g == 0.0 or not free.any():
-            return True
-        ratio = np.linalg.norm(s.forces[free], axis=1) / (s.masses[free] * g)
-        return bool(ratio.max() < _REST_FORCE_RATIO)
-
-    def stability_ratio(self) -> float:
-        """max over current contacts of dt / (2 sqrt(m_eff / k)), k the contact's measured stiffness
-        and m_eff the smaller of the translational and rotational effective masses of the pair."""
-        s = self.solver
-        c = s.contacts
-        if len(c) == 0:
-            return 0.0
-        shapes = s.shape_index
-        rotational = s.principal_inertia.min(axis=1) / s.bounding_radius[shapes] ** 2
-        inverse = np.where(s.fixed, 0.0, 1.0 / np.minimum(s.masses, rotational))
-        inverse_j = np.where(c.body_j >= 0, inverse[np.maximum(c.body_j, 0)], 0.0)
-        ratio = s.time_step * np.sqrt(c.stiffness * (inverse[c.body_i] + inverse_j)) / 2.0
-        worst = int(np.argmax(ratio))
-        j = int(c.body_j[worst])
-        self._stiffest_pair = f"body {int(c.body_i[worst])} and " + (f"wall {-1 - j}" if j < 0 else f"body {j}")
-        return float(ratio[worst])
-
-    def _check_contact_stability(self) -> None:
-        ratio = self.stability_ratio()
-        self._last_stability_ratio = ratio
-        self._max_stability_ratio = max(getattr(self, "_max_stability_ratio", 0.0), ratio)
-        if ratio > _MAX_STABILITY_RATIO:
-            raise InstabilityError(
-                f"time step {self.solver.time_step:.3e} s is too large for the contacts at t = "
-                f"{self.solver.time:.6g} s: dt / (2 sqrt(m/k)) = {ratio:.2f} > {_MAX_STABILITY_RATIO} "
-                f"at the contact of {self._stiffest_pair}; lower time_step or time_step_safety, or "
-                "contact_penalty")
-
-    def max_speed(self) -> float:
-        """Largest speed of a free body including rotation at its bounding radius (m/s)."""
-        s = self.solver
-        free = ~s.fixed
-        if not free.any():
-            return 0.0
-        radius = s.bounding_radius[s.shape_index]
-        speed = np.linalg.norm(s.velocities, axis=1) + np.linalg.norm(s.angular_velocities, axis=1) * radius
-        return float(speed[free].max())
-
+    # ------------------------------------------------------------------ outputs
     # ------------------------------------------------------------------ outputs
     def surface_arrays(self):
         """World boundary surfaces of all bodies: points (n, 3), triangles (m, 3), body of each
@@ -699,27 +417,6 @@ class Simulation:
 
         return solver_contact_statistics(self.solver)
 
-    def _write_frame(self, series, contact_series, time: float | None = None) -> None:
-        """One frame of the rigid bodies and their contacts, at ``time`` (default the rigid
-        solver's clock; a run that steps them inside another model gives its own)."""
-        s = self.solver
-        time = s.time if time is None else time
-        points, triangles, owners = self.surface_arrays()
-        omegas = s.angular_velocities
-        contact = self.contact_forces_on_bodies()
-        statistics = self.contact_statistics()
-        # ParaView colours inf badly; a huge finite number reads as "nothing pushes it sideways".
-        safety = np.minimum(statistics["factor_of_safety_sliding"], 1.0e30)
-        series.add(time, points=points, cells=triangles, cell_type="triangle",
-                   cell_data={"body_id": owners, "velocity": s.velocities[owners],
-                              "speed": np.linalg.norm(s.velocities, axis=1)[owners],
-                              "angular_velocity": omegas[owners],
-                              "contact_force": contact[owners],
-                              "fixed": s.fixed[owners].astype(np.int64),
-                              "coordination_number": statistics["coordination_number"][owners],
-                              "max_contact_force": statistics["max_contact_force"][owners],
-                              "factor_of_safety_sliding": safety[owners]})
-        contact_series.add_contacts(time, s.contacts)
 
     def write_picture(self, path, *, show_fixed: bool = False, planes=None, view=(25, -60),
                       title: str | None = None) -> Path:
@@ -730,23 +427,9 @@ class Simulation:
         fixed, all are drawn in colour. ``planes``: quadrilaterals (4, 3), m, drawn translucent
         (e.g. the slope face); ``view``: camera elevation and azimuth, degrees. The default title
         counts free and fixed bodies separately and says which are not drawn."""
-        from riprap.io.picture import bodies_to_draw, render_bodies_png
-
-        s = self.solver
-        points, triangles, owners = self.surface_arrays()
-        drawn, grey, description = bodies_to_draw(s.fixed, show_fixed=show_fixed)
-        shown = drawn[owners]
-        box = None
-        if self.container_box is not None:
-            # Show the container only up to a little above the bodies, not its full height.
-            lo, hi = (np.array(v, dtype=float) for v in self.container_box)
-            top = points[:, 2].max() if len(points) else hi[2]
-            hi[2] = min(hi[2], top + 0.15 * (top - lo[2]))
-            box = (tuple(lo), tuple(hi))
-        return render_bodies_png(path, triangles_world=points[triangles][shown], body_ids=owners[shown],
-                                 grey_bodies=np.flatnonzero(grey), planes=planes, view=view,
-                                 title=title or f"{description} at t = {s.time:.3f} s",
-                                 walls_box=box)
+        return rigid.write_bodies_picture(path, self.solver, container_box=self.container_box,
+                                          show_fixed=show_fixed, planes=planes, view=view,
+                                          title=title)
 
     # ------------------------------------------------------------------ checkpoints
     def _save_checkpoint(self, name: str, state: dict) -> Path:
@@ -908,3 +591,24 @@ class _Progress:
         if self._progress is not None:
             self._progress.__exit__(*exc)
         return False
+
+
+#: The summary of a fluid run is the summary of any run (the name fluid runs had before).
+FluidRunSummary = RunSummary
+
+
+class FluidRun(Simulation):
+    """``Simulation(fluid=solver, ...)`` under the name fluid runs had before the one run loop;
+    ``solver`` a :class:`riprap.fluid.solver.FluidSolver` or a
+    :class:`riprap.coupling.coupled.CoupledSolver`. The fluid is ``run.fluid`` and, for a coupled
+    run, the bodies' solver is ``run.solver`` (as in every Simulation)."""
+
+    def __init__(self, solver, *, end_time: float, output_interval: float = 0.05,
+                 checkpoint_interval: float = 0.0, output_directory="riprap-out",
+                 paraview: bool = True, picture: bool = True, progress: bool = True,
+                 case_file: str = ""):
+        super().__init__(end_time=end_time, output_interval=output_interval,
+                         checkpoint_interval=checkpoint_interval,
+                         output_directory=output_directory, paraview=paraview, picture=picture,
+                         progress=progress, fluid=solver)
+        self.case_file = case_file

@@ -11,18 +11,15 @@ import numpy as np
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.stresses import principal_stresses, von_mises
 from riprap.errors import InstabilityError, OverlapError, RiprapError
+from riprap.limits import PROGRESS_PERIOD
+from riprap.limits import START_OVERLAP_FRACTION as _START_OVERLAP_FRACTION
 from riprap.models.base import Model
 
 __all__ = ["DeformableModel", "UnitStressRecord"]
 
-# Wall-clock seconds between progress updates.
-_PROGRESS_PERIOD = 0.25
 #: The largest tensile stress of each body is looked for every this many steps (a fixed count, so
 #: that units.csv does not depend on the machine's speed): an impact's peak lasts hundreds of steps.
 RECORD_EVERY_STEPS = 50
-# Bodies may touch but not overlap at the start: a mean overlap above this fraction of the
-# smallest boundary sub-tet height is refused (the rigid bodies' rule).
-_START_OVERLAP_FRACTION = 0.01
 
 
 class UnitStressRecord:
@@ -45,9 +42,10 @@ class UnitStressRecord:
 
 
 class DeformableModel(Model):
-    """The deformable bodies of a :class:`riprap.simulation.Simulation`, joined in a
-    :class:`riprap.deformable.system.DeformableSystem`; with ``rigid`` (the simulation, when it
-    has rigid bodies too) its rigid solver is stepped with the same step, the rigid bodies' poses
+    """The deformable bodies of a scene, joined in a
+    :class:`riprap.deformable.system.DeformableSystem`; with ``rigid`` (a
+    :class:`riprap.models.rigid.RigidModel` of the scene's rigid bodies, when it has some) their
+    solver is stepped with the same step, the rigid bodies' poses
     placed in the system before every step and the contact forces on them handed back as
     external loads."""
 
@@ -96,14 +94,16 @@ class DeformableModel(Model):
     def prepare(self, *, restarted: bool) -> None:
         self.system.time_step       # chosen now, from the stiffest element and contact
         if self.rigid is not None:
-            self._place_rigid()
+            self.place_rigid()
             if not restarted:
                 self.rigid.check_start_overlaps()
         if not restarted:
             self.check_start_overlaps()
-        self._record_stresses()
+        self.record_stresses()
 
-    def _place_rigid(self, everything: bool = True) -> None:
+    def place_rigid(self, everything: bool = True) -> None:
+        """Put the rigid bodies' poses and velocities in the system (only the moving ones'
+        unless ``everything``)."""
         solver = self.rigid.solver
         self.system.set_rigid_poses(solver.rotation_matrices(), solver.positions,
                                     solver.velocities, solver.angular_velocities,
@@ -124,7 +124,7 @@ class DeformableModel(Model):
             solver.advance(n)
             return
         for _ in range(n):
-            self._place_rigid(everything=False)
+            self.place_rigid(everything=False)
             self.system.step(1)
             self._pass_rigid_loads()
             solver.advance(1)
@@ -217,12 +217,12 @@ class DeformableModel(Model):
             next_record = (system.step_count // RECORD_EVERY_STEPS + 1) * RECORD_EVERY_STEPS
             self._step(min(target, next_record) - system.step_count)
             if system.step_count % RECORD_EVERY_STEPS == 0:
-                self._record_stresses()
+                self.record_stresses()
         if system.step_count < target:
             raise RiprapError(f"the deformable bodies made {n - (target - system.step_count)} of "
                               f"{n} steps at t = {system.time:.6g} s and stopped; report it")
         elapsed = wallclock.perf_counter() - tick
-        self._chunk = max(1, min(1_000_000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
+        self._chunk = max(1, min(1_000_000, int(n * PROGRESS_PERIOD / max(elapsed, 1e-6))))
 
     def _check_finite(self) -> None:
         """Stop with the failure checkpoint once a node's position or velocity is not finite
@@ -237,7 +237,8 @@ class DeformableModel(Model):
                 f"(node {node - int(s.node_offsets[k])}, step {s.step_count}); the bodies moved "
                 "more than the step can carry: check the start velocities and the loads")
 
-    def _record_stresses(self) -> None:
+    def record_stresses(self) -> None:
+        """Look for each body's largest tensile stress now (and stop a non-finite state)."""
         self._check_finite()
         before = self.records.stress.max()
         all_sigma_1 = []
@@ -290,7 +291,7 @@ class DeformableModel(Model):
             solver.load_state_arrays(
                 {key[len("rigid_"):]: value for key, value in arrays.items() if key.startswith("rigid_")})
             solver._contacts = None
-            self._place_rigid()
+            self.place_rigid()
 
     def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
         arrays = dict(state)

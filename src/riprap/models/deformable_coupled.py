@@ -29,7 +29,7 @@ class DeformableCoupledModel(CoupledModel):
         # the largest tensile stresses are looked for every RECORD_EVERY_STEPS of the bodies'
         # steps, as in a dry run (an impact lasts a fraction of a fluid step), and at the end of
         # every fluid step
-        coupled.on_steps = stresses._record_stresses
+        coupled.on_steps = stresses.record_stresses
         coupled.steps_between_calls = RECORD_EVERY_STEPS
 
     @property
@@ -40,7 +40,7 @@ class DeformableCoupledModel(CoupledModel):
         # no stress record at the start: the bodies are put in the water unloaded, a state the
         # run never has once the water's pressure is on them (records follow every fluid step)
         if self.stresses.rigid is not None:
-            self.stresses._place_rigid()       # the rigid bodies' surfaces, where they start
+            self.stresses.place_rigid()       # the rigid bodies' surfaces, where they start
         if not restarted:
             self.stresses.check_start_overlaps()
 
@@ -48,7 +48,7 @@ class DeformableCoupledModel(CoupledModel):
         super().advance(until)
         self.deformable_steps += self.solver.last_substeps
         if self.system.step_count % RECORD_EVERY_STEPS:     # else on_steps has just looked
-            self.stresses._record_stresses()
+            self.stresses.record_stresses()
 
     # ------------------------------------------------------------------ state
     def state_arrays(self) -> dict:

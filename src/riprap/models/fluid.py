@@ -16,14 +16,13 @@ import math
 import numpy as np
 
 from riprap.errors import InstabilityError, RiprapError
+from riprap.limits import RUNAWAY_SPEED
 from riprap.models.base import Model
 
 __all__ = ["FluidModel", "CoupledModel", "step_towards"]
 
 # A remaining interval shorter than this fraction of the time is not worth a step of its own.
 _TIME_SLACK = 1e-9
-# A body faster than this (m/s) has blown up even if its numbers are still finite.
-_RUNAWAY_SPEED = 1.0e3
 
 
 def step_towards(stable: float, remaining: float) -> float:
@@ -248,7 +247,7 @@ class CoupledModel(FluidModel):
         outside = np.zeros(len(speeds), dtype=bool)
         outside[finite] = np.any((solids.positions[finite] < np.asarray(grid.lower))
                                  | (solids.positions[finite] > np.asarray(grid.upper)), axis=1)
-        bad = np.flatnonzero(~finite | (speeds > _RUNAWAY_SPEED) | outside)
+        bad = np.flatnonzero(~finite | (speeds > RUNAWAY_SPEED) | outside)
         if len(bad):
             body = int(bad[0])
             where = "no cell (its position is not finite)"
@@ -256,7 +255,7 @@ class CoupledModel(FluidModel):
                 cell = np.floor((solids.positions[body] - np.asarray(grid.lower)) / grid.cell_size)
                 where = f"cell {tuple(int(c) for c in cell)}"
             why = ("its centre has left the fluid box" if outside[body]
-                   else f"more than {_RUNAWAY_SPEED:g} m/s, or not finite")
+                   else f"more than {RUNAWAY_SPEED:g} m/s, or not finite")
             raise InstabilityError(f"body {body} moves at {speeds[body]:.3g} m/s in {where} at "
                                    f"t = {self.time:.6g} s ({why})")
 

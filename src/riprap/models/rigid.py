@@ -1,6 +1,8 @@
-"""Rigid bodies in contact (the solids of a :class:`riprap.simulation.Simulation`) as a model of
-the run loop: a fixed contact time step counted in steps (so that frame and checkpoint times fall
-on the same steps in a run and in its restart), or an adaptive one for settling runs."""
+"""Rigid bodies in contact (a :class:`riprap.solid.solver.SolidSolver` a scene built) as a model
+of the run loop: a fixed contact time step counted in steps (so that frame and checkpoint times
+fall on the same steps in a run and in its restart), or an adaptive one for settling runs. The
+model owns the rigid bodies' physics checks: the start overlaps, runaway bodies, the contacts'
+stability ratio, rest, and the advice after a blow-up."""
 from __future__ import annotations
 
 import math
@@ -8,11 +10,15 @@ import time as wallclock
 
 import numpy as np
 
-from riprap.errors import RiprapError
+from riprap.errors import InstabilityError, RiprapError
+from riprap.limits import PROGRESS_PERIOD, RUNAWAY_SPEED, START_OVERLAP_FRACTION
 from riprap.models.base import Model
+from riprap.models.settings import ModelSettings
 from riprap.solid.kernels import interactions
+from riprap.work_estimate import check_rigid_run
 
-__all__ = ["RigidModel"]
+__all__ = ["RigidModel", "at_rest", "body_setting_the_step", "build_bodies", "check_start_overlaps",
+           "max_speed", "prepare_bodies", "stability_ratio"]
 
 # Adaptive time step (``Simulation(adaptive_time_step=True)``): grow by _STEP_GROWTH while the
 # measured stability ratio stays below _GROW_BELOW_RATIO, cut by _STEP_CUT (from the last good
@@ -25,23 +31,179 @@ _MAX_STEP_OVER_ESTIMATE = 30.0
 _MIN_STEP_OVER_ESTIMATE = 1e-3
 # Time step decisions at fixed step counts, not wall-clock ones, so that a run is reproducible.
 _ADAPT_CHUNK_STEPS = 50
-# Wall-clock seconds between progress updates (and rest checks).
-_PROGRESS_PERIOD = 0.25
+# Largest allowed dt / (2 sqrt(m_eff / k)) over the contacts actually present (1 is the stability
+# limit of an undamped spring; rotation about the contact lowers the effective mass, hence margin).
+_MAX_STABILITY_RATIO = 0.5
+# A body rests when its net force is below this fraction of its weight (and it is slow).
+_REST_FORCE_RATIO = 0.1
+# No body should move more than this fraction of the thinnest boundary layer of tets in a step.
+_MAX_MOTION_PER_STEP = 0.1
+# Gravity above this (m/s^2) is named as the likely cause of a blow-up (a centrifuge model runs
+# at tens of g; more is a typo).
+_ABSURD_GRAVITY = 1000.0
+
+
+# ---------------------------------------------------------------------- building the bodies
+def build_bodies(solver, settings: ModelSettings) -> None:
+    """Build the solver's arrays, choose the time step and evaluate the initial forces, without
+    refusing overlaps (callers that resolve overlaps themselves use ``solver.overlaps``)."""
+    solver._build_arrays()
+    if settings.time_step > 0:
+        solver.time_step = settings.time_step
+    else:
+        solver.time_step = solver.stable_time_step(settings.time_step_safety)
+    solver.finalize()
+
+
+def prepare_bodies(solver, settings: ModelSettings, *, accepted_overlaps: dict,
+                   restarted: bool) -> None:
+    """Build the bodies (once), refuse absurd work, and refuse overlaps at the start of a new run
+    beyond ``accepted_overlaps`` (a restart's overlaps are its own)."""
+    if solver._ready:
+        return
+    build_bodies(solver, settings)
+    check_rigid_run(end_time=settings.end_time, time_step=solver.time_step,
+                    moving_bodies=int((~solver.fixed).sum()), start_time=solver.time,
+                    setting_the_step=lambda numbered=True: body_setting_the_step(
+                        solver, settings, numbered=numbered))
+    if not restarted:
+        check_start_overlaps(solver, accepted_overlaps)
+
+
+def body_setting_the_step(solver, settings: ModelSettings, numbered: bool = True) -> str:
+    """The body whose mass and contact stiffness chose the automatic time step, in words
+    (with its number when ``numbered``); "" for a step the user gave."""
+    if settings.time_step > 0:
+        return ""
+    steps = solver.critical_time_steps()
+    if not np.isfinite(steps).any():
+        return ""
+    body = int(np.argmin(steps))
+    shape = solver.shapes[int(solver.shape_index[body])]
+    return ((f"body {body}, " if numbered else "")
+            + f"shape '{shape.name}', Dn = {shape.volume ** (1 / 3):.3g} m, "
+            f"{solver.masses[body]:.3g} kg")
+
+
+def check_start_overlaps(solver, accepted_overlaps: dict) -> None:
+    """Refuse bodies that overlap at the start (beyond the accepted resting contacts of a
+    pack) or occupy the same place."""
+    smallest = min(shape.min_subtet_height for shape in solver.shapes)
+    solver.check_no_initial_overlap(START_OVERLAP_FRACTION * smallest, accepted=accepted_overlaps)
+
+
+# ---------------------------------------------------------------------- physics checks
+def max_speed(solver) -> float:
+    """Largest speed of a free body including rotation at its bounding radius (m/s)."""
+    free = ~solver.fixed
+    if not free.any():
+        return 0.0
+    radius = solver.bounding_radius[solver.shape_index]
+    speed = (np.linalg.norm(solver.velocities, axis=1)
+             + np.linalg.norm(solver.angular_velocities, axis=1) * radius)
+    return float(speed[free].max())
+
+
+def at_rest(solver, settings: ModelSettings) -> bool:
+    """Every free body slower than ``rest_speed`` and, under gravity, with a net force below
+    ``_REST_FORCE_RATIO`` of its weight (a body at the top of a bounce is slow but not at rest)."""
+    if max_speed(solver) >= settings.rest_speed:
+        return False
+    if settings.rest_kinetic_energy > 0 and solver.kinetic_energy() >= settings.rest_kinetic_energy:
+        return False
+    g = float(np.linalg.norm(solver.gravity))
+    free = ~solver.fixed
+    if g == 0.0 or not free.any():
+        return True
+    ratio = np.linalg.norm(solver.forces[free], axis=1) / (solver.masses[free] * g)
+    return bool(ratio.max() < _REST_FORCE_RATIO)
+
+
+def stability_ratio(solver) -> tuple[float, str]:
+    """(max over current contacts of dt / (2 sqrt(m_eff / k)), the pair where it is, in words);
+    k the contact's measured stiffness and m_eff the smaller of the translational and rotational
+    effective masses of the pair. (0, "") without contacts."""
+    c = solver.contacts
+    if len(c) == 0:
+        return 0.0, ""
+    shapes = solver.shape_index
+    rotational = solver.principal_inertia.min(axis=1) / solver.bounding_radius[shapes] ** 2
+    inverse = np.where(solver.fixed, 0.0, 1.0 / np.minimum(solver.masses, rotational))
+    inverse_j = np.where(c.body_j >= 0, inverse[np.maximum(c.body_j, 0)], 0.0)
+    ratio = solver.time_step * np.sqrt(c.stiffness * (inverse[c.body_i] + inverse_j)) / 2.0
+    worst = int(np.argmax(ratio))
+    j = int(c.body_j[worst])
+    pair = f"body {int(c.body_i[worst])} and " + (f"wall {-1 - j}" if j < 0 else f"body {j}")
+    return float(ratio[worst]), pair
+
+
+def check_runaway(solver) -> None:
+    """A body faster than RUNAWAY_SPEED stops the run, named."""
+    speeds = np.linalg.norm(solver.velocities, axis=1)
+    if speeds.max(initial=0.0) > RUNAWAY_SPEED:
+        body = int(np.argmax(speeds))
+        raise InstabilityError(
+            f"body {body} moves at {speeds[body]:.3g} m/s at t = {solver.time:.6g} s, "
+            f"faster than any armour unit or rock should ({RUNAWAY_SPEED:g} m/s)")
+
+
+def step_keeps_motion_small(solver, time_step: float) -> bool:
+    """No body moves more than _MAX_MOTION_PER_STEP of the smallest boundary sub-tet height in
+    one step, so that a contact cannot go from nothing to a deep overlap in one step."""
+    smallest = min(shape.min_subtet_height for shape in solver.shapes)
+    return max_speed(solver) * time_step <= _MAX_MOTION_PER_STEP * smallest
+
+
+def blow_up_advice(solver, settings: ModelSettings, good: dict) -> str:
+    """What to change after a blow-up, judged from the last good state: the time step only
+    where it is the cause, not where gravity or a start velocity is absurd."""
+    s = solver
+    smallest = min(shape.min_subtet_height for shape in s.shapes)
+    gravity = float(np.linalg.norm(s.gravity))
+    speeds = np.linalg.norm(np.asarray(good["velocities"]), axis=1)
+    speed = float(speeds[~s.fixed].max(initial=0.0))
+    causes = []
+    if gravity > _ABSURD_GRAVITY:
+        causes.append(f"gravity is {gravity:.3g} m/s^2 (the earth's is 9.81): check "
+                      "[simulation] gravity")
+    if speed * s.time_step > _MAX_MOTION_PER_STEP * smallest:
+        causes.append(f"a body moved {speed * s.time_step:.3g} m per step at {speed:.3g} m/s, "
+                      f"more than a tenth of the thinnest boundary layer of tetrahedra "
+                      f"({smallest:.3g} m), so contacts start too deep: check the start "
+                      "velocities, or lower time_step")
+    if not causes:
+        what = ("set [simulation] time_step below the step used" if settings.time_step
+                else "lower [simulation] time_step_safety (or set a smaller time_step)")
+        causes.append(f"the time step {s.time_step:.3e} s is too large for the contact "
+                      f"stiffness: {what}, or lower contact_penalty")
+    return ("Likely cause: " + "; ".join(causes) + ". After lowering the time step, restart "
+            "from the checkpoint with --restart: the new time step is used from there (any "
+            "other change to the case, such as contact_penalty or gravity, needs a new run).")
 
 
 class RigidModel(Model):
-    """The bodies of ``simulation`` (its :class:`riprap.solid.solver.SolidSolver`)."""
+    """The bodies of a :class:`riprap.solid.solver.SolidSolver`, with the meshes and names of its
+    shapes (checkpoints carry them, a restart compares them), the run's ``settings``, the resting
+    contacts accepted at the start (``accepted_overlaps``: (i, j) -> depth, m) and the box the
+    final picture shows (``container_box``). It reads nothing of the run loop."""
 
     kind = "riprap rigid run"
     name = "rigid"
 
-    def __init__(self, simulation):
-        self.simulation = simulation
-        self.solver = simulation.solver
+    def __init__(self, solver, *, meshes, shape_names, settings: ModelSettings,
+                 accepted_overlaps=None, container_box=None):
+        self.solver = solver
+        self.meshes = list(meshes)
+        self.shape_names = list(shape_names)
+        self.settings = settings
+        self.accepted_overlaps = dict(accepted_overlaps or {})
+        self.container_box = container_box
         self._chunk = 10
         self._estimate = 0.0
         self.smallest_step = self.largest_step = 0.0
         self.cuts = 0
+        self.last_stability_ratio = 0.0
+        self.max_stability_ratio = 0.0
         self._series = self._contact_series = None
         self._picture = False
         self._directory = None
@@ -69,25 +231,41 @@ class RigidModel(Model):
         return self.solver.time_step
 
     def prepare(self, *, restarted: bool) -> None:
-        self.simulation._prepare_bodies()
+        prepare_bodies(self.solver, self.settings, accepted_overlaps=self.accepted_overlaps,
+                       restarted=restarted)
         self._estimate = self.smallest_step = self.largest_step = self.solver.time_step
+
+    def check_start_overlaps(self) -> None:
+        """Refuse bodies that overlap at the start beyond the accepted resting contacts."""
+        check_start_overlaps(self.solver, self.accepted_overlaps)
 
     def advance(self, until: float) -> None:
         solver = self.solver
         n = min(self._steps_at(until) - solver.step_count, self._chunk)
         tick = wallclock.perf_counter()
         solver.advance(n)
-        self.simulation._check_runaway()
-        self.simulation._check_contact_stability()
+        check_runaway(solver)
+        self._check_contact_stability()
         elapsed = wallclock.perf_counter() - tick
-        if self.simulation.adaptive_time_step:
+        if self.settings.adaptive_time_step:
             self._chunk = _ADAPT_CHUNK_STEPS
         else:
-            self._chunk = max(1, min(100000, int(n * _PROGRESS_PERIOD / max(elapsed, 1e-6))))
+            self._chunk = max(1, min(100000, int(n * PROGRESS_PERIOD / max(elapsed, 1e-6))))
+
+    def _check_contact_stability(self) -> None:
+        ratio, pair = stability_ratio(self.solver)
+        self.last_stability_ratio = ratio
+        self.max_stability_ratio = max(self.max_stability_ratio, ratio)
+        if ratio > _MAX_STABILITY_RATIO:
+            raise InstabilityError(
+                f"time step {self.solver.time_step:.3e} s is too large for the contacts at t = "
+                f"{self.solver.time:.6g} s: dt / (2 sqrt(m/k)) = {ratio:.2f} > {_MAX_STABILITY_RATIO} "
+                f"at the contact of {pair}; lower time_step or time_step_safety, or "
+                "contact_penalty")
 
     def recover(self, good: dict) -> bool:
         solver = self.solver
-        if not (self.simulation.adaptive_time_step
+        if not (self.settings.adaptive_time_step
                 and solver.time_step * _STEP_CUT >= _MIN_STEP_OVER_ESTIMATE * self._estimate):
             return False
         cut = solver.time_step * _STEP_CUT
@@ -98,16 +276,16 @@ class RigidModel(Model):
         return True
 
     def after_good_chunk(self) -> None:
-        sim, solver = self.simulation, self.solver
+        solver = self.solver
         grown = solver.time_step * _STEP_GROWTH
-        if (sim.adaptive_time_step and sim._last_stability_ratio < _GROW_BELOW_RATIO
+        if (self.settings.adaptive_time_step and self.last_stability_ratio < _GROW_BELOW_RATIO
                 and grown <= _MAX_STEP_OVER_ESTIMATE * self._estimate
-                and sim._step_keeps_motion_small(grown)):
+                and step_keeps_motion_small(solver, grown)):
             solver.set_time_step(grown)
             self.largest_step = max(self.largest_step, solver.time_step)
 
     def at_rest(self) -> bool:
-        return self.simulation.rest_speed > 0 and self.simulation.at_rest()
+        return self.settings.rest_speed > 0 and at_rest(self.solver, self.settings)
 
     # ------------------------------------------------------------------ state
     def state_arrays(self) -> dict:
@@ -122,10 +300,10 @@ class RigidModel(Model):
         arrays["shape_index"] = s.shape_index
         arrays["material_index"] = s.material_index_of_body
         arrays["fixed"] = s.fixed
-        for k, mesh in enumerate(self.simulation._meshes):
+        for k, mesh in enumerate(self.meshes):
             arrays[f"shape_{k}_nodes"] = mesh.nodes
             arrays[f"shape_{k}_tets"] = mesh.tets
-        return arrays, {"n_bodies": int(s.n_bodies), "shapes": list(self.simulation._shape_names)}
+        return arrays, {"n_bodies": int(s.n_bodies), "shapes": list(self.shape_names)}
 
     def check_checkpoint(self, path, arrays: dict, metadata: dict) -> None:
         s = self.solver
@@ -133,11 +311,11 @@ class RigidModel(Model):
         problems = []
         if metadata.get("n_bodies") != s.n_bodies:
             problems.append(f"it has {metadata.get('n_bodies')} bodies, the case {s.n_bodies}")
-        names = list(self.simulation._shape_names)
+        names = list(self.shape_names)
         if metadata.get("shapes") != names:
             problems.append(f"its shapes {metadata.get('shapes')} differ from the case's {names}")
         else:
-            for k, mesh in enumerate(self.simulation._meshes):
+            for k, mesh in enumerate(self.meshes):
                 if not (np.array_equal(arrays[f"shape_{k}_nodes"], mesh.nodes)
                         and np.array_equal(arrays[f"shape_{k}_tets"], mesh.tets)):
                     problems.append(f"shape '{names[k]}' was meshed differently")
@@ -146,15 +324,15 @@ class RigidModel(Model):
                               + "; ".join(problems))
 
     def restore(self, arrays: dict) -> None:
-        sim, s = self.simulation, self.solver
+        settings, s = self.settings, self.solver
         s.time_step = float(arrays["clock"][2])
         s._ready = True
         s.load_state_arrays(arrays)
-        if not sim.adaptive_time_step:
+        if not settings.adaptive_time_step:
             # The case's time step wins over the checkpoint's (the same case gives the same step, so
             # a restart stays bit for bit): after a blow-up a smaller step is the usual fix.
-            step = (sim.requested_time_step if sim.requested_time_step > 0
-                    else s.stable_time_step(sim.time_step_safety))
+            step = (settings.time_step if settings.time_step > 0
+                    else s.stable_time_step(settings.time_step_safety))
             if step != s.time_step:
                 s.set_time_step(step)
         s._last = (np.zeros((0, interactions.C_SIZE)), np.zeros((0, 2), np.int64),
@@ -173,7 +351,32 @@ class RigidModel(Model):
 
     def write_frame(self, frame_index: int) -> None:
         if self._series is not None:
-            self.simulation._write_frame(self._series, self._contact_series)
+            self._write_frame(self._series, self._contact_series)
+
+    def _write_frame(self, series, contact_series, time: float | None = None) -> None:
+        """One frame of the rigid bodies and their contacts, at ``time`` (default the rigid
+        solver's clock; a run that steps them inside another model gives its own)."""
+        from riprap.analysis.unit_contacts import solver_contact_statistics
+        from riprap.solid.surfaces import surface_arrays
+
+        s = self.solver
+        time = s.time if time is None else time
+        points, triangles, owners = surface_arrays(s)
+        omegas = s.angular_velocities
+        contact = s.contact_forces()
+        statistics = solver_contact_statistics(s)
+        # ParaView colours inf badly; a huge finite number reads as "nothing pushes it sideways".
+        safety = np.minimum(statistics["factor_of_safety_sliding"], 1.0e30)
+        series.add(time, points=points, cells=triangles, cell_type="triangle",
+                   cell_data={"body_id": owners, "velocity": s.velocities[owners],
+                              "speed": np.linalg.norm(s.velocities, axis=1)[owners],
+                              "angular_velocity": omegas[owners],
+                              "contact_force": contact[owners],
+                              "fixed": s.fixed[owners].astype(np.int64),
+                              "coordination_number": statistics["coordination_number"][owners],
+                              "max_contact_force": statistics["max_contact_force"][owners],
+                              "factor_of_safety_sliding": safety[owners]})
+        contact_series.add_contacts(time, s.contacts)
 
     def close_outputs(self) -> dict:
         outputs = {}
@@ -181,7 +384,9 @@ class RigidModel(Model):
             outputs["paraview"] = str(self._series.pvd_path)
             outputs["contacts"] = str(self._contact_series.pvd_path)
         if self._picture:
-            outputs["picture"] = str(self.simulation.write_picture(self._directory / "final_state.png"))
+            outputs["picture"] = str(write_bodies_picture(self._directory / "final_state.png",
+                                                          self.solver,
+                                                          container_box=self.container_box))
         return outputs
 
     def progress_text(self) -> str:
@@ -189,15 +394,40 @@ class RigidModel(Model):
                 f"dt {self.solver.time_step:.2e} s")
 
     def summary_fields(self, wall_time: float, steps: int) -> dict:
-        s, sim = self.solver, self.simulation
+        s = self.solver
         return {"time_step": s.time_step,
                 "body_steps_per_second": steps * s.n_bodies / max(wall_time, 1e-9),
                 "bodies": s.n_bodies, "contacts": len(s.contacts),
-                "kinetic_energy": s.kinetic_energy(), "max_speed": sim.max_speed(),
-                "stability_ratio_max": getattr(sim, "_max_stability_ratio", 0.0),
+                "kinetic_energy": s.kinetic_energy(), "max_speed": max_speed(s),
+                "stability_ratio_max": self.max_stability_ratio,
                 "time_step_min": self.smallest_step, "time_step_max": self.largest_step,
                 "time_step_cuts": self.cuts}
 
     def failure_advice(self, good: dict) -> str:
-        return self.simulation._blow_up_advice(good)
+        return blow_up_advice(self.solver, self.settings, good)
+
+
+def write_bodies_picture(path, solver, *, container_box=None, show_fixed: bool = False,
+                         planes=None, view=(25, -60), title: str | None = None):
+    """Shaded PNG of the bodies now (:func:`riprap.io.picture.render_bodies_png`); the arguments
+    are those of :meth:`riprap.simulation.Simulation.write_picture`, ``container_box`` the walls'
+    box ((lower), (upper)) or None."""
+    from riprap.io.picture import bodies_to_draw, render_bodies_png
+    from riprap.solid.surfaces import surface_arrays
+
+    s = solver
+    points, triangles, owners = surface_arrays(s)
+    drawn, grey, description = bodies_to_draw(s.fixed, show_fixed=show_fixed)
+    shown = drawn[owners]
+    box = None
+    if container_box is not None:
+        # Show the container only up to a little above the bodies, not its full height.
+        lo, hi = (np.array(v, dtype=float) for v in container_box)
+        top = points[:, 2].max() if len(points) else hi[2]
+        hi[2] = min(hi[2], top + 0.15 * (top - lo[2]))
+        box = (tuple(lo), tuple(hi))
+    return render_bodies_png(path, triangles_world=points[triangles][shown], body_ids=owners[shown],
+                             grey_bodies=np.flatnonzero(grey), planes=planes, view=view,
+                             title=title or f"{description} at t = {s.time:.3f} s",
+                             walls_box=box)
 

@@ -25,6 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from riprap.case.schema import MAXIMUM_BODY_COUNT, default_of
 from riprap.errors import CaseFileError, OverlapError
+from riprap.limits import START_OVERLAP_FRACTION as _START_OVERLAP_FRACTION
 from riprap.placement import layer_metrics
 from riprap.placement.lowering import Surface, VerticalLowering
 from riprap.simulation import Simulation
@@ -39,8 +40,6 @@ _MAX_LIFTS = 40
 # Generated units reaching through a side wall are moved inside, this fraction of their width
 # clear of it.
 _SIDE_WALL_GAP = 0.01
-# Overlap tolerance at the start, as a fraction of the smallest boundary sub-tet height.
-_START_OVERLAP_FRACTION = 0.01
 # Units lowered onto the layer are released this fraction of D_n above what they touch.
 _RELEASE_GAP = 0.002
 
