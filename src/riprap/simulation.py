@@ -220,8 +220,6 @@ class Simulation:
     deformable_mass_damping = _OfScene()
     deformable_case_index = _OfScene()
     deformable_accepted_depths = _OfScene()
-    #: The former name of ``shape_names`` (read by riprap.case.build_placement).
-    _shape_names = _OfScene("shape_names")
 
     add_material = _of_scene(Scene.add_material)
     add_shape = _of_scene(Scene.add_shape)

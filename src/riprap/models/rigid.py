@@ -356,7 +356,7 @@ class RigidModel(Model):
     def _write_frame(self, series, contact_series, time: float | None = None) -> None:
         """One frame of the rigid bodies and their contacts, at ``time`` (default the rigid
         solver's clock; a run that steps them inside another model gives its own)."""
-        from riprap.analysis.unit_contacts import solver_contact_statistics
+        from riprap.solid.contact_statistics import solver_contact_statistics
         from riprap.solid.surfaces import surface_arrays
 
         s = self.solver

@@ -275,7 +275,7 @@ def _listed(numbers, most: int = 10) -> str:
 def _layer_description(unit, slope, underlayer, result, design_positions):
     """What ``riprap analyse`` needs to know of the layer (written as ``layer.json``)."""
     sim = result.simulation
-    unit_shape = sim.solver.shapes[sim._shape_names[UNIT_SHAPE_NAME]]
+    unit_shape = sim.solver.shapes[sim.shape_names[UNIT_SHAPE_NAME]]
     return LayerDescription.for_unit(unit, unit_shape, slope=slope,
                                      underlayer_top=underlayer.top_level,
                                      unit_bodies=result.unit_bodies, rows=result.rows,
