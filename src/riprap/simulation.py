@@ -276,7 +276,7 @@ class Simulation:
         a pack) or occupy the same place."""
         rigid.check_start_overlaps(self.solver, self.accepted_overlaps)
 
-    def _body_setting_the_step(self, numbered: bool = True) -> str:
+    def body_setting_the_step(self, numbered: bool = True) -> str:
         """:func:`riprap.models.rigid.body_setting_the_step` (read by riprap.placement.place)."""
         return rigid.body_setting_the_step(self.solver, self.settings, numbered=numbered)
 

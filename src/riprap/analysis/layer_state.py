@@ -217,7 +217,7 @@ def state_from_simulation(sim, layer: LayerDescription, *, source: str = "simula
     solver = sim.solver
     meshes = [shape.mesh for shape in solver.shapes]
     names = [None] * len(meshes)
-    for name, index in sim._shape_names.items():
+    for name, index in sim.shape_names.items():
         names[index] = name
     walls = solver.walls
     material_index = {m.name: k for k, m in enumerate(solver.materials)}

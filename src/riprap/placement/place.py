@@ -194,7 +194,7 @@ def free_body_time_step(shapes, materials: PlacementMaterials, material: str,
         sim.add_body(shape=shape.name, material=material,
                      position=(0.0, 0.0, 10.0 * k * (1.0 + shape.bounding_radius)))
     sim.build_without_checks()
-    return sim.solver.time_step, lambda: sim._body_setting_the_step(numbered=False)
+    return sim.solver.time_step, lambda: sim.body_setting_the_step(numbered=False)
 
 
 def _stick_to_face(sim: Simulation) -> bool:

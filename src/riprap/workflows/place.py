@@ -285,7 +285,7 @@ def _layer_description(unit, slope, underlayer, result, design_positions):
 def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
     sim = result.simulation
     solver = sim.solver
-    names = {index: name for name, index in sim._shape_names.items()}
+    names = {index: name for name, index in sim.shape_names.items()}
     shapes = {names[k]: shape.mesh for k, shape in enumerate(solver.shapes)}
     material_names = [m.name for m in solver.materials]
     omegas = solver.angular_velocities
