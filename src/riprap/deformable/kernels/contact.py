@@ -28,6 +28,7 @@ from numba import prange
 
 from riprap._jit import inline_kernel, kernel, leaf_kernel, parallel_kernel
 from riprap.solid.kernels.contact import plane_section
+from riprap.solid.kernels.pair_rule import pair_friction
 
 MAX_VERTICES = 16
 N_COLUMNS = 10
@@ -366,7 +367,7 @@ def pair_forces(positions, triangles, tets, pairs, penalty, forces, velocities, 
         tri = pairs[q, 0]
         w, a = triangle_in_tet(positions, triangles, tri, tets, t, lam_map, penalty, forces,
                                polygon, work, signed, integrals, piece, node_force, velocities,
-                               masses, min(triangle_friction[tri], tet_friction[t]),
+                               masses, pair_friction(triangle_friction[tri], tet_friction[t]),
                                min(triangle_damping[tri], tet_damping[t]), tet_stiffness[t],
                                time_step, springs, q)
         if w == 0.0:
@@ -461,7 +462,7 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
             forces[node, 2] -= f * nz
             pushed += f * norm * cosine
         total += pushed
-        mu = min(triangle_friction[tri], wall_friction)
+        mu = pair_friction(triangle_friction[tri], wall_friction)
         if (mu > 0.0 or triangle_damping[tri] > 0.0) and pushed > 0.0:
             slide_on_wall(triangles, tri, 3, node_force, pushed, wall_normal, velocities, masses,
                           mu, tangential_ratio * penalty * piece_area / wall_depths[tri],
@@ -506,7 +507,7 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
             pushed += node_force[k]
         total += pushed
         area += 0.5 * section_area
-        mu = min(tet_friction[t], wall_friction)
+        mu = pair_friction(tet_friction[t], wall_friction)
         if (mu > 0.0 or tet_damping[t] > 0.0) and pushed > 0.0:
             slide_on_wall(tets, t, 4, node_force, pushed, wall_normal, velocities, masses, mu,
                           tet_stiffness[t] * section_area, tet_damping[t], time_step,
