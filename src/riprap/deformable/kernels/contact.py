@@ -342,15 +342,21 @@ def make_scratch():
 
 
 @kernel
-def pair_forces(positions, triangles, tets, pairs, penalty, forces, velocities, masses,
-                triangle_friction, tet_friction, triangle_damping, tet_damping, tet_stiffness,
-                time_step, springs):
+def pair_forces(positions, triangles, tets, pairs, forces, velocities, masses, laws, time_step,
+                springs):
     """Forces of every candidate (boundary triangle, tet) pair, (n, 2) indices into ``triangles``
-    and ``tets``; the friction coefficient of a pair is the smaller of its triangle's and its
-    tet's, likewise its normal damping ratio; its tangential stiffness ``tet_stiffness[tet]`` (N/m
-    per m^2 of contact) times its
-    contact area, its spring ``springs[pair]`` (zeroed while the pair does not touch). Returns
-    (total p int phi dS, contact area)."""
+    and ``tets``, under ``laws`` (:class:`~riprap.deformable.kernels.bundles.SurfaceLaws`); the
+    friction coefficient of a pair is the smaller of its triangle's and its tet's
+    (``solid/kernels/pair_rule.py``), likewise its normal damping ratio; its tangential stiffness
+    ``tet_stiffness[tet]`` (N/m per m^2 of contact) times its contact area, its spring
+    ``springs[pair]`` (zeroed while the pair does not touch). Returns (total p int phi dS, contact
+    area)."""
+    penalty = laws.penalty
+    triangle_friction = laws.triangle_friction
+    tet_friction = laws.tet_friction
+    triangle_damping = laws.triangle_damping
+    tet_damping = laws.tet_damping
+    tet_stiffness = laws.tet_stiffness
     polygon, work, signed, integrals, piece, node_force = make_scratch()
     lam_map = np.empty((4, 4))
     weight = 0.0
@@ -383,9 +389,8 @@ PAIR_CHUNKS = 4
 
 
 @parallel_kernel
-def pair_forces_parallel(positions, triangles, tets, pairs, penalty, forces, velocities, masses,
-                         triangle_friction, tet_friction, triangle_damping, tet_damping,
-                         tet_stiffness, time_step, springs):
+def pair_forces_parallel(positions, triangles, tets, pairs, forces, velocities, masses, laws,
+                         time_step, springs):
     """:func:`pair_forces` on ``PAIR_CHUNKS`` runs of the pairs at once, each into a force buffer
     of its own (a node may sit in pairs of several runs), summed in a fixed order."""
     n_pairs = pairs.shape[0]
@@ -395,10 +400,9 @@ def pair_forces_parallel(positions, triangles, tets, pairs, penalty, forces, vel
     for c in prange(PAIR_CHUNKS):
         first = c * n_pairs // PAIR_CHUNKS
         last = (c + 1) * n_pairs // PAIR_CHUNKS
-        weights[c], areas[c] = pair_forces(positions, triangles, tets, pairs[first:last], penalty,
-                                           buffers[c], velocities, masses, triangle_friction,
-                                           tet_friction, triangle_damping, tet_damping,
-                                           tet_stiffness, time_step, springs[first:last])
+        weights[c], areas[c] = pair_forces(positions, triangles, tets, pairs[first:last],
+                                           buffers[c], velocities, masses, laws, time_step,
+                                           springs[first:last])
     for n in prange(positions.shape[0]):
         for i in range(3):
             total = forces[n, i]
@@ -409,16 +413,26 @@ def pair_forces_parallel(positions, triangles, tets, pairs, penalty, forces, vel
 
 
 @kernel
-def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wall_depths,
-                forces, velocities, masses, triangle_friction, tet_friction, wall_friction,
-                triangle_damping, tet_damping, tangential_ratio, tet_stiffness, time_step,
-                triangle_springs, tet_springs):
-    """Forces of one half-space wall on boundary ``triangles`` and ``tets`` (only those near the
-    surface need be listed), added to ``forces``; ``wall_depths[tri]`` is the depth over which the
-    wall's potential rises for that triangle's body; friction as for body pairs, with the
-    coefficients given per triangle and per tet (the smaller of that and ``wall_friction`` acts),
-    tangential springs per triangle and per tet of ``tangential_ratio`` p A / h_w and
-    ``tet_stiffness`` A. Returns (normal force, contact area)."""
+def wall_forces(positions, triangles, tets, wall, wall_depths, forces, velocities, masses, laws,
+                time_step, triangle_springs, tet_springs):
+    """Forces of one half-space ``wall`` (7,: point, outward normal, friction coefficient) on
+    boundary ``triangles`` and ``tets`` (only those near the surface need be listed), added to
+    ``forces``; ``wall_depths[tri]`` is the depth over which the wall's potential rises for that
+    triangle's body; friction as for body pairs under ``laws``
+    (:class:`~riprap.deformable.kernels.bundles.SurfaceLaws`), with the coefficients given per
+    triangle and per tet (the pair rule of that and the wall's acts), tangential springs per
+    triangle and per tet of ``tangential_ratio`` p A / h_w and ``tet_stiffness`` A. Returns
+    (normal force, contact area)."""
+    wall_point = wall[0:3]
+    wall_normal = wall[3:6]
+    wall_friction = wall[6]
+    penalty = laws.penalty
+    tangential_ratio = laws.tangential_ratio
+    triangle_friction = laws.triangle_friction
+    tet_friction = laws.tet_friction
+    triangle_damping = laws.triangle_damping
+    tet_damping = laws.tet_damping
+    tet_stiffness = laws.tet_stiffness
     polygon, work, signed, integrals, piece, node_force = make_scratch()
     total = 0.0
     area = 0.0

@@ -21,6 +21,7 @@ import numpy as np
 from riprap._jit import inline_kernel, kernel, leaf_kernel, parallel_kernel, prange
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import joints as joint_kernels
+from riprap.deformable.kernels.bundles import SurfaceLaws
 from riprap.deformable.kernels.slots import joint_slot_sum, node_slot_sum, single_slots_of
 
 
@@ -212,13 +213,18 @@ FORCE_BLOCKS = 64
 @parallel_kernel
 def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, materials,
                           element_material, element_forces, jacobians, joint_data):
-    """:func:`tet4_element` for every element and the joints' forces (``joint_data`` as in
-    :func:`advance_steps`) in one parallel loop: both only read the positions, so one region
+    """:func:`tet4_element` for every element and the joints' forces (``joint_data``:
+    :class:`~riprap.deformable.kernels.bundles.JointData`) in one parallel loop: both only read the positions, so one region
     instead of two (each region costs the threads a wake-up)."""
-    (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer, joint_released, joint_anchors) = (
-        joint_data[0], joint_data[1], joint_data[2], joint_data[3], joint_data[4], joint_data[5],
-        joint_data[6], joint_data[8], joint_data[10])
+    joint_nodes = joint_data.nodes
+    joint_sizes = joint_data.sizes
+    joint_properties = joint_data.properties
+    joint_material = joint_data.material
+    joint_damage = joint_data.damage
+    joint_broken = joint_data.broken
+    joint_buffer = joint_data.buffer
+    joint_released = joint_data.released
+    joint_anchors = joint_data.anchors
     n_tets = tets.shape[0]
     n_joints = joint_nodes.shape[0]
     for block in prange(FORCE_BLOCKS):
@@ -511,35 +517,29 @@ PARALLEL_PAIRS = 2000
 
 
 @kernel
-def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradients, gradients,
-                  weights, materials, element_material, element_forces, jacobians, node_offsets,
-                  node_slots, masses, external_forces, contact_forces, gravity, mass_damping,
-                  constrained, prescribed_velocities, time_step, contact, joint_data):
-    """Up to ``n_steps`` central-difference steps without returning to Python.
+def advance_steps(n_steps, parallel, nodes, element_state, gravity, mass_damping, time_step,
+                  contact, joint_data):
+    """Up to ``n_steps`` central-difference steps of ``time_step`` without returning to Python.
 
-    ``contact`` = (the triangles and tets walls act on, all contact triangles and tets, wall depth
-    per triangle, candidate (triangle, tet) pairs, penalty, walls (n, 7: point, outward normal,
-    friction coefficient), positions when the pairs were listed, skin, totals (n_walls + 1): the
-    normal force of each wall and of the body pairs at the last step, friction coefficient per
-    triangle and per tet, tangential over normal contact stiffness, tangential stiffness per tet
-    and m^2 of contact, the tangential springs of the pairs, of the wall triangles and of the
-    wall tets, the normal damping ratio per triangle and per tet).
-    ``joint_data`` = the joints between tets of fracturing bodies (``riprap/deformable/kernels/joints.py``):
-    (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
-    the buffer of their forces (a row per joint vertex, and a last row kept zero:
-    ``kernels/joints.joint_forces``) and each element slot's rows in it (elements.size, 3: one
-    per face at the slot's corner), released (broken joints whose faces slid apart: no force
-    any more), their work done on the nodes so far (1,), by the trapezoidal rule, and the
-    friction anchors of their points (n, 3, 2)); no joints: none, and a buffer of no rows.
-    Their forces are added in the node update (not to ``contact_forces``), which also sums
-    their work.
+    ``nodes``: :class:`~riprap.deformable.kernels.bundles.NodeState` (advanced in place);
+    ``element_state``: ``ElementState``; ``gravity`` (3,) m/s^2 and ``mass_damping`` (1/s) act
+    on every node. ``contact``: ``ContactState`` (no contact: no triangles). ``joint_data``: the
+    joints between tets of fracturing bodies, ``JointData`` (no joints: none, and a buffer of no
+    rows). Their forces are added in the node update (not to ``contact_forces``), which also sums
+    their work. Runs on threads where ``parallel``.
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
     which ``element`` has J <= 0 (or a non-finite J); REBUILD_CONTACTS before a step once a node has
     moved half the skin since the pairs were listed."""
+    (positions, velocities, masses, external_forces, contact_forces, constrained,
+     prescribed_velocities, node_offsets, node_slots) = nodes
+    (elements, tet4_gradients, gradients, weights, materials, element_material, element_forces,
+     jacobians) = element_state
     (wall_triangles, wall_tets, triangles, contact_tets, wall_depths, pairs, penalty, walls,
      listed_positions, skin, totals, triangle_friction, tet_friction, tangential_ratio,
      tet_stiffness, pair_springs, wall_triangle_springs, wall_tet_springs, triangle_damping,
      tet_damping) = contact
+    laws = SurfaceLaws(penalty, tangential_ratio, triangle_friction, tet_friction,
+                       triangle_damping, tet_damping, tet_stiffness)
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
      joint_buffer, joint_slot_rows, joint_released, joint_work, joint_anchors) = joint_data
     has_joints = joint_nodes.shape[0] > 0
@@ -581,23 +581,17 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
             totals[:] = 0.0
             if pairs.shape[0] >= PARALLEL_PAIRS:
                 weight, _ = contact_kernels.pair_forces_parallel(
-                    positions, triangles, contact_tets, pairs, penalty, contact_forces, velocities,
-                    masses, triangle_friction, tet_friction, triangle_damping, tet_damping,
-                    tet_stiffness, time_step, pair_springs)
+                    positions, triangles, contact_tets, pairs, contact_forces, velocities, masses,
+                    laws, time_step, pair_springs)
             else:
                 weight, _ = contact_kernels.pair_forces(
-                    positions, triangles, contact_tets, pairs, penalty, contact_forces, velocities,
-                    masses, triangle_friction, tet_friction, triangle_damping, tet_damping,
-                    tet_stiffness, time_step, pair_springs)
+                    positions, triangles, contact_tets, pairs, contact_forces, velocities, masses,
+                    laws, time_step, pair_springs)
             totals[walls.shape[0]] = weight
             for w in range(walls.shape[0]):
                 force, _ = contact_kernels.wall_forces(positions, wall_triangles, wall_tets,
-                                                       walls[w, 0:3], walls[w, 3:6], penalty,
-                                                       wall_depths, contact_forces, velocities,
-                                                       masses, triangle_friction, tet_friction,
-                                                       walls[w, 6], triangle_damping, tet_damping,
-                                                       tangential_ratio,
-                                                       tet_stiffness, time_step,
+                                                       walls[w], wall_depths, contact_forces,
+                                                       velocities, masses, laws, time_step,
                                                        wall_triangle_springs[w],
                                                        wall_tet_springs[w])
                 totals[w] = force
