@@ -16,6 +16,8 @@ Constitutive codes (``riprap.deformable.material.CONSTITUTIVE_MODELS``): 0 the s
 """
 import math
 
+import types
+
 import numpy as np
 
 from riprap._jit import inline_kernel, kernel, leaf_kernel, parallel_kernel, prange
@@ -318,11 +320,23 @@ def update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses, extern
     return work, mx * mx + my * my + mz * mz
 
 
-@parallel_kernel
-def central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
-                              single_slots, masses, external_forces, contact_forces, gravity,
-                              mass_damping, constrained, prescribed_velocities, first_loaded,
-                              first_held, time_step, listed_positions):
+def _serial_twin(function, name):
+    """A copy of ``function`` under its own ``name``, to be compiled on one thread as the twin of
+    its parallel kernel: one body for both (``prange`` is ``range`` outside a parallel kernel).
+    The name keeps the two apart in numba's on-disk cache, which is keyed by a function's name and
+    its argument types, not by the compile options."""
+    twin = types.FunctionType(function.__code__, function.__globals__, name,
+                              function.__defaults__, function.__closure__)
+    twin.__qualname__ = name
+    twin.__module__ = function.__module__
+    twin.__doc__ = function.__doc__
+    return twin
+
+
+def _central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
+                               single_slots, masses, external_forces, contact_forces, gravity,
+                               mass_damping, constrained, prescribed_velocities, first_loaded,
+                               first_held, time_step, listed_positions):
     """Sum the element forces at every node, add loads, gravity and mass-proportional damping,
     and advance the half-step velocity and the position (central difference / leapfrog).
     Returns the largest squared distance of a node from ``listed_positions`` after it (pass
@@ -331,7 +345,13 @@ def central_difference_update(positions, velocities, element_forces, node_offset
     ``node_slots[node_offsets[n]:node_offsets[n + 1]]`` lists the flat (element, local node)
     entries of ``element_forces`` that act on node n; ``single_slots[n]`` names its one entry
     where it has only one, else -1 (``slots.single_slots_of``). Components flagged in
-    ``constrained`` take ``prescribed_velocities`` instead."""
+    ``constrained`` take ``prescribed_velocities`` instead.
+
+    17 arguments: the arrays of ``NodeState`` and the step's settings one by one, because this
+    body is also the parallel kernel's, whose threads take plain arrays.
+    ``central_difference_update_serial``: the same on one thread (small bodies: no thread
+    start-up), compiled without reference counts (``leaf_kernel``): numba took references to the
+    arrays read in ``update_node``'s branches, per node."""
     flat = element_forces.reshape((-1, 3))
     largest = 0.0
     for n in prange(positions.shape[0]):
@@ -344,36 +364,20 @@ def central_difference_update(positions, velocities, element_forces, node_offset
     return largest
 
 
-@leaf_kernel
-def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
-                                     node_slots, single_slots, masses, external_forces,
-                                     contact_forces, gravity, mass_damping, constrained,
-                                     prescribed_velocities, first_loaded, first_held, time_step,
-                                     listed_positions):
-    """:func:`central_difference_update` on one thread (small bodies: no thread start-up).
-    Compiled without reference counts (``leaf_kernel``): numba took references to the arrays
-    read in ``update_node``'s branches, per node."""
-    flat = element_forces.reshape((-1, 3))
-    largest = 0.0
-    for n in range(positions.shape[0]):
-        ex, ey, ez = node_slot_sum(n, flat, single_slots, node_offsets, node_slots)
-        _, moved = update_node(n, ex, ey, ez, 0.0, 0.0, 0.0, positions, velocities, masses,
-                               external_forces, contact_forces, gravity, mass_damping,
-                               constrained, prescribed_velocities, first_loaded, first_held,
-                               time_step, listed_positions)
-        largest = max(largest, moved)
-    return largest
+central_difference_update = parallel_kernel(_central_difference_update)
+central_difference_update_serial = leaf_kernel(
+    _serial_twin(_central_difference_update, "central_difference_update_serial"))
 
 
-@parallel_kernel
-def jointed_update(positions, velocities, element_forces, node_offsets, node_slots, single_slots,
-                   masses, external_forces, contact_forces, gravity, mass_damping, constrained,
-                   prescribed_velocities, first_loaded, first_held, time_step, joint_forces,
-                   joint_slot_rows, listed_positions):
+def _jointed_update(positions, velocities, element_forces, node_offsets, node_slots, single_slots,
+                    masses, external_forces, contact_forces, gravity, mass_damping, constrained,
+                    prescribed_velocities, first_loaded, first_held, time_step, joint_forces,
+                    joint_slot_rows, listed_positions):
     """:func:`central_difference_update` with the joints' forces added (``joint_forces``: a row
     per joint vertex, ``kernels/joints.joint_forces``; ``joint_slot_rows``: the rows of each
     element slot's three faces); returns also the joints' work over the step. (A loop of its
-    own: the bodies without joints read no joint rows.)"""
+    own: the bodies without joints read no joint rows.) ``jointed_update_serial``: the same on
+    one thread, without reference counts, as ``central_difference_update_serial``."""
     flat = element_forces.reshape((-1, 3))
     work = 0.0
     largest = 0.0
@@ -389,27 +393,8 @@ def jointed_update(positions, velocities, element_forces, node_offsets, node_slo
     return work, largest
 
 
-@leaf_kernel
-def jointed_update_serial(positions, velocities, element_forces, node_offsets, node_slots,
-                          single_slots, masses, external_forces, contact_forces, gravity,
-                          mass_damping, constrained, prescribed_velocities, first_loaded,
-                          first_held, time_step, joint_forces, joint_slot_rows,
-                          listed_positions):
-    """:func:`jointed_update` on one thread (without reference counts, as
-    :func:`central_difference_update_serial`)."""
-    flat = element_forces.reshape((-1, 3))
-    work = 0.0
-    largest = 0.0
-    for n in range(positions.shape[0]):
-        ex, ey, ez, jx, jy, jz = joint_slot_sum(n, flat, joint_forces, joint_slot_rows,
-                                                single_slots, node_offsets, node_slots)
-        node_work, moved = update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses,
-                                       external_forces, contact_forces, gravity, mass_damping,
-                                       constrained, prescribed_velocities, first_loaded,
-                                       first_held, time_step, listed_positions)
-        work += node_work
-        largest = max(largest, moved)
-    return work, largest
+jointed_update = parallel_kernel(_jointed_update)
+jointed_update_serial = leaf_kernel(_serial_twin(_jointed_update, "jointed_update_serial"))
 
 
 @parallel_kernel
