@@ -261,7 +261,10 @@ def own_momentum_rhs(entry_start, entry_face, entry_half, face_axis, face_index,
     Summed over the bodies of a face this is the momentum_systems right-hand side (w u - C): for a
     face of one body it is the same; where two bodies share a face, neither takes the other's
     motion (a unit sliding on the slope is not dragged by the slope's share of the face).
-    ``rhs`` (bodies, 6); only bodies with ``chosen[b]``, the others left 0."""
+    ``rhs`` (bodies, 6); only bodies with ``chosen[b]``, the others left 0.
+
+    16 arguments: as :func:`momentum_systems`; not yet bundled.
+    """
     volume = h * h * h
     for b in prange(entry_start.shape[0] - 1):
         jac = np.empty(6)
@@ -315,6 +318,9 @@ def momentum_systems(entry_start, entry_face, entry_half, face_axis, face_index,
     phi_b' rho_b), whose product with a motion is the body's momentum on the grid. Each body's sums
     are its own (threads over bodies), in the order of its entries. Only bodies with ``chosen[b]``
     are summed; the others are left 0.
+
+    18 arguments: the faces' entry lists of the bodies (six arrays), the fluid's fields and the
+    outputs; not yet bundled.
     """
     volume = h * h * h
     n_rhs = velocities.shape[0]

@@ -178,7 +178,11 @@ def triangle_in_tet(positions, triangles, tri, tets, t, lam_map, penalty, forces
     tet's nodes; the pair's tangential spring is ``springs[q]``. ``polygon`` .. ``node_force`` are
     scratch arrays (``make_scratch``). Returns (force on the triangle's body along its...
     magnitude p int phi dS, contact area). (Rows are passed by index, never as slices: each
-    slice cost an atomic reference count each way, most of a pair's time.)"""
+    slice cost an atomic reference count each way, most of a pair's time.)
+
+    22 arguments: a leaf kernel called per (triangle, tet) piece with the scratch arrays one by one
+    (see above); a bundle would add nothing the compiled code needs.
+    """
     # quick rejection: all three corners outside the same face of the tet
     for k in range(4):
         outside = 0
@@ -292,7 +296,11 @@ def apply_friction(triangles, tri, tets, t, node_force, weight, nx, ny, nz, velo
     two sides at the force's centre (``springs[q]``) (:func:`spring_friction`), and a dashpot on their normal
     relative speed with ``damping_ratio`` of the contact's normal stiffness (taken as the tangential
     one over 2/7) and their lumped masses, clipped so that the contact never pulls; spread with the
-    same weights, equal and opposite."""
+    same weights, equal and opposite.
+
+    18 arguments: a leaf kernel per contact piece; the normal (three scalars) and the piece's
+    indices change every call.
+    """
     rx = ry = rz = 0.0
     side_a = side_b = 0.0
     for v in range(3):
@@ -351,12 +359,7 @@ def pair_forces(positions, triangles, tets, pairs, forces, velocities, masses, l
     ``tet_stiffness[tet]`` (N/m per m^2 of contact) times its contact area, its spring
     ``springs[pair]`` (zeroed while the pair does not touch). Returns (total p int phi dS, contact
     area)."""
-    penalty = laws.penalty
-    triangle_friction = laws.triangle_friction
-    tet_friction = laws.tet_friction
-    triangle_damping = laws.triangle_damping
-    tet_damping = laws.tet_damping
-    tet_stiffness = laws.tet_stiffness
+    penalty, _, triangle_friction, tet_friction, triangle_damping, tet_damping, tet_stiffness = laws
     polygon, work, signed, integrals, piece, node_force = make_scratch()
     lam_map = np.empty((4, 4))
     weight = 0.0
@@ -426,13 +429,8 @@ def wall_forces(positions, triangles, tets, wall, wall_depths, forces, velocitie
     wall_point = wall[0:3]
     wall_normal = wall[3:6]
     wall_friction = wall[6]
-    penalty = laws.penalty
-    tangential_ratio = laws.tangential_ratio
-    triangle_friction = laws.triangle_friction
-    tet_friction = laws.tet_friction
-    triangle_damping = laws.triangle_damping
-    tet_damping = laws.tet_damping
-    tet_stiffness = laws.tet_stiffness
+    (penalty, tangential_ratio, triangle_friction, tet_friction, triangle_damping, tet_damping,
+     tet_stiffness) = laws
     polygon, work, signed, integrals, piece, node_force = make_scratch()
     total = 0.0
     area = 0.0
@@ -534,7 +532,10 @@ def slide_on_wall(nodes, row, count, node_force, normal_force, wall_normal, velo
                   friction_coefficient, stiffness, damping_ratio, time_step, springs, q, forces):
     """Friction and normal damping of the ``count`` nodes ``nodes[row]`` pressed on a still wall
     with ``normal_force`` spread as ``node_force``, as :func:`apply_friction` with a still,
-    infinitely heavy second side (tangential spring ``springs[q]``)."""
+    infinitely heavy second side (tangential spring ``springs[q]``).
+
+    15 arguments: as :func:`apply_friction`, per node group on a wall.
+    """
     total = 0.0
     for i in range(count):
         total += node_force[i]

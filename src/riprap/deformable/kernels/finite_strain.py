@@ -33,7 +33,12 @@ def kirchhoff_stress(model, mu, lam, kappa, eta,
                      g00, g01, g02, g10, g11, g12, g20, g21, g22):
     """J and the Kirchhoff stress tau = J sigma (6 components xx, yy, zz, xy, yz, zx) for the
     deformation gradient F (f..) and its rate dF/dt (g..); also F's cofactor matrix (F^-T = cof / J).
-    Returns (J, t00, t11, t22, t01, t12, t20, c00, c01, c02, c10, c11, c12, c20, c21, c22)."""
+    Returns (J, t00, t11, t22, t01, t12, t20, c00, c01, c02, c10, c11, c12, c20, c21, c22).
+
+    23 arguments: the material's scalars and the 18 entries of F and dF/dt as scalars, so that the
+    inlined law stays in registers (an array per point would be allocated or reference-counted per
+    integration point).
+    """
     c00 = f11 * f22 - f12 * f21
     c01 = f12 * f20 - f10 * f22
     c02 = f10 * f21 - f11 * f20
@@ -218,15 +223,8 @@ def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, mater
     """:func:`tet4_element` for every element and the joints' forces (``joint_data``:
     :class:`~riprap.deformable.kernels.bundles.JointData`) in one parallel loop: both only read the positions, so one region
     instead of two (each region costs the threads a wake-up)."""
-    joint_nodes = joint_data.nodes
-    joint_sizes = joint_data.sizes
-    joint_properties = joint_data.properties
-    joint_material = joint_data.material
-    joint_damage = joint_data.damage
-    joint_broken = joint_data.broken
-    joint_buffer = joint_data.buffer
-    joint_released = joint_data.released
-    joint_anchors = joint_data.anchors
+    (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
+     joint_buffer, _, joint_released, _, joint_anchors) = joint_data
     n_tets = tets.shape[0]
     n_joints = joint_nodes.shape[0]
     for block in prange(FORCE_BLOCKS):
@@ -272,7 +270,11 @@ def update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses, extern
     """Central-difference update of node ``n`` (see :func:`central_difference_update`) under the
     elements' force (ex, ey, ez) and the joints' (jx, jy, jz) on it; returns the work of the
     joints' force over the step and the node's squared distance from ``listed_positions`` after
-    it."""
+    it.
+
+    20 arguments: inlined per node into both node-update loops, which hand it plain arrays and
+    scalars (a bundle would be taken apart per node).
+    """
     m = masses[n]
     # nodes before ``first_loaded`` (``first_held``) have no load (no held component): they skip
     # those reads and choices (examples/11's split unit: its node update alone 80 -> 62
@@ -377,7 +379,10 @@ def _jointed_update(positions, velocities, element_forces, node_offsets, node_sl
     per joint vertex, ``kernels/joints.joint_forces``; ``joint_slot_rows``: the rows of each
     element slot's three faces); returns also the joints' work over the step. (A loop of its
     own: the bodies without joints read no joint rows.) ``jointed_update_serial``: the same on
-    one thread, without reference counts, as ``central_difference_update_serial``."""
+    one thread, without reference counts, as ``central_difference_update_serial``.
+
+    19 arguments: as :func:`central_difference_update`, with the joints' force rows.
+    """
     flat = element_forces.reshape((-1, 3))
     work = 0.0
     largest = 0.0

@@ -63,6 +63,9 @@ def transport_component(q, axis, mass_x, mass_y, mass_z, velocity_x, velocity_y,
     velocity (before the pressure correction) to ``q_out`` and the control volume's new density to
     ``density_out`` for every interior node; boundary nodes along ``axis`` are copied unchanged.
     All arrays C-contiguous float64.
+
+    17 arguments: the solver's 3D fields as the public entry; it bundles them for
+    :func:`_transport_flat`.
     """
     masses = (mass_x, mass_y, mass_z)
     velocities = (velocity_x, velocity_y, velocity_z)

@@ -91,26 +91,10 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin, 
     """
     node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles, \
         triangle_normals = shapes.mesh
-    lookup = shapes.lookup
-    triangle_centres = lookup.triangle_centres
-    triangle_radii = lookup.triangle_radii
-    cluster_offset = lookup.cluster_offset
-    cluster_begin = lookup.cluster_begin
-    cluster_end = lookup.cluster_end
-    cluster_centres = lookup.cluster_centres
-    cluster_radii = lookup.cluster_radii
-    grid_origin = lookup.grid_origin
-    grid_cell_size = lookup.grid_cell_size
-    grid_dims = lookup.grid_dims
-    cell_offset = lookup.cell_offset
-    cell_start_offset = lookup.cell_start_offset
-    cell_start = lookup.cell_start
-    cell_tets_offset = lookup.cell_tets_offset
-    cell_tets = lookup.cell_tets
-    cell_clearance = lookup.cell_clearance
-    local_box_min = lookup.local_box_min
-    local_box_max = lookup.local_box_max
-    tet_boxes = lookup.tet_boxes
+    (triangle_centres, triangle_radii, cluster_offset, cluster_begin, cluster_end, cluster_centres,
+     cluster_radii, grid_origin, grid_cell_size, grid_dims, cell_offset, cell_start_offset,
+     cell_start, cell_tets_offset, cell_tets, cell_clearance, local_box_min, local_box_max, _,
+     tet_boxes, _) = shapes.lookup
     sp = potential_shape
     ss = surface_shape
     origin = grid_origin[sp]
@@ -127,17 +111,9 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin, 
     troff = triangle_offset[ss]
     capacity = pieces.shape[0]
 
-    vertices = scratch.work.vertices
-    lam = scratch.work.lam
-    normal = scratch.work.normal
-    centre = scratch.centre
-    candidates = scratch.candidates
-    stamp = scratch.stamp
-    counter = scratch.counter
-    tri_lo = scratch.tri_lo
-    tri_hi = scratch.tri_hi
-    i_lo = scratch.i_lo
-    i_hi = scratch.i_hi
+    _, _, vertices, lam, normal, _, _ = scratch.work
+    (_, _, _, _, centre, candidates, stamp, counter, tri_lo, tri_hi, i_lo, i_hi, _,
+     _) = scratch
     # the potential body's box, taken once: a slice per call in the loops below cost an atomic
     # reference count each way, shared by the threads
     shape_lo = local_box_min[sp]

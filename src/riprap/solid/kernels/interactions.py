@@ -187,33 +187,20 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, system, motion, 
     """Candidates ``first:last`` (body pairs, then wall pairs) on one thread, with work arrays
     of their own and rows ``batch * capacity`` on of the fresh piece buffer; arguments as for
     :func:`evaluate_candidates`."""
-    shapes = system.shapes
-    scratch = make_scratch(shapes.mesh.tets.shape[0])
     # the arrays the pair loop needs, out of their bundles once: a bundle read per pair cost an
     # atomic reference count per array each way, shared with the other threads
+    _, shapes, walls, laws = system
+    _, inverse_masses, _, _, shape_index, material_index = system.bodies
     mesh = shapes.mesh
     bounding_radius = shapes.lookup.bounding_radius
-    work = scratch.work
-    positions = motion.positions
-    quaternions = motion.quaternions
-    velocities = motion.velocities
-    shape_index = system.bodies.shape_index
-    material_index = system.bodies.material_index
-    inverse_masses = system.bodies.inverse_masses
-    wall_points = system.walls.points
-    wall_normals = system.walls.normals
-    wall_materials = system.walls.materials
-    laws = system.laws
+    positions, quaternions, velocities, _, _, _ = motion
+    wall_points, wall_normals, wall_materials = walls
     pair_penalty = laws.penalty
-    step = settings.step
-    skin = settings.skin
+    _, _, _, step, _, skin = settings
+    results, fresh, capacity, source, bounds, poses = outputs
+    scratch = make_scratch(mesh.tets.shape[0])
+    work = scratch.work
     key_stride = positions.shape[0] + wall_points.shape[0]
-    results = outputs.results
-    fresh = outputs.fresh
-    capacity = outputs.capacity
-    source = outputs.source
-    bounds = outputs.bounds
-    poses = outputs.poses
     out = np.zeros(OUT_SIZE)
     n_body_pairs = body_pairs.shape[0]
     cache_keys, cache_poses, cache_bounds, cache_pieces = piece_cache

@@ -20,20 +20,12 @@ def compute_forces(system, motion, history, settings, piece_cache):
 
     Returns (history, results, body_pairs, wall_pairs, omegas, overflow, piece_cache).
     """
-    positions = motion.positions
-    quaternions = motion.quaternions
-    forces = motion.forces
-    torques = motion.torques
-    bodies = system.bodies
-    fixed = bodies.fixed
-    masses = bodies.masses
-    shape_index = bodies.shape_index
+    positions, quaternions, _, angular_momenta, forces, torques = motion
+    masses, _, inverse_principal_inertia, fixed, shape_index, _ = system.bodies
     lookup = system.shapes.lookup
     bounding_radius = lookup.bounding_radius
-    wall_points = system.walls.points
-    gravity = settings.gravity
-    external_loads = settings.external_loads
-    margin = settings.margin
+    wall_points, wall_normals, _ = system.walls
+    gravity, external_loads, margin, _, _, _ = settings
     n = positions.shape[0]
     lo, hi = broad_phase.world_boxes(positions, quaternions, shape_index, lookup.local_box_min,
                                      lookup.local_box_max, margin)
@@ -42,9 +34,8 @@ def compute_forces(system, motion, history, settings, piece_cache):
         radii[b] = bounding_radius[shape_index[b]] + margin
     body_pairs = broad_phase.overlapping_pairs(lo, hi, fixed, positions, radii)
     wall_pairs = broad_phase.near_wall_pairs(positions, shape_index, bounding_radius, fixed,
-                                             wall_points, system.walls.normals, margin)
-    omegas = integrate.angular_velocities(quaternions, motion.angular_momenta,
-                                          bodies.inverse_principal_inertia)
+                                             wall_points, wall_normals, margin)
+    omegas = integrate.angular_velocities(quaternions, angular_momenta, inverse_principal_inertia)
     key_stride = n + wall_points.shape[0]
     results, piece_cache = interactions.evaluate_candidates(
         body_pairs, wall_pairs, system, motion, omegas, history, settings, piece_cache)
@@ -86,16 +77,9 @@ def advance(n_steps, system, motion, omegas, history, settings, piece_cache):
     velocity-Verlet steps of ``settings.step``; ``omegas``: the angular velocities of the last
     force evaluation. Returns (steps done, status, history, results, body_pairs, wall_pairs,
     omegas, piece_cache) of the last force evaluation."""
-    positions = motion.positions
-    quaternions = motion.quaternions
-    velocities = motion.velocities
-    angular_momenta = motion.angular_momenta
-    forces = motion.forces
-    torques = motion.torques
-    inverse_masses = system.bodies.inverse_masses
-    inverse_principal_inertia = system.bodies.inverse_principal_inertia
-    step = settings.step
-    local_damping = settings.local_damping
+    positions, quaternions, velocities, angular_momenta, forces, torques = motion
+    _, inverse_masses, inverse_principal_inertia, _, _, _ = system.bodies
+    _, _, _, step, local_damping, _ = settings
     results = np.zeros((0, interactions.C_SIZE))
     body_pairs = np.zeros((0, 2), dtype=np.int64)
     wall_pairs = np.zeros((0, 2), dtype=np.int64)
