@@ -41,7 +41,7 @@ def reference_ratio(pack: Path, max_pairs: int) -> tuple[float, float, int]:
     if not pairs:
         return float("nan"), float("nan"), 0
     rotations = solver.rotation_matrices()
-    arrays = solver._shape_arrays
+    arrays = solver._shapes
     out = np.zeros(14)
 
     def fast(i, j):

@@ -5,6 +5,7 @@ import numpy as np
 
 from riprap.deformable import DeformableBody, ElasticMaterial, box_mesh
 from riprap.deformable.kernels import contact
+from riprap.deformable.kernels.bundles import SurfaceLaws
 from riprap.deformable.kernels.finite_strain import PARALLEL_PAIRS
 from riprap.deformable.system import DeformableSystem
 
@@ -24,10 +25,11 @@ def _pressed_blocks():
 def _evaluate(system, kernel):
     forces = np.zeros_like(system.positions)
     springs = np.full((len(system._pairs), 3), 1e-6)
+    laws = SurfaceLaws(system.contact_penalty, system.tangential_stiffness_ratio,
+                       system.triangle_friction, system.tet_friction, system.triangle_damping,
+                       system.tet_damping, system.tet_stiffness)
     weight, area = kernel(system.positions, system.triangles, system.contact_tets, system._pairs,
-                          system.contact_penalty, forces, system.velocities, system.masses,
-                          system.triangle_friction, system.tet_friction, system.triangle_damping,
-                          system.tet_damping, system.tet_stiffness, system.time_step, springs)
+                          forces, system.velocities, system.masses, laws, system.time_step, springs)
     return forces, springs, weight, area
 
 

@@ -581,8 +581,8 @@ class CoupledSolver:
             if np.any(transferred[b]):
                 predicted[b] += np.linalg.lstsq(body_matrices[b], transferred[b], rcond=None)[0]
         blended_rigid = faces.zeros()
-        rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
-                                        fluid.h, centres, predicted, faces.phi, blended_rigid)
+        rigid_coupling.accumulate_rigid(self._body_faces(faces), centres, predicted, faces.phi,
+                                        blended_rigid)
         fluid_share = 1.0 - faces.capped
         blended = fluid_share * fluid_part + blended_rigid
         # The projection moves each share of a face by the pressure at its own density, so the
@@ -646,8 +646,7 @@ class CoupledSolver:
         loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted_dry)
                  - np.einsum("bij,bj->bi", matrices - body_matrices, final)) / dt
         rigid = faces.zeros()
-        rigid_coupling.accumulate_rigid(*faces.entries, faces.axis, faces.index, self._lower,
-                                        fluid.h, centres, final, faces.phi, rigid)
+        rigid_coupling.accumulate_rigid(self._body_faces(faces), centres, final, faces.phi, rigid)
         after = fluid_share * projected + rigid
         faces.scatter(after, (u, v, w))
         # The projected field is divergence free; the water and the mass of the next step move
@@ -687,11 +686,15 @@ class CoupledSolver:
         n = self.solids.n_bodies
         matrices, body, rhs = np.zeros((n, 6, 6)), np.zeros((n, 6, 6)), np.zeros((n, len(velocities), 6))
         chosen = np.ones(n, dtype=np.bool_) if bodies is None else np.asarray(bodies, dtype=np.bool_)
-        rigid_coupling.momentum_systems(*faces.entries, faces.axis, faces.index, self._lower,
-                                        self.fluid.h, centres, densities, faces.phi, rho_fluid,
-                                        np.array(velocities), np.array(unaccounted), with_matrices,
-                                        chosen, matrices, body, rhs)
+        rigid_coupling.momentum_systems(self._body_faces(faces), centres, densities, faces.phi,
+                                        rho_fluid, np.array(velocities), np.array(unaccounted),
+                                        with_matrices, chosen, matrices, body, rhs)
         return matrices, body, rhs
+
+    def _body_faces(self, faces) -> rigid_coupling.BodyFaces:
+        """The face set as the coupling kernels take it."""
+        return rigid_coupling.BodyFaces(*faces.entries, faces.axis, faces.index, self._lower,
+                                        self.fluid.h)
 
     def _porous_factors(self, faces) -> np.ndarray:
         """The fluid's porous factor (``FluidSolver._porous_factors``) on each face of the set;
@@ -722,9 +725,8 @@ class CoupledSolver:
                       fluid_term, bodies):
         """``rigid_coupling.own_momentum_rhs`` (bodies, 6) for the chosen bodies (bool each)."""
         rhs = np.zeros((self.solids.n_bodies, 6))
-        rigid_coupling.own_momentum_rhs(*faces.entries, faces.axis, faces.index, self._lower,
-                                        self.fluid.h, centres, motions, densities, faces.phi,
-                                        rho_fluid, pressure_impulse, fluid_term,
+        rigid_coupling.own_momentum_rhs(self._body_faces(faces), centres, motions, densities,
+                                        faces.phi, rho_fluid, pressure_impulse, fluid_term,
                                         np.asarray(bodies, dtype=np.bool_), rhs)
         return rhs
 

@@ -364,10 +364,7 @@ class DeformableBodies:
                 "positions": s.positions.copy(), "velocities": s.velocities.copy(),
                 "contact_forces": s.contact_forces.copy(), "external_forces": s.external_forces.copy(),
                 "ambient_pressures": np.array([b.ambient_pressure for b in s.bodies]),
-                "contact_pairs": s._pairs.copy(), "listed_positions": s._listed_positions.copy(),
-                "pair_springs": s.pair_springs.copy(),
-                "wall_triangle_springs": s.wall_triangle_springs.copy(),
-                "wall_tet_springs": s.wall_tet_springs.copy(),
+                **s.contact_state(),
                 "rigid_contact_loads": self.rigid_contact_loads.copy(),
                 **s.joint_state(),
                 **({f"rigid_{key}": value for key, value in self.rigid.state_arrays().items()}
@@ -377,19 +374,10 @@ class DeformableBodies:
 
     def load_state_arrays(self, arrays: dict) -> None:
         s = self.system
-        s.time = float(arrays["clock"][0])
-        s.step_count = int(arrays["clock"][1])
-        for name in ("positions", "velocities", "contact_forces", "external_forces"):
+        s.restore_state(arrays)
+        for name in ("contact_forces", "external_forces"):
             getattr(s, name)[:] = arrays[name]
-        s.load_joint_state(arrays)
-        s._pairs = np.array(arrays["contact_pairs"], dtype=np.int64).reshape(-1, 2)
-        s._listed_positions[:] = arrays["listed_positions"]
-        s.pair_springs = np.array(arrays["pair_springs"], dtype=np.float64).reshape(-1, 3)
-        s.wall_triangle_springs = np.array(arrays["wall_triangle_springs"], dtype=np.float64)
-        s.wall_tet_springs = np.array(arrays["wall_tet_springs"], dtype=np.float64)
         for body, ambient in zip(s.bodies, arrays["ambient_pressures"]):
-            body.time = s.time
-            body.step_count = s.step_count
             body.ambient_pressure = float(ambient)
         self.rigid_contact_loads[:] = arrays["rigid_contact_loads"]
         if self.rigid is not None:

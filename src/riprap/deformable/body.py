@@ -16,6 +16,7 @@ import numpy as np
 
 from riprap.deformable.elements import build_element_set
 from riprap.deformable.kernels import finite_strain
+from riprap.deformable.kernels.bundles import ContactState, ElementState, JointData, NodeState
 from riprap.deformable.material import ElasticMaterial
 from riprap.errors import CaseFileError, InstabilityError
 
@@ -23,20 +24,26 @@ from riprap.errors import CaseFileError, InstabilityError
 TIME_STEP_SAFETY = 0.9
 
 # The contact arguments of a run without contact (see finite_strain.advance_steps).
-NO_CONTACT = (np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int64),
-              np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int64), np.zeros(0),
-              np.zeros((0, 2), dtype=np.int64), 0.0, np.zeros((0, 7)), np.zeros((0, 3)), 1.0,
-              np.zeros(1), np.zeros(0), np.zeros(0), 0.0, np.zeros(0), np.zeros((0, 3)),
-              np.zeros((0, 0, 3)), np.zeros((0, 0, 3)), np.zeros(0), np.zeros(0))
+NO_CONTACT = ContactState(
+    wall_triangles=np.zeros((0, 3), dtype=np.int64), wall_tets=np.zeros((0, 4), dtype=np.int64),
+    triangles=np.zeros((0, 3), dtype=np.int64), contact_tets=np.zeros((0, 4), dtype=np.int64),
+    wall_depths=np.zeros(0), pairs=np.zeros((0, 2), dtype=np.int64), penalty=0.0,
+    walls=np.zeros((0, 7)), listed_positions=np.zeros((0, 3)), skin=1.0, totals=np.zeros(1),
+    triangle_friction=np.zeros(0), tet_friction=np.zeros(0), tangential_ratio=0.0,
+    tet_stiffness=np.zeros(0), pair_springs=np.zeros((0, 3)),
+    wall_triangle_springs=np.zeros((0, 0, 3)), wall_tet_springs=np.zeros((0, 0, 3)),
+    triangle_damping=np.zeros(0), tet_damping=np.zeros(0))
 NO_TET4_GRADIENTS = np.zeros((0, 4, 3))
 
 
 def no_joints() -> tuple:
     """The joint arguments of a run without joints (see finite_strain.advance_steps)."""
-    return (np.zeros((0, 6), dtype=np.int32), np.zeros(0), np.zeros((1, 9)),
-            np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0, dtype=np.bool_),
-            np.zeros((1, 3)), np.zeros((0, 3), dtype=np.int32), np.zeros(0, dtype=np.bool_),
-            np.zeros(1), np.zeros((0, 3, 2)))
+    return JointData(nodes=np.zeros((0, 6), dtype=np.int32), sizes=np.zeros(0),
+                     properties=np.zeros((1, 9)), material=np.zeros(0, dtype=np.int64),
+                     damage=np.zeros((0, 3)), broken=np.zeros(0, dtype=np.bool_),
+                     buffer=np.zeros((1, 3)), slot_rows=np.zeros((0, 3), dtype=np.int32),
+                     released=np.zeros(0, dtype=np.bool_), work=np.zeros(1),
+                     anchors=np.zeros((0, 3, 2)))
 
 # Bodies with fewer integration points than this step on one thread: starting the threads of a
 # parallel loop (twice a step) cost more than the work for the 480-tet cantilever of the tests
@@ -196,13 +203,15 @@ class DeformableBody:
         tet4_gradients = (elements.tet4_gradients if elements.tet4_gradients is not None
                           else NO_TET4_GRADIENTS)
         parallel = self.n_elements * elements.weights.shape[1] >= PARALLEL_POINTS
+        nodes = NodeState(self.positions, self.velocities, self.masses, self.external_forces,
+                          self.contact_forces, self.constrained, self.prescribed_velocities,
+                          self._offsets, self._slots)
+        element_state = ElementState(elements.elements, tet4_gradients, elements.gradients,
+                                     elements.weights, self.materials, self.element_material,
+                                     self._element_forces, self.jacobians)
         done, status, worst, value = finite_strain.advance_steps(
-            int(n_steps), parallel, self.positions, self.velocities, elements.elements,
-            tet4_gradients, elements.gradients, elements.weights, self.materials,
-            self.element_material, self._element_forces, self.jacobians, self._offsets,
-            self._slots, self.masses, self.external_forces, self.contact_forces, self.gravity,
-            self.mass_damping, self.constrained, self.prescribed_velocities, dt, NO_CONTACT,
-            self._joint_arguments())
+            int(n_steps), parallel, nodes, element_state, self.gravity, self.mass_damping, dt,
+            NO_CONTACT, self._joint_arguments())
         self.step_count += int(done)
         self.time += int(done) * dt
         if status == finite_strain.INVERTED:

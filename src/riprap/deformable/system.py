@@ -23,6 +23,7 @@ from riprap.deformable.elements import _OUTWARD_FACES
 from riprap.deformable.joints import FracturingBody
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import finite_strain
+from riprap.deformable.kernels.bundles import ContactState, ElementState, JointData, NodeState
 from riprap.errors import CaseFileError
 from riprap.geometry.meshing import boundary_tet_heights
 from riprap.geometry.tetmesh import TetMesh
@@ -241,9 +242,10 @@ class DeformableSystem:
             slot_rows[first_slot:first_slot + len(local)] = np.where(
                 local < 6 * len(body.joints), local + 6 * self.joint_offsets[i], 6 * n_joints)
         self.joint_work = np.zeros(1)
-        self.joint_data = (self.joints, sizes, properties, material, self.joint_damage,
-                           self.joint_broken, np.zeros((6 * n_joints + 1, 3)), slot_rows,
-                           self.joint_released, self.joint_work, self.joint_friction_anchor)
+        self.joint_data = JointData(self.joints, sizes, properties, material, self.joint_damage,
+                                    self.joint_broken, np.zeros((6 * n_joints + 1, 3)), slot_rows,
+                                    self.joint_released, self.joint_work,
+                                    self.joint_friction_anchor)
 
     def _fracturing_surface(self, body) -> tuple:
         """A fracturing body's contact surface now: its outer faces and the faces of its parted
@@ -335,6 +337,33 @@ class DeformableSystem:
         self._pairs = np.zeros((0, 2), dtype=np.int64)
         self.pair_springs = np.zeros((0, 3))
         self.surface_rebuilds += 1
+
+    def contact_state(self) -> dict:
+        """The contacts' state for a checkpoint: the listed pairs, the node positions they were
+        listed at, and the friction springs of the pairs and of the walls."""
+        return {"contact_pairs": self._pairs.copy(), "listed_positions": self._listed_positions.copy(),
+                "pair_springs": self.pair_springs.copy(),
+                "wall_triangle_springs": self.wall_triangle_springs.copy(),
+                "wall_tet_springs": self.wall_tet_springs.copy()}
+
+    def restore_state(self, arrays: dict) -> None:
+        """Put back a checkpoint's state: the clock (``arrays["clock"]``: time, step count), the
+        nodes' positions and velocities, the joints (:meth:`joint_state`) with the contact
+        surfaces they make, then the contacts (:meth:`contact_state`) on those surfaces."""
+        self.time = float(arrays["clock"][0])
+        self.step_count = int(arrays["clock"][1])
+        self.positions[:] = arrays["positions"]
+        self.velocities[:] = arrays["velocities"]
+        # the cracks first: they decide the contact surfaces the springs below belong to
+        self.load_joint_state(arrays)
+        self._pairs = np.array(arrays["contact_pairs"], dtype=np.int64).reshape(-1, 2)
+        self._listed_positions[:] = arrays["listed_positions"]
+        self.pair_springs = np.array(arrays["pair_springs"], dtype=np.float64).reshape(-1, 3)
+        self.wall_triangle_springs = np.array(arrays["wall_triangle_springs"], dtype=np.float64)
+        self.wall_tet_springs = np.array(arrays["wall_tet_springs"], dtype=np.float64)
+        for body in self.bodies:
+            body.time = self.time
+            body.step_count = self.step_count
 
     def joint_state(self) -> dict:
         """The joints' state for a checkpoint (empty without fracturing bodies)."""
@@ -543,20 +572,23 @@ class DeformableSystem:
             chunk = remaining
             if self.fracturing_bodies:
                 chunk = min(chunk, FRAGMENT_CHECK_STEPS - self.step_count % FRAGMENT_CHECK_STEPS)
-            contact = (self.triangles[:self.n_wall_triangles], self.contact_tets[:self.n_wall_tets],
-                       self.triangles, self.contact_tets, self.wall_depths, self._pairs,
-                       self.contact_penalty, self.walls, self._listed_positions, self.skin,
-                       self.contact_totals, self.triangle_friction, self.tet_friction,
-                       self.tangential_stiffness_ratio, self.tet_stiffness, self.pair_springs,
-                       self.wall_triangle_springs, self.wall_tet_springs, self.triangle_damping,
-                       self.tet_damping)
+            contact = ContactState(
+                self.triangles[:self.n_wall_triangles], self.contact_tets[:self.n_wall_tets],
+                self.triangles, self.contact_tets, self.wall_depths, self._pairs,
+                self.contact_penalty, self.walls, self._listed_positions, self.skin,
+                self.contact_totals, self.triangle_friction, self.tet_friction,
+                self.tangential_stiffness_ratio, self.tet_stiffness, self.pair_springs,
+                self.wall_triangle_springs, self.wall_tet_springs, self.triangle_damping,
+                self.tet_damping)
+            nodes = NodeState(self.positions, self.velocities, self.masses, self.external_forces,
+                              self.contact_forces, self.constrained, self.prescribed_velocities,
+                              self._offsets, self._slots)
+            element_state = ElementState(self.elements, self.tet4_gradients, self.gradients,
+                                         self.weights, self.materials, self.element_material,
+                                         self._element_forces, self.jacobians)
             done, status, worst, value = finite_strain.advance_steps(
-                chunk, parallel, self.positions, self.velocities, self.elements,
-                self.tet4_gradients, self.gradients, self.weights, self.materials,
-                self.element_material, self._element_forces, self.jacobians, self._offsets,
-                self._slots, self.masses, self.external_forces, self.contact_forces, self.gravity,
-                self.mass_damping, self.constrained, self.prescribed_velocities, dt, contact,
-                self.joint_data)
+                chunk, parallel, nodes, element_state, self.gravity, self.mass_damping, dt,
+                contact, self.joint_data)
             self.step_count += int(done)
             self.time += int(done) * dt
             for body in self.bodies:

@@ -9,6 +9,7 @@ import time as wallclock
 import numpy as np
 
 from riprap.deformable.kernels import contact as contact_kernels
+from riprap.deformable.kernels.bundles import SurfaceLaws
 from riprap.deformable.stresses import principal_stresses, von_mises
 from riprap.errors import InstabilityError, OverlapError, RiprapError
 from riprap.limits import PROGRESS_PERIOD
@@ -149,13 +150,13 @@ class DeformableModel(Model):
         forces = np.zeros_like(s.positions)
         allowed = _START_OVERLAP_FRACTION * float(s.potential_heights.min())
         no_friction = np.zeros(max(len(s.triangles), len(s.contact_tets)))
+        laws = SurfaceLaws(s.contact_penalty, 0.0, no_friction, no_friction, no_friction,
+                           no_friction, no_friction)
         touching = {}
         for q in range(len(s._pairs)):
             pair = s._pairs[q:q + 1]
             weight, area = contact_kernels.pair_forces(s.positions, s.triangles, s.contact_tets, pair,
-                                                       s.contact_penalty, forces, s.velocities,
-                                                       s.masses, no_friction, no_friction,
-                                                       no_friction, no_friction, no_friction, 1.0,
+                                                       forces, s.velocities, s.masses, laws, 1.0,
                                                        np.zeros((1, 3)))
             if weight > 0.0 and area > 0.0:
                 a, b = int(s.triangle_body[pair[0, 0]]), int(s.tet_body[pair[0, 1]])
@@ -174,12 +175,11 @@ class DeformableModel(Model):
         for w in range(len(s.walls)):
             for k, body in enumerate(s.bodies):
                 on_body = s.triangle_body == k
+                frictionless_wall = np.r_[s.walls[w, :6], 0.0]
                 total, area = contact_kernels.wall_forces(
                     s.positions, s.triangles[on_body], s.contact_tets[s.tet_body == k],
-                    s.walls[w, :3], s.walls[w, 3:6], s.contact_penalty, s.wall_depths[on_body], forces,
-                    s.velocities, s.masses, no_friction, no_friction, 0.0, no_friction, no_friction,
-                    0.0, no_friction, 1.0, np.zeros((len(s.triangles), 3)),
-                    np.zeros((len(s.contact_tets), 3)))
+                    frictionless_wall, s.wall_depths[on_body], forces, s.velocities, s.masses,
+                    laws, 1.0, np.zeros((len(s.triangles), 3)), np.zeros((len(s.contact_tets), 3)))
                 if total <= 0.0 or area <= 0.0:
                     continue
                 depth = s.potential_heights[k] * total / (s.contact_penalty * area)
@@ -255,10 +255,7 @@ class DeformableModel(Model):
         s = self.system
         return {"clock": np.array([s.time, float(s.step_count), s.time_step]),
                 "positions": s.positions.copy(), "velocities": s.velocities.copy(),
-                "contact_pairs": s._pairs.copy(), "listed_positions": s._listed_positions.copy(),
-                "pair_springs": s.pair_springs.copy(),
-                "wall_triangle_springs": s.wall_triangle_springs.copy(),
-                "wall_tet_springs": s.wall_tet_springs.copy(),
+                **s.contact_state(),
                 "record_stress": self.records.stress.copy(),
                 "record_element": self.records.element.copy(),
                 "record_point": self.records.point.copy(), "record_time": self.records.time.copy(),
@@ -267,21 +264,7 @@ class DeformableModel(Model):
                    if self.rigid is not None else {})}
 
     def load_state_arrays(self, arrays: dict) -> None:
-        s = self.system
-        s.time = float(arrays["clock"][0])
-        s.step_count = int(arrays["clock"][1])
-        s.positions[:] = arrays["positions"]
-        s.velocities[:] = arrays["velocities"]
-        # the cracks first: they decide the contact surfaces the springs below belong to
-        s.load_joint_state(arrays)
-        s._pairs = np.array(arrays["contact_pairs"], dtype=np.int64).reshape(-1, 2)
-        s._listed_positions[:] = arrays["listed_positions"]
-        s.pair_springs = np.array(arrays["pair_springs"], dtype=np.float64).reshape(-1, 3)
-        s.wall_triangle_springs = np.array(arrays["wall_triangle_springs"], dtype=np.float64)
-        s.wall_tet_springs = np.array(arrays["wall_tet_springs"], dtype=np.float64)
-        for body in s.bodies:
-            body.time = s.time
-            body.step_count = s.step_count
+        self.system.restore_state(arrays)
         self.records.stress[:] = arrays["record_stress"]
         self.records.element[:] = arrays["record_element"]
         self.records.point[:] = arrays["record_point"]

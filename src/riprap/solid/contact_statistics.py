@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from riprap.solid.kernels.pair_rule import pair_friction as pair_friction_rule
+
 
 @dataclass(frozen=True)
 class UnitContacts:
@@ -69,7 +71,7 @@ def pair_friction(contacts, friction_of_material, material_of_body, material_of_
     walls = np.where(is_wall, -1 - body_j, 0)
     other = np.where(is_wall, material_of_wall[walls] if len(material_of_wall) else 0,
                      material_of_body[np.maximum(body_j, 0)])
-    return np.minimum(mu[material_of_body[body_i]], mu[other])
+    return pair_friction_rule.py_func(mu[material_of_body[body_i]], mu[other])
 
 
 def sliding_factor_of_safety(n_bodies: int, contacts, friction_coefficient) -> np.ndarray:

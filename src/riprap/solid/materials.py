@@ -10,6 +10,7 @@ import numpy as np
 from scipy import optimize
 
 from riprap.errors import CaseFileError
+from riprap.solid.kernels import pair_rule
 
 
 @dataclass(frozen=True)
@@ -120,17 +121,18 @@ def damping_ratio_for_restitution(restitution: float) -> float:
 def pair_tables(materials) -> dict[str, np.ndarray]:
     """Contact parameters of every material pair.
 
-    Combination rule (printed in the run log): the smaller friction coefficient, the smaller
-    restitution and the smaller penalty of the two (as in Y3D for the penalty), the mean of the
-    tangential stiffness ratios.
+    Combination rule (``solid/kernels/pair_rule.py``, printed in the run log): the smaller friction
+    coefficient, the smaller restitution and the smaller penalty of the two (as in Y3D for the
+    penalty); the mean of the tangential stiffness ratios.
     """
     n = len(materials)
     tables = {k: np.zeros((n, n)) for k in ("penalty", "friction", "damping_ratio", "tangential_ratio")}
     for i, a in enumerate(materials):
         for j, b in enumerate(materials):
-            weaker = a if a.restitution <= b.restitution else b
-            tables["penalty"][i, j] = min(a.contact_penalty, b.contact_penalty)
-            tables["friction"][i, j] = min(a.friction_coefficient, b.friction_coefficient)
-            tables["damping_ratio"][i, j] = weaker.damping_ratio
+            tables["penalty"][i, j] = pair_rule.pair_penalty.py_func(a.contact_penalty, b.contact_penalty)
+            tables["friction"][i, j] = pair_rule.pair_friction.py_func(a.friction_coefficient,
+                                                                       b.friction_coefficient)
+            restitution = pair_rule.pair_restitution.py_func(a.restitution, b.restitution)
+            tables["damping_ratio"][i, j] = damping_ratio_for_restitution(float(restitution))
             tables["tangential_ratio"][i, j] = 0.5 * (a.tangential_stiffness_ratio + b.tangential_stiffness_ratio)
     return tables

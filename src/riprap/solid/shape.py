@@ -23,6 +23,7 @@ import numpy as np
 
 from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.tetmesh import TetMesh
+from riprap.solid.kernels.bundles import ShapeLookup, ShapeMesh, Shapes
 from riprap.solid.kernels.geometry_ops import surface_clearance
 
 # The tet lookup grid has cells of 3/4 of a median tet edge (at most this many per axis), so that a
@@ -324,12 +325,15 @@ class ShapeTable:
             tet_boxes=tet_boxes,
         )
 
-    def kernel_arrays(self) -> tuple:
-        """The arrays the contact kernels take, in their argument order."""
-        return (self.node_offset, self.nodes, self.tet_offset, self.tets, self.barycentric,
-                self.triangle_offset, self.triangles, self.triangle_normals, self.triangle_centres,
-                self.triangle_radii, self.cluster_offset, self.cluster_begin, self.cluster_end, self.cluster_centres,
-                self.cluster_radii, self.grid_origin, self.grid_cell_size, self.grid_dims,
-                self.cell_offset, self.cell_start_offset, self.cell_start, self.cell_tets_offset,
-                self.cell_tets, self.cell_clearance, self.local_box_min, self.local_box_max,
-                self.wall_potential_depth, self.tet_boxes)
+    def kernel_arrays(self) -> Shapes:
+        """The shapes as the contact kernels take them (``solid/kernels/bundles.py``)."""
+        mesh = ShapeMesh(self.node_offset, self.nodes, self.tet_offset, self.tets, self.barycentric,
+                         self.triangle_offset, self.triangles, self.triangle_normals)
+        lookup = ShapeLookup(
+            self.triangle_centres, self.triangle_radii, self.cluster_offset, self.cluster_begin,
+            self.cluster_end, self.cluster_centres, self.cluster_radii, self.grid_origin,
+            self.grid_cell_size, self.grid_dims, self.cell_offset, self.cell_start_offset,
+            self.cell_start, self.cell_tets_offset, self.cell_tets, self.cell_clearance,
+            self.local_box_min, self.local_box_max, self.wall_potential_depth, self.tet_boxes,
+            np.array([s.bounding_radius for s in self.shapes], dtype=np.float64))
+        return Shapes(mesh, lookup)

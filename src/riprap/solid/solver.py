@@ -12,6 +12,8 @@ import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, KernelOverflowError, OverlapError
 from riprap.solid.kernels import integrate, interactions, stepper
+from riprap.solid.kernels.bundles import (Bodies, History, Motion, PairLaws, RigidSystem,
+                                          StepSettings, Walls)
 from riprap.solid.kernels.geometry_ops import rotation_matrices, rotation_matrix
 from riprap.solid.materials import Material, pair_tables
 from riprap.solid.shape import RigidShape, ShapeTable
@@ -173,13 +175,11 @@ class SolidSolver:
         self.forces = np.zeros((n, 3))
         self.torques = np.zeros((n, 3))
         self.table = ShapeTable.build(self.shapes)
-        self._shape_arrays = self.table.kernel_arrays()
-        self.bounding_radius = np.array([s.bounding_radius for s in self.shapes])
+        self._shapes = self.table.kernel_arrays()
+        self.bounding_radius = self._shapes.lookup.bounding_radius
         tables = pair_tables(self.materials)
-        self._pair_penalty = tables["penalty"]
-        self._pair_friction = tables["friction"]
-        self._pair_damping = tables["damping_ratio"]
-        self._pair_tangential = tables["tangential_ratio"]
+        self._pair_laws = PairLaws(tables["penalty"], tables["friction"], tables["damping_ratio"],
+                                   tables["tangential_ratio"])
         self.wall_points = np.array([w.point for w in self.walls], dtype=np.float64).reshape(-1, 3)
         self.wall_normals = np.array([w.normal for w in self.walls], dtype=np.float64).reshape(-1, 3)
         self.wall_materials = np.array([self.material_index(w.material) for w in self.walls], dtype=np.int64)
@@ -256,25 +256,34 @@ class SolidSolver:
             if self.fixed[b]:
                 continue
             shape = self.shapes[self.shape_index[b]]
-            penalty = self._pair_penalty[self.material_index_of_body[b]].max()
+            penalty = self._pair_laws.penalty[self.material_index_of_body[b]].max()
             stiffness = 2.0 * penalty * shape.volume ** (2.0 / 3.0) / shape.min_subtet_height
             rotational_mass = self.principal_inertia[b].min() / shape.bounding_radius ** 2
             mass = min(self.masses[b], rotational_mass)
             steps[b] = 2.0 * np.sqrt(mass / stiffness)
         return steps
 
-    def _common_arguments(self):
-        return (self.masses, self.inverse_masses, self.inverse_principal_inertia, self.fixed,
-                self.shape_index, self.material_index_of_body, self.gravity, self.wall_points,
-                self.wall_normals, self.wall_materials, self.bounding_radius, self._pair_penalty,
-                self._pair_friction, self._pair_damping, self._pair_tangential, self.external_loads)
+    def _kernel_state(self, step: float):
+        """The bundles the stepping kernels take (``solid/kernels/bundles.py``), made afresh per
+        call because a restart or ``fix_bodies`` may have replaced the arrays they hold."""
+        system = RigidSystem(
+            Bodies(self.masses, self.inverse_masses, self.inverse_principal_inertia, self.fixed,
+                   self.shape_index, self.material_index_of_body),
+            self._shapes,
+            Walls(self.wall_points, self.wall_normals, self.wall_materials),
+            self._pair_laws)
+        motion = Motion(self.positions, self.quaternions, self.velocities, self.angular_momenta,
+                        self.forces, self.torques)
+        settings = StepSettings(self.gravity, self.external_loads, self._margin, step,
+                                self.local_damping, self._skin)
+        return system, motion, History(self.history_keys, self.history_springs), settings
 
     def _compute_forces(self, step: float) -> None:
-        (self.history_keys, self.history_springs, results, body_pairs, wall_pairs, self._omegas,
-         overflow, self._piece_cache) = stepper.compute_forces(
-            self.positions, self.quaternions, self.velocities, self.angular_momenta, self.forces,
-            self.torques, *self._common_arguments(), self.history_keys, self.history_springs,
-            self._margin, step, self._piece_cache, self._skin, self._shape_arrays)
+        system, motion, history, settings = self._kernel_state(step)
+        (history, results, body_pairs, wall_pairs, self._omegas, overflow,
+         self._piece_cache) = stepper.compute_forces(system, motion, history, settings,
+                                                     self._piece_cache)
+        self.history_keys, self.history_springs = history
         self._store_results(results, body_pairs, wall_pairs)
         if overflow:
             self._raise_overflow()
@@ -298,12 +307,11 @@ class SolidSolver:
         self.finalize()
         if n_steps <= 0:
             return
-        (done, status, self.history_keys, self.history_springs, results, body_pairs, wall_pairs,
-         self._omegas, self._piece_cache) = stepper.advance(
-            int(n_steps), self.positions, self.quaternions, self.velocities, self.angular_momenta,
-            self.forces, self.torques, self._omegas, *self._common_arguments(),
-            self.history_keys, self.history_springs, self._margin, self.time_step,
-            self.local_damping, self._piece_cache, self._skin, self._shape_arrays)
+        system, motion, history, settings = self._kernel_state(self.time_step)
+        (done, status, history, results, body_pairs, wall_pairs, self._omegas,
+         self._piece_cache) = stepper.advance(int(n_steps), system, motion, self._omegas, history,
+                                              settings, self._piece_cache)
+        self.history_keys, self.history_springs = history
         self.step_count += int(done)
         self.time = self.step_count * self.time_step if self._time_origin is None else self._time_origin + (self.step_count - self._step_origin) * self.time_step
         self._store_results(results, body_pairs, wall_pairs)

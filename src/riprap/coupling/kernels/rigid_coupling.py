@@ -20,6 +20,8 @@ Face set arrays: ``face_axis`` (F,), ``face_index`` (F, 3) the face's index in i
 array, ``entry_start`` (bodies + 1,), ``entry_face`` (E,) slots into the face set, ``entry_half``
 (E,) the half cell fraction a body's cell gives that face (once per cell and face).
 """
+from collections import namedtuple
+
 import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
@@ -223,12 +225,20 @@ def _face_jacobian(axis, index, lower, h, centre, jac):
         jac[4] = -rho_x
 
 
+#: The faces the bodies' cells touch: per body its entries (``entry_start`` (bodies + 1,) into
+#: ``entry_face`` (E,), the face of each entry, and ``entry_half`` (E,), the body's share of it),
+#: each face's axis and (i, j, k) index, and the grid's lower corner (m) and cell size ``h`` (m).
+BodyFaces = namedtuple("BodyFaces", ["entry_start", "entry_face", "entry_half", "face_axis",
+                                     "face_index", "lower", "h"])
+
+
 @kernel
-def accumulate_rigid(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
-                     motions, phi, out):
-    """out[f] += sum over bodies of phi_b' (J x_b) on the set's faces, phi_b' the body's share
-    scaled by 1 / max(1, phi): the rigid part of a blended velocity. A body at rest (x_b = 0: a
-    fixed one after the projection) adds nothing and is skipped."""
+def accumulate_rigid(faces, centres, motions, phi, out):
+    """out[f] += sum over bodies of phi_b' (J x_b) on the set's faces (``faces``:
+    :class:`BodyFaces`), phi_b' the body's share scaled by 1 / max(1, phi): the rigid part of a
+    blended velocity. A body at rest (x_b = 0: a fixed one after the projection) adds nothing and
+    is skipped."""
+    entry_start, entry_face, entry_half, face_axis, face_index, lower, h = faces
     jac = np.empty(6)
     for b in range(entry_start.shape[0] - 1):
         moving = False
@@ -248,9 +258,8 @@ def accumulate_rigid(entry_start, entry_face, entry_half, face_axis, face_index,
 
 
 @parallel_kernel
-def own_momentum_rhs(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
-                     motions, densities, phi, fluid_density, pressure_impulse, fluid_term, chosen,
-                     rhs):
+def own_momentum_rhs(faces, centres, motions, densities, phi, fluid_density, pressure_impulse,
+                     fluid_term, chosen, rhs):
     """Per body the right-hand side r of its 6 x 6 system after the projection, each part of a
     face's momentum given to whom it belongs: the body's own share at its own blended motion plus
     the pressure's velocity change on the face, and its part (phi_b' / phi) of the fluid share's
@@ -261,7 +270,10 @@ def own_momentum_rhs(entry_start, entry_face, entry_half, face_axis, face_index,
     Summed over the bodies of a face this is the momentum_systems right-hand side (w u - C): for a
     face of one body it is the same; where two bodies share a face, neither takes the other's
     motion (a unit sliding on the slope is not dragged by the slope's share of the face).
-    ``rhs`` (bodies, 6); only bodies with ``chosen[b]``, the others left 0."""
+    ``rhs`` (bodies, 6); only bodies with ``chosen[b]``, the others left 0. ``faces``:
+    :class:`BodyFaces`, taken apart here, outside the parallel loop.
+    """
+    entry_start, entry_face, entry_half, face_axis, face_index, lower, h = faces
     volume = h * h * h
     for b in prange(entry_start.shape[0] - 1):
         jac = np.empty(6)
@@ -297,9 +309,8 @@ def accumulate_density(entry_start, entry_face, entry_half, densities, phi, flui
 
 
 @parallel_kernel
-def momentum_systems(entry_start, entry_face, entry_half, face_axis, face_index, lower, h, centres,
-                     densities, phi, fluid_density, velocities, unaccounted, with_matrices,
-                     chosen, matrices, body_matrices, rhs):
+def momentum_systems(faces, centres, densities, phi, fluid_density, velocities, unaccounted,
+                     with_matrices, chosen, matrices, body_matrices, rhs):
     """For every body the 6 x 6 system M x = r of its rigid motion after the projection:
 
         M = sum_f w_f J_f^T J_f,  r = sum_f J_f^T (w_f u_f - C_f phi_b' / phi),
@@ -315,7 +326,10 @@ def momentum_systems(entry_start, entry_face, entry_half, face_axis, face_index,
     phi_b' rho_b), whose product with a motion is the body's momentum on the grid. Each body's sums
     are its own (threads over bodies), in the order of its entries. Only bodies with ``chosen[b]``
     are summed; the others are left 0.
+ ``faces``: :class:`BodyFaces`, taken apart
+    here, outside the parallel loop.
     """
+    entry_start, entry_face, entry_half, face_axis, face_index, lower, h = faces
     volume = h * h * h
     n_rhs = velocities.shape[0]
     for b in prange(entry_start.shape[0] - 1):

@@ -28,6 +28,7 @@ from numba import prange
 
 from riprap._jit import inline_kernel, kernel, leaf_kernel, parallel_kernel
 from riprap.solid.kernels.contact import plane_section
+from riprap.solid.kernels.pair_rule import pair_friction
 
 MAX_VERTICES = 16
 N_COLUMNS = 10
@@ -177,7 +178,11 @@ def triangle_in_tet(positions, triangles, tri, tets, t, lam_map, penalty, forces
     tet's nodes; the pair's tangential spring is ``springs[q]``. ``polygon`` .. ``node_force`` are
     scratch arrays (``make_scratch``). Returns (force on the triangle's body along its...
     magnitude p int phi dS, contact area). (Rows are passed by index, never as slices: each
-    slice cost an atomic reference count each way, most of a pair's time.)"""
+    slice cost an atomic reference count each way, most of a pair's time.)
+
+    22 arguments: a leaf kernel called per (triangle, tet) piece with the scratch arrays one by one
+    (see above); a bundle would add nothing the compiled code needs.
+    """
     # quick rejection: all three corners outside the same face of the tet
     for k in range(4):
         outside = 0
@@ -291,7 +296,11 @@ def apply_friction(triangles, tri, tets, t, node_force, weight, nx, ny, nz, velo
     two sides at the force's centre (``springs[q]``) (:func:`spring_friction`), and a dashpot on their normal
     relative speed with ``damping_ratio`` of the contact's normal stiffness (taken as the tangential
     one over 2/7) and their lumped masses, clipped so that the contact never pulls; spread with the
-    same weights, equal and opposite."""
+    same weights, equal and opposite.
+
+    18 arguments: a leaf kernel per contact piece; the normal (three scalars) and the piece's
+    indices change every call.
+    """
     rx = ry = rz = 0.0
     side_a = side_b = 0.0
     for v in range(3):
@@ -341,15 +350,16 @@ def make_scratch():
 
 
 @kernel
-def pair_forces(positions, triangles, tets, pairs, penalty, forces, velocities, masses,
-                triangle_friction, tet_friction, triangle_damping, tet_damping, tet_stiffness,
-                time_step, springs):
+def pair_forces(positions, triangles, tets, pairs, forces, velocities, masses, laws, time_step,
+                springs):
     """Forces of every candidate (boundary triangle, tet) pair, (n, 2) indices into ``triangles``
-    and ``tets``; the friction coefficient of a pair is the smaller of its triangle's and its
-    tet's, likewise its normal damping ratio; its tangential stiffness ``tet_stiffness[tet]`` (N/m
-    per m^2 of contact) times its
-    contact area, its spring ``springs[pair]`` (zeroed while the pair does not touch). Returns
-    (total p int phi dS, contact area)."""
+    and ``tets``, under ``laws`` (:class:`~riprap.deformable.kernels.bundles.SurfaceLaws`); the
+    friction coefficient of a pair is the smaller of its triangle's and its tet's
+    (``solid/kernels/pair_rule.py``), likewise its normal damping ratio; its tangential stiffness
+    ``tet_stiffness[tet]`` (N/m per m^2 of contact) times its contact area, its spring
+    ``springs[pair]`` (zeroed while the pair does not touch). Returns (total p int phi dS, contact
+    area)."""
+    penalty, _, triangle_friction, tet_friction, triangle_damping, tet_damping, tet_stiffness = laws
     polygon, work, signed, integrals, piece, node_force = make_scratch()
     lam_map = np.empty((4, 4))
     weight = 0.0
@@ -366,7 +376,7 @@ def pair_forces(positions, triangles, tets, pairs, penalty, forces, velocities, 
         tri = pairs[q, 0]
         w, a = triangle_in_tet(positions, triangles, tri, tets, t, lam_map, penalty, forces,
                                polygon, work, signed, integrals, piece, node_force, velocities,
-                               masses, min(triangle_friction[tri], tet_friction[t]),
+                               masses, pair_friction(triangle_friction[tri], tet_friction[t]),
                                min(triangle_damping[tri], tet_damping[t]), tet_stiffness[t],
                                time_step, springs, q)
         if w == 0.0:
@@ -382,9 +392,8 @@ PAIR_CHUNKS = 4
 
 
 @parallel_kernel
-def pair_forces_parallel(positions, triangles, tets, pairs, penalty, forces, velocities, masses,
-                         triangle_friction, tet_friction, triangle_damping, tet_damping,
-                         tet_stiffness, time_step, springs):
+def pair_forces_parallel(positions, triangles, tets, pairs, forces, velocities, masses, laws,
+                         time_step, springs):
     """:func:`pair_forces` on ``PAIR_CHUNKS`` runs of the pairs at once, each into a force buffer
     of its own (a node may sit in pairs of several runs), summed in a fixed order."""
     n_pairs = pairs.shape[0]
@@ -394,10 +403,9 @@ def pair_forces_parallel(positions, triangles, tets, pairs, penalty, forces, vel
     for c in prange(PAIR_CHUNKS):
         first = c * n_pairs // PAIR_CHUNKS
         last = (c + 1) * n_pairs // PAIR_CHUNKS
-        weights[c], areas[c] = pair_forces(positions, triangles, tets, pairs[first:last], penalty,
-                                           buffers[c], velocities, masses, triangle_friction,
-                                           tet_friction, triangle_damping, tet_damping,
-                                           tet_stiffness, time_step, springs[first:last])
+        weights[c], areas[c] = pair_forces(positions, triangles, tets, pairs[first:last],
+                                           buffers[c], velocities, masses, laws, time_step,
+                                           springs[first:last])
     for n in prange(positions.shape[0]):
         for i in range(3):
             total = forces[n, i]
@@ -408,16 +416,21 @@ def pair_forces_parallel(positions, triangles, tets, pairs, penalty, forces, vel
 
 
 @kernel
-def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wall_depths,
-                forces, velocities, masses, triangle_friction, tet_friction, wall_friction,
-                triangle_damping, tet_damping, tangential_ratio, tet_stiffness, time_step,
-                triangle_springs, tet_springs):
-    """Forces of one half-space wall on boundary ``triangles`` and ``tets`` (only those near the
-    surface need be listed), added to ``forces``; ``wall_depths[tri]`` is the depth over which the
-    wall's potential rises for that triangle's body; friction as for body pairs, with the
-    coefficients given per triangle and per tet (the smaller of that and ``wall_friction`` acts),
-    tangential springs per triangle and per tet of ``tangential_ratio`` p A / h_w and
-    ``tet_stiffness`` A. Returns (normal force, contact area)."""
+def wall_forces(positions, triangles, tets, wall, wall_depths, forces, velocities, masses, laws,
+                time_step, triangle_springs, tet_springs):
+    """Forces of one half-space ``wall`` (7,: point, outward normal, friction coefficient) on
+    boundary ``triangles`` and ``tets`` (only those near the surface need be listed), added to
+    ``forces``; ``wall_depths[tri]`` is the depth over which the wall's potential rises for that
+    triangle's body; friction as for body pairs under ``laws``
+    (:class:`~riprap.deformable.kernels.bundles.SurfaceLaws`), with the coefficients given per
+    triangle and per tet (the pair rule of that and the wall's acts), tangential springs per
+    triangle and per tet of ``tangential_ratio`` p A / h_w and ``tet_stiffness`` A. Returns
+    (normal force, contact area)."""
+    wall_point = wall[0:3]
+    wall_normal = wall[3:6]
+    wall_friction = wall[6]
+    (penalty, tangential_ratio, triangle_friction, tet_friction, triangle_damping, tet_damping,
+     tet_stiffness) = laws
     polygon, work, signed, integrals, piece, node_force = make_scratch()
     total = 0.0
     area = 0.0
@@ -461,7 +474,7 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
             forces[node, 2] -= f * nz
             pushed += f * norm * cosine
         total += pushed
-        mu = min(triangle_friction[tri], wall_friction)
+        mu = pair_friction(triangle_friction[tri], wall_friction)
         if (mu > 0.0 or triangle_damping[tri] > 0.0) and pushed > 0.0:
             slide_on_wall(triangles, tri, 3, node_force, pushed, wall_normal, velocities, masses,
                           mu, tangential_ratio * penalty * piece_area / wall_depths[tri],
@@ -506,7 +519,7 @@ def wall_forces(positions, triangles, tets, wall_point, wall_normal, penalty, wa
             pushed += node_force[k]
         total += pushed
         area += 0.5 * section_area
-        mu = min(tet_friction[t], wall_friction)
+        mu = pair_friction(tet_friction[t], wall_friction)
         if (mu > 0.0 or tet_damping[t] > 0.0) and pushed > 0.0:
             slide_on_wall(tets, t, 4, node_force, pushed, wall_normal, velocities, masses, mu,
                           tet_stiffness[t] * section_area, tet_damping[t], time_step,
@@ -519,7 +532,10 @@ def slide_on_wall(nodes, row, count, node_force, normal_force, wall_normal, velo
                   friction_coefficient, stiffness, damping_ratio, time_step, springs, q, forces):
     """Friction and normal damping of the ``count`` nodes ``nodes[row]`` pressed on a still wall
     with ``normal_force`` spread as ``node_force``, as :func:`apply_friction` with a still,
-    infinitely heavy second side (tangential spring ``springs[q]``)."""
+    infinitely heavy second side (tangential spring ``springs[q]``).
+
+    15 arguments: as :func:`apply_friction`, per node group on a wall.
+    """
     total = 0.0
     for i in range(count):
         total += node_force[i]

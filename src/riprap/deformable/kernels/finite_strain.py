@@ -16,11 +16,14 @@ Constitutive codes (``riprap.deformable.material.CONSTITUTIVE_MODELS``): 0 the s
 """
 import math
 
+import types
+
 import numpy as np
 
 from riprap._jit import inline_kernel, kernel, leaf_kernel, parallel_kernel, prange
 from riprap.deformable.kernels import contact as contact_kernels
 from riprap.deformable.kernels import joints as joint_kernels
+from riprap.deformable.kernels.bundles import SurfaceLaws
 from riprap.deformable.kernels.slots import joint_slot_sum, node_slot_sum, single_slots_of
 
 
@@ -30,7 +33,12 @@ def kirchhoff_stress(model, mu, lam, kappa, eta,
                      g00, g01, g02, g10, g11, g12, g20, g21, g22):
     """J and the Kirchhoff stress tau = J sigma (6 components xx, yy, zz, xy, yz, zx) for the
     deformation gradient F (f..) and its rate dF/dt (g..); also F's cofactor matrix (F^-T = cof / J).
-    Returns (J, t00, t11, t22, t01, t12, t20, c00, c01, c02, c10, c11, c12, c20, c21, c22)."""
+    Returns (J, t00, t11, t22, t01, t12, t20, c00, c01, c02, c10, c11, c12, c20, c21, c22).
+
+    23 arguments: the material's scalars and the 18 entries of F and dF/dt as scalars, so that the
+    inlined law stays in registers (an array per point would be allocated or reference-counted per
+    integration point).
+    """
     c00 = f11 * f22 - f12 * f21
     c01 = f12 * f20 - f10 * f22
     c02 = f10 * f21 - f11 * f20
@@ -212,13 +220,11 @@ FORCE_BLOCKS = 64
 @parallel_kernel
 def tet4_and_joint_forces(positions, velocities, tets, gradients, volumes, materials,
                           element_material, element_forces, jacobians, joint_data):
-    """:func:`tet4_element` for every element and the joints' forces (``joint_data`` as in
-    :func:`advance_steps`) in one parallel loop: both only read the positions, so one region
+    """:func:`tet4_element` for every element and the joints' forces (``joint_data``:
+    :class:`~riprap.deformable.kernels.bundles.JointData`) in one parallel loop: both only read the positions, so one region
     instead of two (each region costs the threads a wake-up)."""
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
-     joint_buffer, joint_released, joint_anchors) = (
-        joint_data[0], joint_data[1], joint_data[2], joint_data[3], joint_data[4], joint_data[5],
-        joint_data[6], joint_data[8], joint_data[10])
+     joint_buffer, _, joint_released, _, joint_anchors) = joint_data
     n_tets = tets.shape[0]
     n_joints = joint_nodes.shape[0]
     for block in prange(FORCE_BLOCKS):
@@ -264,7 +270,11 @@ def update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses, extern
     """Central-difference update of node ``n`` (see :func:`central_difference_update`) under the
     elements' force (ex, ey, ez) and the joints' (jx, jy, jz) on it; returns the work of the
     joints' force over the step and the node's squared distance from ``listed_positions`` after
-    it."""
+    it.
+
+    20 arguments: inlined per node into both node-update loops, which hand it plain arrays and
+    scalars (a bundle would be taken apart per node).
+    """
     m = masses[n]
     # nodes before ``first_loaded`` (``first_held``) have no load (no held component): they skip
     # those reads and choices (examples/11's split unit: its node update alone 80 -> 62
@@ -312,11 +322,23 @@ def update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses, extern
     return work, mx * mx + my * my + mz * mz
 
 
-@parallel_kernel
-def central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
-                              single_slots, masses, external_forces, contact_forces, gravity,
-                              mass_damping, constrained, prescribed_velocities, first_loaded,
-                              first_held, time_step, listed_positions):
+def _serial_twin(function, name):
+    """A copy of ``function`` under its own ``name``, to be compiled on one thread as the twin of
+    its parallel kernel: one body for both (``prange`` is ``range`` outside a parallel kernel).
+    The name keeps the two apart in numba's on-disk cache, which is keyed by a function's name and
+    its argument types, not by the compile options."""
+    twin = types.FunctionType(function.__code__, function.__globals__, name,
+                              function.__defaults__, function.__closure__)
+    twin.__qualname__ = name
+    twin.__module__ = function.__module__
+    twin.__doc__ = function.__doc__
+    return twin
+
+
+def _central_difference_update(positions, velocities, element_forces, node_offsets, node_slots,
+                               single_slots, masses, external_forces, contact_forces, gravity,
+                               mass_damping, constrained, prescribed_velocities, first_loaded,
+                               first_held, time_step, listed_positions):
     """Sum the element forces at every node, add loads, gravity and mass-proportional damping,
     and advance the half-step velocity and the position (central difference / leapfrog).
     Returns the largest squared distance of a node from ``listed_positions`` after it (pass
@@ -325,7 +347,13 @@ def central_difference_update(positions, velocities, element_forces, node_offset
     ``node_slots[node_offsets[n]:node_offsets[n + 1]]`` lists the flat (element, local node)
     entries of ``element_forces`` that act on node n; ``single_slots[n]`` names its one entry
     where it has only one, else -1 (``slots.single_slots_of``). Components flagged in
-    ``constrained`` take ``prescribed_velocities`` instead."""
+    ``constrained`` take ``prescribed_velocities`` instead.
+
+    17 arguments: the arrays of ``NodeState`` and the step's settings one by one, because this
+    body is also the parallel kernel's, whose threads take plain arrays.
+    ``central_difference_update_serial``: the same on one thread (small bodies: no thread
+    start-up), compiled without reference counts (``leaf_kernel``): numba took references to the
+    arrays read in ``update_node``'s branches, per node."""
     flat = element_forces.reshape((-1, 3))
     largest = 0.0
     for n in prange(positions.shape[0]):
@@ -338,36 +366,23 @@ def central_difference_update(positions, velocities, element_forces, node_offset
     return largest
 
 
-@leaf_kernel
-def central_difference_update_serial(positions, velocities, element_forces, node_offsets,
-                                     node_slots, single_slots, masses, external_forces,
-                                     contact_forces, gravity, mass_damping, constrained,
-                                     prescribed_velocities, first_loaded, first_held, time_step,
-                                     listed_positions):
-    """:func:`central_difference_update` on one thread (small bodies: no thread start-up).
-    Compiled without reference counts (``leaf_kernel``): numba took references to the arrays
-    read in ``update_node``'s branches, per node."""
-    flat = element_forces.reshape((-1, 3))
-    largest = 0.0
-    for n in range(positions.shape[0]):
-        ex, ey, ez = node_slot_sum(n, flat, single_slots, node_offsets, node_slots)
-        _, moved = update_node(n, ex, ey, ez, 0.0, 0.0, 0.0, positions, velocities, masses,
-                               external_forces, contact_forces, gravity, mass_damping,
-                               constrained, prescribed_velocities, first_loaded, first_held,
-                               time_step, listed_positions)
-        largest = max(largest, moved)
-    return largest
+central_difference_update = parallel_kernel(_central_difference_update)
+central_difference_update_serial = leaf_kernel(
+    _serial_twin(_central_difference_update, "central_difference_update_serial"))
 
 
-@parallel_kernel
-def jointed_update(positions, velocities, element_forces, node_offsets, node_slots, single_slots,
-                   masses, external_forces, contact_forces, gravity, mass_damping, constrained,
-                   prescribed_velocities, first_loaded, first_held, time_step, joint_forces,
-                   joint_slot_rows, listed_positions):
+def _jointed_update(positions, velocities, element_forces, node_offsets, node_slots, single_slots,
+                    masses, external_forces, contact_forces, gravity, mass_damping, constrained,
+                    prescribed_velocities, first_loaded, first_held, time_step, joint_forces,
+                    joint_slot_rows, listed_positions):
     """:func:`central_difference_update` with the joints' forces added (``joint_forces``: a row
     per joint vertex, ``kernels/joints.joint_forces``; ``joint_slot_rows``: the rows of each
     element slot's three faces); returns also the joints' work over the step. (A loop of its
-    own: the bodies without joints read no joint rows.)"""
+    own: the bodies without joints read no joint rows.) ``jointed_update_serial``: the same on
+    one thread, without reference counts, as ``central_difference_update_serial``.
+
+    19 arguments: as :func:`central_difference_update`, with the joints' force rows.
+    """
     flat = element_forces.reshape((-1, 3))
     work = 0.0
     largest = 0.0
@@ -383,27 +398,8 @@ def jointed_update(positions, velocities, element_forces, node_offsets, node_slo
     return work, largest
 
 
-@leaf_kernel
-def jointed_update_serial(positions, velocities, element_forces, node_offsets, node_slots,
-                          single_slots, masses, external_forces, contact_forces, gravity,
-                          mass_damping, constrained, prescribed_velocities, first_loaded,
-                          first_held, time_step, joint_forces, joint_slot_rows,
-                          listed_positions):
-    """:func:`jointed_update` on one thread (without reference counts, as
-    :func:`central_difference_update_serial`)."""
-    flat = element_forces.reshape((-1, 3))
-    work = 0.0
-    largest = 0.0
-    for n in range(positions.shape[0]):
-        ex, ey, ez, jx, jy, jz = joint_slot_sum(n, flat, joint_forces, joint_slot_rows,
-                                                single_slots, node_offsets, node_slots)
-        node_work, moved = update_node(n, ex, ey, ez, jx, jy, jz, positions, velocities, masses,
-                                       external_forces, contact_forces, gravity, mass_damping,
-                                       constrained, prescribed_velocities, first_loaded,
-                                       first_held, time_step, listed_positions)
-        work += node_work
-        largest = max(largest, moved)
-    return work, largest
+jointed_update = parallel_kernel(_jointed_update)
+jointed_update_serial = leaf_kernel(_serial_twin(_jointed_update, "jointed_update_serial"))
 
 
 @parallel_kernel
@@ -511,35 +507,29 @@ PARALLEL_PAIRS = 2000
 
 
 @kernel
-def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradients, gradients,
-                  weights, materials, element_material, element_forces, jacobians, node_offsets,
-                  node_slots, masses, external_forces, contact_forces, gravity, mass_damping,
-                  constrained, prescribed_velocities, time_step, contact, joint_data):
-    """Up to ``n_steps`` central-difference steps without returning to Python.
+def advance_steps(n_steps, parallel, nodes, element_state, gravity, mass_damping, time_step,
+                  contact, joint_data):
+    """Up to ``n_steps`` central-difference steps of ``time_step`` without returning to Python.
 
-    ``contact`` = (the triangles and tets walls act on, all contact triangles and tets, wall depth
-    per triangle, candidate (triangle, tet) pairs, penalty, walls (n, 7: point, outward normal,
-    friction coefficient), positions when the pairs were listed, skin, totals (n_walls + 1): the
-    normal force of each wall and of the body pairs at the last step, friction coefficient per
-    triangle and per tet, tangential over normal contact stiffness, tangential stiffness per tet
-    and m^2 of contact, the tangential springs of the pairs, of the wall triangles and of the
-    wall tets, the normal damping ratio per triangle and per tet).
-    ``joint_data`` = the joints between tets of fracturing bodies (``riprap/deformable/kernels/joints.py``):
-    (their six nodes, sizes, the joint materials' table, material per joint, damage, broken,
-    the buffer of their forces (a row per joint vertex, and a last row kept zero:
-    ``kernels/joints.joint_forces``) and each element slot's rows in it (elements.size, 3: one
-    per face at the slot's corner), released (broken joints whose faces slid apart: no force
-    any more), their work done on the nodes so far (1,), by the trapezoidal rule, and the
-    friction anchors of their points (n, 3, 2)); no joints: none, and a buffer of no rows.
-    Their forces are added in the node update (not to ``contact_forces``), which also sums
-    their work.
+    ``nodes``: :class:`~riprap.deformable.kernels.bundles.NodeState` (advanced in place);
+    ``element_state``: ``ElementState``; ``gravity`` (3,) m/s^2 and ``mass_damping`` (1/s) act
+    on every node. ``contact``: ``ContactState`` (no contact: no triangles). ``joint_data``: the
+    joints between tets of fracturing bodies, ``JointData`` (no joints: none, and a buffer of no
+    rows). Their forces are added in the node update (not to ``contact_forces``), which also sums
+    their work. Runs on threads where ``parallel``.
     Returns (steps done, status, element, J): status DONE; INVERTED before the update of a step in
     which ``element`` has J <= 0 (or a non-finite J); REBUILD_CONTACTS before a step once a node has
     moved half the skin since the pairs were listed."""
+    (positions, velocities, masses, external_forces, contact_forces, constrained,
+     prescribed_velocities, node_offsets, node_slots) = nodes
+    (elements, tet4_gradients, gradients, weights, materials, element_material, element_forces,
+     jacobians) = element_state
     (wall_triangles, wall_tets, triangles, contact_tets, wall_depths, pairs, penalty, walls,
      listed_positions, skin, totals, triangle_friction, tet_friction, tangential_ratio,
      tet_stiffness, pair_springs, wall_triangle_springs, wall_tet_springs, triangle_damping,
      tet_damping) = contact
+    laws = SurfaceLaws(penalty, tangential_ratio, triangle_friction, tet_friction,
+                       triangle_damping, tet_damping, tet_stiffness)
     (joint_nodes, joint_sizes, joint_properties, joint_material, joint_damage, joint_broken,
      joint_buffer, joint_slot_rows, joint_released, joint_work, joint_anchors) = joint_data
     has_joints = joint_nodes.shape[0] > 0
@@ -581,23 +571,17 @@ def advance_steps(n_steps, parallel, positions, velocities, elements, tet4_gradi
             totals[:] = 0.0
             if pairs.shape[0] >= PARALLEL_PAIRS:
                 weight, _ = contact_kernels.pair_forces_parallel(
-                    positions, triangles, contact_tets, pairs, penalty, contact_forces, velocities,
-                    masses, triangle_friction, tet_friction, triangle_damping, tet_damping,
-                    tet_stiffness, time_step, pair_springs)
+                    positions, triangles, contact_tets, pairs, contact_forces, velocities, masses,
+                    laws, time_step, pair_springs)
             else:
                 weight, _ = contact_kernels.pair_forces(
-                    positions, triangles, contact_tets, pairs, penalty, contact_forces, velocities,
-                    masses, triangle_friction, tet_friction, triangle_damping, tet_damping,
-                    tet_stiffness, time_step, pair_springs)
+                    positions, triangles, contact_tets, pairs, contact_forces, velocities, masses,
+                    laws, time_step, pair_springs)
             totals[walls.shape[0]] = weight
             for w in range(walls.shape[0]):
                 force, _ = contact_kernels.wall_forces(positions, wall_triangles, wall_tets,
-                                                       walls[w, 0:3], walls[w, 3:6], penalty,
-                                                       wall_depths, contact_forces, velocities,
-                                                       masses, triangle_friction, tet_friction,
-                                                       walls[w, 6], triangle_damping, tet_damping,
-                                                       tangential_ratio,
-                                                       tet_stiffness, time_step,
+                                                       walls[w], wall_depths, contact_forces,
+                                                       velocities, masses, laws, time_step,
                                                        wall_triangle_springs[w],
                                                        wall_tet_springs[w])
                 totals[w] = force

@@ -108,7 +108,10 @@ def _friction(tx, ty, tz, compression, tan_phi, penalty_over_h, e1x, e1y, e1z, e
     the point's anchor, no stronger than tan(phi) (-compression); where it would be, the anchor
     follows the slip (it slides: the work is dissipated, as in the contact's friction). The
     anchor is held in multiples of the joint's edges e1, e2, so it turns (and stretches) with the
-    joint."""
+    joint.
+
+    16 arguments: scalars of one joint point, inlined per point.
+    """
     if compression == 0.0:
         # faces not pressed together: no friction, and none kept (NaN: it starts afresh where
         # they are pressed again; looked at first: a store would dirty the line)
@@ -378,7 +381,11 @@ def _point_law(sx, sy, sz, nx, ny, nz, h, tensile, cohesion, penalty_over_h, sli
     intact joint whose faces are apart by (sx, sy, sz), mid-surface normal n, damage ``before``
     the step. Returns the traction, the damage after it, the slip vector and the compression (for
     the friction, ``_friction``). Every case is computed and one chosen (no branches), so that the
-    loop of ``_law_block`` runs on vector registers."""
+    loop of ``_law_block`` runs on vector registers.
+
+    17 arguments: scalars only, inlined into the vectorised law loop (arrays would stop it running
+    on vector registers).
+    """
     opening = sx * nx + sy * ny + sz * nz
     tx = sx - opening * nx
     ty = sy - opening * ny
@@ -569,7 +576,11 @@ def joint_range(start, stop, positions, joints, sizes, properties, joint_materia
     joints with two or more points at D >= 1 are marked ``broken`` (they act as broken joints
     from the next step on). Returns the number broken now. (Two loops: the broken joints' code
     inside the intact joints' loop made every joint about 15 % slower, though few joints ever
-    break: bench/joint_kernel.py.)"""
+    break: bench/joint_kernel.py.)
+
+    13 arguments: called per block inside the parallel element-and-joint loop, whose threads take
+    plain arrays (``JointData``'s fields).
+    """
     for j in range(start, stop):
         if broken[j]:
             _broken_joint(j, positions, joints, sizes, properties, joint_material, released,

@@ -25,6 +25,8 @@ with free slip (no shear), 2 open (zero gradient; no shear; mass may cross).
 Arrays are indexed [i, j, k]; a velocity component along ``axis`` has one more entry along that
 axis than the cells. Masses are in kg per step, densities kg/m^3, velocities m/s.
 """
+from collections import namedtuple
+
 import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
@@ -61,26 +63,45 @@ def transport_component(q, axis, mass_x, mass_y, mass_z, velocity_x, velocity_y,
     velocity (before the pressure correction) to ``q_out`` and the control volume's new density to
     ``density_out`` for every interior node; boundary nodes along ``axis`` are copied unchanged.
     All arrays C-contiguous float64.
+
+    17 arguments: the solver's 3D fields as the public entry; it bundles them for
+    :func:`_transport_flat`.
     """
     masses = (mass_x, mass_y, mass_z)
     velocities = (velocity_x, velocity_y, velocity_z)
     face_strides = np.stack([_strides(m) for m in masses])
-    _transport_flat(q.reshape(-1), np.array(q.shape, dtype=np.int64), _strides(q), int(axis),
-                    mass_x.reshape(-1), mass_y.reshape(-1), mass_z.reshape(-1),
-                    velocities[0].reshape(-1), velocities[1].reshape(-1), velocities[2].reshape(-1),
-                    face_strides, cell_density.reshape(-1), cell_viscosity.reshape(-1),
-                    np.array(cell_density.shape, dtype=np.int64), _strides(cell_density),
-                    np.asarray(boundary_kind, dtype=np.int64), float(h), float(dt),
-                    float(gravity_component), bool(two_dimensional), q_out.reshape(-1),
+    component = Component(q.reshape(-1), np.array(q.shape, dtype=np.int64), _strides(q), int(axis))
+    faces = FaceFlow(mass_x.reshape(-1), mass_y.reshape(-1), mass_z.reshape(-1),
+                     velocities[0].reshape(-1), velocities[1].reshape(-1),
+                     velocities[2].reshape(-1), face_strides)
+    cells = CellFields(cell_density.reshape(-1), cell_viscosity.reshape(-1),
+                       np.array(cell_density.shape, dtype=np.int64), _strides(cell_density))
+    _transport_flat(component, faces, cells, np.asarray(boundary_kind, dtype=np.int64), float(h),
+                    float(dt), float(gravity_component), bool(two_dimensional), q_out.reshape(-1),
                     density_out.reshape(-1))
 
 
+#: One velocity component in flat storage: its values, its nodes per axis (3,), its element
+#: strides (3,) and the axis it points along.
+Component = namedtuple("Component", ["values", "shape", "stride", "axis"])
+#: The faces' flow over the step, flat: the mass (kg) across each x, y, z face, the face velocities
+#: at the start, and the element strides of each face array (3, 3).
+FaceFlow = namedtuple("FaceFlow", ["mass_x", "mass_y", "mass_z", "velocity_x", "velocity_y",
+                                   "velocity_z", "stride"])
+#: The cells' density and viscosity at the start, flat, with their count per axis and strides.
+CellFields = namedtuple("CellFields", ["density", "viscosity", "shape", "stride"])
+
+
 @parallel_kernel
-def _transport_flat(q, shape, q_stride, axis, mass_x, mass_y, mass_z, velocity_x, velocity_y,
-                    velocity_z, face_stride, cell_density, cell_viscosity, cells, cell_stride,
-                    boundary_kind, h, dt, gravity_component, two_dimensional, q_out, density_out):
+def _transport_flat(component, faces, cells_bundle, boundary_kind, h, dt, gravity_component,
+                    two_dimensional, q_out, density_out):
     """Flat-index form of :func:`transport_component`: every neighbour is a fixed offset (the
-    strides of its array along x, y, z), so the inner loop does no tuple indexing."""
+    strides of its array along x, y, z), so the inner loop does no tuple indexing. The bundles
+    (:class:`Component`, :class:`FaceFlow`, :class:`CellFields`) are taken apart here, outside
+    the parallel loop, which then reads plain arrays as before."""
+    q, shape, q_stride, axis = component
+    mass_x, mass_y, mass_z, velocity_x, velocity_y, velocity_z, face_stride = faces
+    cell_density, cell_viscosity, cells, cell_stride = cells_bundle
     volume = h * h * h
     a_q = q_stride[axis]
     a_c = cell_stride[axis]

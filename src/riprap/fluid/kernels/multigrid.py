@@ -861,6 +861,9 @@ def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tol
     Stops when ||r||_2 <= tolerance ||system_rhs||_2, with r re-evaluated as system_rhs - L
     pressure before stopping (CG restarts from it if the recurrence had drifted). Returns
     (iterations, relative residual of the returned pressure, outcome code).
+
+    13 arguments: the ``Hierarchy`` bundle, the CG's own work arrays (written) and its settings;
+    the work arrays are allocated once per solver, not per solve.
     """
     beta_x = face_array(hierarchy.beta_x, hierarchy, 0, 0)
     beta_y = face_array(hierarchy.beta_y, hierarchy, 0, 1)

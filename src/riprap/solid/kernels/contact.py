@@ -27,6 +27,7 @@ barycentric maps, triangle clusters and the tet lookup grid are precomputed (``s
 import numpy as np
 
 from riprap._jit import kernel, leaf_kernel
+from riprap.solid.kernels.bundles import PairWork, Scratch
 from riprap.solid.kernels.geometry_ops import (MAX_POLYGON, clip_polygon, integrate_linear_on_polygon,
                                                integrate_tet_potential_on_polygon,
                                                integrate_tet_potential_on_triangle, mat3_mul_transposed,
@@ -58,43 +59,42 @@ R_SIZE = 22
 
 @kernel
 def make_scratch(max_tets):
-    """Work arrays of one thread, allocated once per batch of pairs (allocation inside the pair
-    loop costs more than the geometry)."""
-    return (np.empty((MAX_POLYGON, 7)), np.empty((MAX_POLYGON, 7)), np.empty((MAX_POLYGON, 7)),
-            np.empty(MAX_POLYGON), np.zeros(6), np.empty((3, 3)), np.empty((3, 4)), np.empty(3),
-            np.empty(3), np.empty(MAX_CANDIDATE_TETS, dtype=np.int64),
-            np.full(max(max_tets, 1), -1, dtype=np.int64), np.zeros(1, dtype=np.int64),
-            np.empty(3), np.empty(3), np.empty(3, dtype=np.int64), np.empty(3, dtype=np.int64),
-            np.zeros(R_SIZE), np.empty(4), np.empty((MAX_PAIR_PIECES, 2), dtype=np.int64),
-            np.empty((3, MAX_POLYGON, 2)))
+    """Work arrays of one thread (:class:`~riprap.solid.kernels.bundles.Scratch`), allocated once
+    per batch of pairs (allocation inside the pair loop costs more than the geometry)."""
+    work = PairWork(np.empty(MAX_POLYGON), np.zeros(6), np.empty((3, 3)), np.empty((3, 4)),
+                    np.empty(3), np.empty((3, MAX_POLYGON, 2)), np.zeros(R_SIZE))
+    return Scratch(np.empty((MAX_POLYGON, 7)), np.empty((MAX_POLYGON, 7)),
+                   np.empty((MAX_POLYGON, 7)), work, np.empty(3),
+                   np.empty(MAX_CANDIDATE_TETS, dtype=np.int64),
+                   np.full(max(max_tets, 1), -1, dtype=np.int64), np.zeros(1, dtype=np.int64),
+                   np.empty(3), np.empty(3), np.empty(3, dtype=np.int64),
+                   np.empty(3, dtype=np.int64), np.empty(4),
+                   np.empty((MAX_PAIR_PIECES, 2), dtype=np.int64))
 
 
-@kernel
-def pair_work_arrays(scratch):
-    """The work arrays of :func:`pair_force_from_pieces` out of ``make_scratch``'s tuple
-    (signed, moments, vertices, lam, normal, polygons, res): taken once per batch of pairs."""
-    return scratch[3], scratch[4], scratch[5], scratch[6], scratch[7], scratch[19], scratch[16]
-
-
-@kernel
-def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
-                   node_offset, nodes, tet_offset, tets, barycentric,
-                   triangle_offset, triangles, triangle_normals, triangle_centres,
-                   triangle_radii, cluster_offset, cluster_begin, cluster_end,
-                   cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
-                   cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets,
-                   cell_clearance, local_box_min, local_box_max, tet_boxes, scratch,
+@leaf_kernel
+def collect_pieces(surface_shape, potential_shape, rotation, translation, skin, shapes, scratch,
                    pieces, n_pieces, result):
     """List the (boundary triangle of the surface body, tet of the potential body) pairs that
     can overlap, appending rows (local triangle, local tet) to ``pieces`` from row ``n_pieces``;
-    returns the new row count.
+    returns the new row count. ``shapes``: :class:`~riprap.solid.kernels.bundles.Shapes`;
+    ``scratch``: ``make_scratch``'s work arrays.
 
     With ``skin`` > 0 every test is widened by ``skin`` (m): the list then holds every pair that can
     overlap after the surface body has moved, relative to the potential body, by up to ``skin`` at
     every point, so that it can be reused for as long as the relative motion stays below that.
     Widening only adds pairs, whose integral is exactly zero, so the force does not depend on it.
     Rows come out ordered by triangle, then tet, whatever the skin.
+
+    A leaf kernel (no reference counts): it is called twice per pair, and taking a reference to
+    each of the bundles' arrays on every call would cost more than reading them.
     """
+    node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles, \
+        triangle_normals = shapes.mesh
+    (triangle_centres, triangle_radii, cluster_offset, cluster_begin, cluster_end, cluster_centres,
+     cluster_radii, grid_origin, grid_cell_size, grid_dims, cell_offset, cell_start_offset,
+     cell_start, cell_tets_offset, cell_tets, cell_clearance, local_box_min, local_box_max, _,
+     tet_boxes, _) = shapes.lookup
     sp = potential_shape
     ss = surface_shape
     origin = grid_origin[sp]
@@ -102,11 +102,6 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
     nx = grid_dims[sp, 0]
     ny = grid_dims[sp, 1]
     nz = grid_dims[sp, 2]
-    box_lo = origin
-    box_hi = np.empty(3)
-    box_hi[0] = origin[0] + nx * cell
-    box_hi[1] = origin[1] + ny * cell
-    box_hi[2] = origin[2] + nz * cell
     coff = cell_offset[sp]
     csoff = cell_start_offset[sp]
     ctoff = cell_tets_offset[sp]
@@ -116,8 +111,9 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
     troff = triangle_offset[ss]
     capacity = pieces.shape[0]
 
-    (_, _, _, _, _, vertices, lam, normal, centre, candidates, stamp,
-     counter, tri_lo, tri_hi, i_lo, i_hi, _, _, _, _) = scratch
+    _, _, vertices, lam, normal, _, _ = scratch.work
+    (_, _, _, _, centre, candidates, stamp, counter, tri_lo, tri_hi, i_lo, i_hi, _,
+     _) = scratch
     # the potential body's box, taken once: a slice per call in the loops below cost an atomic
     # reference count each way, shared by the threads
     shape_lo = local_box_min[sp]
@@ -129,7 +125,7 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
         for c in range(3):
             centre[c] = (rotation[c, 0] * cluster_centres[cl, 0] + rotation[c, 1] * cluster_centres[cl, 1]
                          + rotation[c, 2] * cluster_centres[cl, 2] + translation[c])
-        if _sphere_far(centre, cluster_radii[cl] + skin, box_lo, box_hi, origin, cell, nx, ny, nz,
+        if _sphere_far(centre, cluster_radii[cl] + skin, origin, cell, nx, ny, nz,
                        cell_clearance, coff, shape_lo, shape_hi):
             continue
         for tri_local in range(cluster_begin[cl], cluster_end[cl]):
@@ -137,8 +133,8 @@ def collect_pieces(surface_shape, potential_shape, rotation, translation, skin,
             for c in range(3):
                 centre[c] = (rotation[c, 0] * triangle_centres[tri, 0] + rotation[c, 1] * triangle_centres[tri, 1]
                              + rotation[c, 2] * triangle_centres[tri, 2] + translation[c])
-            if _sphere_far(centre, triangle_radii[tri] + skin, box_lo, box_hi, origin, cell, nx, ny,
-                           nz, cell_clearance, coff, shape_lo, shape_hi):
+            if _sphere_far(centre, triangle_radii[tri] + skin, origin, cell, nx, ny, nz,
+                           cell_clearance, coff, shape_lo, shape_hi):
                 continue
             _place_triangle(rotation, translation, nodes, noff_s, triangles, triangle_normals, tri,
                             vertices, normal)
@@ -251,15 +247,17 @@ def _separated(barycentric, t, vertices, normal, nodes, noff_p, tets, skin, lam)
 
 
 @leaf_kernel
-def integrate_pieces(surface_shape, potential_shape, rotation, translation, penalty, pieces, first,
-                     last, node_offset, nodes, tet_offset, tets, barycentric, triangle_offset,
-                     triangles, triangle_normals, signed, moments, vertices, lam, normal, polygons,
-                     result):
+def integrate_pieces(surface_shape, potential_shape, rotation, translation, penalty, mesh, work,
+                     pieces, first, last):
     """Integrate the potential of ``potential_shape`` over the listed (triangle, tet) pieces of
     ``surface_shape``'s boundary (rows ``first:last`` of ``pieces``), at the relative pose
-    ``rotation``, ``translation``. Adds to ``result`` (layout R_*) in the potential body's frame.
-    ``signed`` .. ``polygons``: work arrays (``make_scratch``'s 3, 4, 5, 6, 7 and 19), passed one
-    by one: a tuple unpacked per pair cost an atomic reference count per array each way."""
+    ``rotation``, ``translation``. Adds to ``work.res`` (layout R_*) in the potential body's
+    frame. ``mesh``: :class:`~riprap.solid.kernels.bundles.ShapeMesh`; ``work``:
+    :class:`~riprap.solid.kernels.bundles.PairWork`. A leaf kernel: its bundles cost no reference
+    counts, though it runs once per direction of every pair."""
+    node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles, \
+        triangle_normals = mesh
+    signed, moments, vertices, lam, normal, polygons, result = work
     sp = potential_shape
     ss = surface_shape
     noff_s = node_offset[ss]
@@ -353,8 +351,7 @@ def _store_spread(total, weight, point, out):
 
 
 @leaf_kernel
-def _sphere_far(centre, radius, box_lo, box_hi, origin, cell, nx, ny, nz, clearance, coff,
-                shape_lo, shape_hi):
+def _sphere_far(centre, radius, origin, cell, nx, ny, nz, clearance, coff, shape_lo, shape_hi):
     """True when a sphere cannot touch the body (outside its box, or in a cell far from it)."""
     gap2 = 0.0
     for c in range(3):
@@ -376,31 +373,31 @@ def _sphere_far(centre, radius, box_lo, box_hi, origin, cell, nx, ny, nz, cleara
 
 @kernel
 def body_pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
-                              penalty, shape_arrays, out):
+                              penalty, shapes, out):
     """Potential (normal) contact between two rigid bodies, both directions of the boundary form.
+    ``shapes``: :class:`~riprap.solid.kernels.bundles.Shapes`.
 
     ``out`` (14,): [0:3] force on A (world), [3:6] torque on A about its centroid, [6:9] torque on B
     about its centroid, [9:12] force-weighted contact point, [12] stiffness (N/m), [13] overflow.
     """
-    scratch = make_scratch(shape_arrays[3].shape[0])
+    scratch = make_scratch(shapes.mesh.tets.shape[0])
     full = np.zeros(OUT_SIZE)
     pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b, penalty,
-                         shape_arrays, scratch, full)
+                         shapes, scratch, full)
     for i in range(min(out.shape[0], OUT_SIZE)):
         out[i] = full[i]
 
 
 @kernel
 def pair_potential_force(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
-                         penalty, shape_arrays, scratch, out):
+                         penalty, shapes, scratch, out):
     """:func:`body_pair_potential_force` with caller-provided work arrays; ``out`` (OUT_SIZE,)."""
-    pieces = scratch[18]
+    pieces = scratch.pieces
     split, last, overflow = collect_pair_pieces(shape_a, shape_b, position_a, rotation_a,
-                                                position_b, rotation_b, 0.0, shape_arrays,
+                                                position_b, rotation_b, 0.0, shapes,
                                                 scratch, pieces, 0)
     pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
-                           penalty, *shape_arrays[:8], *pair_work_arrays(scratch), pieces, 0, split,
-                           last, out)
+                           penalty, shapes.mesh, scratch.work, pieces, 0, split, last, out)
     out[13] += overflow
 
 
@@ -414,45 +411,34 @@ def relative_pose(position_a, rotation_a, position_b, rotation_b):
 
 @kernel
 def collect_pair_pieces(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b, skin,
-                        shape_arrays, scratch, pieces, first):
+                        shapes, scratch, pieces, first):
     """The (triangle, tet) pieces of both directions of a pair (:func:`collect_pieces`), written
     to ``pieces`` from row ``first``: A's triangles in B's tets, then B's in A's.
     Returns (row where the second direction starts, row after the last, overflow count)."""
-    (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
-     triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
-     cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
-     cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets, cell_clearance,
-     local_box_min, local_box_max, wall_potential_depth, tet_boxes) = shape_arrays
     rotation_1, translation_1, rotation_2, translation_2 = relative_pose(position_a, rotation_a,
                                                                           position_b, rotation_b)
-    counters = scratch[16]
+    counters = scratch.work.res
     counters[:] = 0.0
-    split = collect_pieces(shape_a, shape_b, rotation_1, translation_1, skin, node_offset, nodes,
-                           tet_offset, tets, barycentric, triangle_offset, triangles,
-                           triangle_normals, triangle_centres, triangle_radii, cluster_offset,
-                           cluster_begin, cluster_end, cluster_centres, cluster_radii,
-                           grid_origin, grid_cell_size, grid_dims, cell_offset, cell_start_offset,
-                           cell_start, cell_tets_offset, cell_tets, cell_clearance, local_box_min,
-                           local_box_max, tet_boxes, scratch, pieces, first, counters)
-    last = collect_pieces(shape_b, shape_a, rotation_2, translation_2, skin, node_offset, nodes,
-                          tet_offset, tets, barycentric, triangle_offset, triangles,
-                          triangle_normals, triangle_centres, triangle_radii, cluster_offset,
-                          cluster_begin, cluster_end, cluster_centres, cluster_radii,
-                          grid_origin, grid_cell_size, grid_dims, cell_offset, cell_start_offset,
-                          cell_start, cell_tets_offset, cell_tets, cell_clearance, local_box_min,
-                          local_box_max, tet_boxes, scratch, pieces, split, counters)
+    split = collect_pieces(shape_a, shape_b, rotation_1, translation_1, skin, shapes, scratch,
+                           pieces, first, counters)
+    last = collect_pieces(shape_b, shape_a, rotation_2, translation_2, skin, shapes, scratch,
+                          pieces, split, counters)
     return split, last, counters[R_OVERFLOW]
 
 
 @kernel
 def pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b, rotation_b,
-                           penalty, node_offset, nodes, tet_offset, tets, barycentric,
-                           triangle_offset, triangles, triangle_normals, signed, moments, vertices,
-                           lam, normal, polygons, res, pieces, first, split, last, out):
+                           penalty, mesh, work, pieces, first, split, last, out):
     """Potential contact of a pair from its listed pieces (rows ``first:split`` A's triangles in
     B's tets, ``split:last`` B's in A's); ``out`` (OUT_SIZE,) as for
-    :func:`body_pair_potential_force`. ``node_offset`` .. ``triangle_normals``: the first eight
-    shape arrays; ``signed`` .. ``res``: work arrays (``pair_work_arrays``)."""
+    :func:`body_pair_potential_force`. ``mesh``: the shapes'
+    :class:`~riprap.solid.kernels.bundles.ShapeMesh` (not the whole ``Shapes``: called per pair,
+    it takes a reference to each array it is given); ``work``: ``make_scratch``'s
+    :class:`~riprap.solid.kernels.bundles.PairWork`.
+
+    14 arguments: the two bodies' (shape, position, rotation) and the pair's penalty are per-pair
+    scalars and views that change every call; bundling them would build a tuple per pair."""
+    res = work.res
     for i in range(OUT_SIZE):
         out[i] = 0.0
     weight = 0.0
@@ -465,9 +451,8 @@ def pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b,
                                                                           position_b, rotation_b)
     # Direction 1: A's surface in B's potential, evaluated in B's frame.
     res[:] = 0.0
-    integrate_pieces(shape_a, shape_b, rotation_1, translation_1, penalty, pieces, first, split,
-                     node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
-                     triangle_normals, signed, moments, vertices, lam, normal, polygons, res)
+    integrate_pieces(shape_a, shape_b, rotation_1, translation_1, penalty, mesh, work, pieces,
+                     first, split)
     force1 = mat3_vec(rotation_b, res[R_FORCE:R_FORCE + 3])          # on A
     moment1 = mat3_vec(rotation_b, res[R_MOMENT:R_MOMENT + 3])       # about B's centroid
     # torque on A about its centroid: moment about B's centroid + (x_B - x_A) x F
@@ -483,9 +468,8 @@ def pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b,
     area += res[R_AREA]
     # Direction 2: B's surface in A's potential, evaluated in A's frame.
     res[:] = 0.0
-    integrate_pieces(shape_b, shape_a, rotation_2, translation_2, penalty, pieces, split, last,
-                     node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
-                     triangle_normals, signed, moments, vertices, lam, normal, polygons, res)
+    integrate_pieces(shape_b, shape_a, rotation_2, translation_2, penalty, mesh, work, pieces,
+                     split, last)
     force2 = mat3_vec(rotation_a, res[R_FORCE:R_FORCE + 3])          # on B
     moment2 = mat3_vec(rotation_a, res[R_MOMENT:R_MOMENT + 3])       # about A's centroid
     force_a -= force2
@@ -511,12 +495,12 @@ def pair_force_from_pieces(shape_a, shape_b, position_a, rotation_a, position_b,
 
 @kernel
 def body_wall_potential_force(shape, position, rotation, wall_point, wall_normal, penalty,
-                              shape_arrays, out):
+                              shapes, out):
     """Potential contact between a rigid body and a half-space wall (see
     :func:`wall_potential_force`)."""
     scratch = make_scratch(1)
     full = np.zeros(OUT_SIZE)
-    wall_potential_force(shape, position, rotation, wall_point, wall_normal, penalty, shape_arrays,
+    wall_potential_force(shape, position, rotation, wall_point, wall_normal, penalty, shapes,
                          scratch, full)
     for i in range(min(out.shape[0], OUT_SIZE)):
         out[i] = full[i]
@@ -524,21 +508,22 @@ def body_wall_potential_force(shape, position, rotation, wall_point, wall_normal
 
 @kernel
 def wall_potential_force(shape, position, rotation, wall_point, wall_normal, penalty,
-                         shape_arrays, scratch, out):
+                         shapes, scratch, out):
     """Potential contact between a rigid body and a half-space wall.
 
     The wall is {x : n.(x - point) < 0}; its potential rises linearly with depth over the body's
     ``wall_potential_depth`` (as if the wall were meshed like the body). Boundary form:
     F = -p int_{dA in wall} phi_W n_A dS + p int_{wall plane in A} phi_A n dS.
-    ``out`` as for :func:`body_pair_potential_force` with [6:9] unused.
+    ``shapes``: :class:`~riprap.solid.kernels.bundles.Shapes`; ``out`` as for
+    :func:`body_pair_potential_force` with [6:9] unused.
     """
     area = 0.0
     local_second = np.zeros(6)
     (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
-     triangle_normals, triangle_centres, triangle_radii, cluster_offset, cluster_begin,
-     cluster_end, cluster_centres, cluster_radii, grid_origin, grid_cell_size, grid_dims,
-     cell_offset, cell_start_offset, cell_start, cell_tets_offset, cell_tets, cell_clearance,
-     local_box_min, local_box_max, wall_potential_depth, tet_boxes) = shape_arrays
+     triangle_normals) = shapes.mesh
+    triangle_centres = shapes.lookup.triangle_centres
+    triangle_radii = shapes.lookup.triangle_radii
+    wall_potential_depth = shapes.lookup.wall_potential_depth
     for i in range(OUT_SIZE):
         out[i] = 0.0
     # The plane in the body frame: n_b . y = offset; inside the wall where n_b . y < offset.
@@ -552,11 +537,11 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
     point = np.zeros(3)
     weight = 0.0
     stiffness = 0.0
-    polygon = scratch[0]
-    work_a = scratch[1]
-    work_b = scratch[2]
-    signed = scratch[3]
-    moments = scratch[4]
+    polygon = scratch.polygon
+    work_a = scratch.work_a
+    work_b = scratch.work_b
+    signed = scratch.work.signed
+    moments = scratch.work.moments
     noff = node_offset[shape]
     # (i) boundary triangles inside the wall, weighted by the wall potential depth / h_wall.
     for tri in range(triangle_offset[shape], triangle_offset[shape + 1]):
@@ -596,7 +581,7 @@ def wall_potential_force(shape, position, rotation, wall_point, wall_normal, pen
         area += moments[4]
     # (ii) the wall plane inside the body's tets, weighted by the body's potential.
     toff = tet_offset[shape]
-    depths = scratch[17]
+    depths = scratch.depths
     for t_local in range(tet_offset[shape + 1] - toff):
         t = toff + t_local
         n_in = 0

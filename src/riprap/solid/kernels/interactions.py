@@ -25,8 +25,10 @@ The damping and friction forces act at the force-weighted contact point.
 import numpy as np
 
 from riprap._jit import kernel, parallel_kernel, prange
+from riprap.solid.kernels.bundles import (Candidate, CandidateOutputs, PieceCache, RigidSystem,
+                                          Shapes)
 from riprap.solid.kernels.contact import (OUT_SIZE, collect_pair_pieces, make_scratch,
-                                          pair_force_from_pieces, pair_work_arrays, relative_pose,
+                                          pair_force_from_pieces, relative_pose,
                                           wall_potential_force)
 from riprap.solid.kernels.geometry_ops import rotation_matrix
 
@@ -54,21 +56,22 @@ SOURCE_FRESH = 2    # rows of this step's fresh buffer
 
 
 @kernel
-def evaluate_candidates(body_pairs, wall_pairs, positions, quaternions, velocities, omegas,
-                        shape_index, material_index, inverse_masses, wall_points, wall_normals,
-                        wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
-                        pair_tangential_ratio, history_keys, history_springs, key_stride, step,
-                        piece_cache, skin, bounding_radius, shape_arrays):
-    """Evaluate every candidate body-body and body-wall pair.
+def evaluate_candidates(body_pairs, wall_pairs, system, motion, omegas, history, settings,
+                        piece_cache):
+    """Evaluate every candidate body-body and body-wall pair of ``system``
+    (:class:`~riprap.solid.kernels.bundles.RigidSystem`) at ``motion`` (``Motion``) with angular
+    velocities ``omegas``, the contacts' spring ``history`` (``History``) and the step's
+    ``settings`` (``StepSettings``: the time step and the skin are read).
 
     Returns (results (n_candidates, C_SIZE), the piece cache for the next step).
 
-    ``piece_cache`` = (keys, poses, bounds, pieces): for each body pair evaluated last step (sorted
-    pair keys), the relative pose at which its (triangle, tet) pieces were listed with the widening
-    ``skin`` (m), and its rows [start, split, end) of ``pieces``. A pair whose surfaces have moved
-    less than ``skin`` relative to each other since then reuses its list; otherwise the list is
-    made again (:func:`riprap.solid.kernels.contact.collect_pieces`). Reuse does not change the
-    force, not even its round-off: lists are ordered canonically and extra pieces add exactly zero.
+    ``piece_cache`` (``PieceCache``: keys, poses, bounds, pieces): for each body pair evaluated
+    last step (sorted pair keys), the relative pose at which its (triangle, tet) pieces were listed
+    with the widening ``skin`` (m), and its rows [start, split, end) of ``pieces``. A pair whose
+    surfaces have moved less than ``skin`` relative to each other since then reuses its list;
+    otherwise the list is made again (:func:`riprap.solid.kernels.contact.collect_pieces`). Reuse
+    does not change the force, not even its round-off: lists are ordered canonically and extra
+    pieces add exactly zero.
 
     Few candidates are done on the calling thread (waking the thread pool costs more than they
     do); the serial loop lives outside the parallel function because numba leaked the work arrays
@@ -83,36 +86,34 @@ def evaluate_candidates(body_pairs, wall_pairs, positions, quaternions, velociti
     bounds = np.zeros((n_body_pairs, 3), dtype=np.int64)
     poses = np.empty((n_body_pairs, 12))
     per_batch = (n_body_pairs + n_batches - 1) // n_batches
-    capacity = 8192 + 2 * (piece_cache[3].shape[0] // n_batches) + 128 * per_batch
+    capacity = 8192 + 2 * (piece_cache.pieces.shape[0] // n_batches) + 128 * per_batch
     fresh = np.empty((n_batches * capacity, 2), dtype=np.int64)
+    outputs = CandidateOutputs(results, fresh, capacity, source, bounds, poses)
     if n_batches == 1:
-        _evaluate_range(0, 0, n_total, body_pairs, wall_pairs, positions, quaternions,
-                        velocities, omegas, shape_index, material_index, inverse_masses,
-                        wall_points, wall_normals, wall_materials, pair_penalty, pair_friction,
-                        pair_damping_ratio, pair_tangential_ratio, history_keys, history_springs,
-                        key_stride, step, piece_cache, skin, bounding_radius, shape_arrays,
-                        fresh, capacity, source, bounds, poses, results)
+        _evaluate_range(0, 0, n_total, body_pairs, wall_pairs, system, motion, omegas, history,
+                        settings, piece_cache, outputs)
     else:
-        _evaluate_parallel(n_batches, body_pairs, wall_pairs, positions, quaternions, velocities,
-                           omegas, shape_index, material_index, inverse_masses, wall_points,
-                           wall_normals, wall_materials, pair_penalty, pair_friction,
-                           pair_damping_ratio, pair_tangential_ratio, history_keys,
-                           history_springs, key_stride, step, piece_cache, skin, bounding_radius,
-                           shape_arrays, fresh, capacity, source, bounds, poses, results)
-    return results, _next_piece_cache(body_pairs, key_stride, piece_cache, fresh, source, bounds,
-                                      poses)
+        _evaluate_parallel(n_batches, body_pairs, wall_pairs, system.bodies, system.shapes.mesh,
+                           system.shapes.lookup, system.walls, system.laws, motion, omegas,
+                           history, settings, piece_cache, outputs)
+    key_stride = motion.positions.shape[0] + system.walls.points.shape[0]
+    return results, _next_piece_cache(body_pairs, key_stride, piece_cache, outputs)
 
 
 @kernel
 def empty_piece_cache():
-    return (np.zeros(0, dtype=np.int64), np.zeros((0, 12)), np.zeros((0, 3), dtype=np.int64),
-            np.zeros((0, 2), dtype=np.int64))
+    return PieceCache(np.zeros(0, dtype=np.int64), np.zeros((0, 12)),
+                      np.zeros((0, 3), dtype=np.int64), np.zeros((0, 2), dtype=np.int64))
 
 
 @kernel
-def _next_piece_cache(body_pairs, key_stride, piece_cache, fresh, source, bounds, poses):
+def _next_piece_cache(body_pairs, key_stride, piece_cache, outputs):
     """Gather the kept piece lists into a new cache ordered by pair key."""
     old_keys, old_poses, old_bounds, old_pieces = piece_cache
+    fresh = outputs.fresh
+    source = outputs.source
+    bounds = outputs.bounds
+    poses = outputs.poses
     n = body_pairs.shape[0]
     n_kept = 0
     all_old = True
@@ -159,42 +160,47 @@ def _next_piece_cache(body_pairs, key_stride, piece_cache, fresh, source, bounds
                 new_pieces[row + r, 0] = fresh[first + r, 0]
                 new_pieces[row + r, 1] = fresh[first + r, 1]
         row += count
-    return new_keys, new_poses, new_bounds, new_pieces
+    return PieceCache(new_keys, new_poses, new_bounds, new_pieces)
 
 
 @parallel_kernel
-def _evaluate_parallel(n_batches, body_pairs, wall_pairs, positions, quaternions, velocities,
-                       omegas, shape_index, material_index, inverse_masses, wall_points,
-                       wall_normals, wall_materials, pair_penalty, pair_friction,
-                       pair_damping_ratio, pair_tangential_ratio, history_keys, history_springs,
-                       key_stride, step, piece_cache, skin, bounding_radius, shape_arrays, fresh,
-                       capacity, source, bounds, poses, results):
+def _evaluate_parallel(n_batches, body_pairs, wall_pairs, bodies, mesh, lookup, walls, laws,
+                       motion, omegas, history, settings, piece_cache, outputs):
     """Contiguous batches of candidates in parallel, each batch with its own work arrays and its
-    own part of the fresh piece buffer."""
-    n_total = results.shape[0]
+    own part of the fresh piece buffer.
+
+    Takes the system's parts (``RigidSystem`` fields, the shapes as mesh and lookup) one by one:
+    numba's parallel loop passes a bundle of arrays to its threads only when it is an argument of
+    the function, not a bundle of bundles nor one taken out of another. Each batch puts the
+    system together again (a struct of pointers, no copy)."""
+    n_total = outputs.results.shape[0]
     for batch in prange(n_batches):
         _evaluate_range(batch, batch * n_total // n_batches, (batch + 1) * n_total // n_batches,
-                        body_pairs, wall_pairs, positions, quaternions, velocities, omegas,
-                        shape_index, material_index, inverse_masses, wall_points, wall_normals,
-                        wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
-                        pair_tangential_ratio, history_keys, history_springs, key_stride, step,
-                        piece_cache, skin, bounding_radius, shape_arrays, fresh, capacity, source,
-                        bounds, poses, results)
+                        body_pairs, wall_pairs,
+                        RigidSystem(bodies, Shapes(mesh, lookup), walls, laws), motion, omegas,
+                        history, settings, piece_cache, outputs)
 
 
 @kernel
-def _evaluate_range(batch, first, last, body_pairs, wall_pairs, positions, quaternions,
-                    velocities, omegas, shape_index, material_index, inverse_masses, wall_points,
-                    wall_normals, wall_materials, pair_penalty, pair_friction, pair_damping_ratio,
-                    pair_tangential_ratio, history_keys, history_springs, key_stride, step,
-                    piece_cache, skin, bounding_radius, shape_arrays, fresh, capacity, source,
-                    bounds, poses, results):
-    scratch = make_scratch(shape_arrays[3].shape[0])
-    # the arrays the pair loop needs, out of their tuples once: a tuple unpacked per pair cost an
+def _evaluate_range(batch, first, last, body_pairs, wall_pairs, system, motion, omegas, history,
+                    settings, piece_cache, outputs):
+    """Candidates ``first:last`` (body pairs, then wall pairs) on one thread, with work arrays
+    of their own and rows ``batch * capacity`` on of the fresh piece buffer; arguments as for
+    :func:`evaluate_candidates`."""
+    # the arrays the pair loop needs, out of their bundles once: a bundle read per pair cost an
     # atomic reference count per array each way, shared with the other threads
-    (node_offset, nodes, tet_offset, tets, barycentric, triangle_offset, triangles,
-     triangle_normals) = shape_arrays[:8]
-    signed, moments, vertices, lam, normal, polygons, res = pair_work_arrays(scratch)
+    _, shapes, walls, laws = system
+    _, inverse_masses, _, _, shape_index, material_index = system.bodies
+    mesh = shapes.mesh
+    bounding_radius = shapes.lookup.bounding_radius
+    positions, quaternions, velocities, _, _, _ = motion
+    wall_points, wall_normals, wall_materials = walls
+    pair_penalty = laws.penalty
+    _, _, _, step, _, skin = settings
+    results, fresh, capacity, source, bounds, poses = outputs
+    scratch = make_scratch(mesh.tets.shape[0])
+    work = scratch.work
+    key_stride = positions.shape[0] + wall_points.shape[0]
     out = np.zeros(OUT_SIZE)
     n_body_pairs = body_pairs.shape[0]
     cache_keys, cache_poses, cache_bounds, cache_pieces = piece_cache
@@ -218,26 +224,20 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, positions, quate
                     and _within_skin(rotation_1, translation_1, cache_poses[idx],
                                      bounding_radius[shape_i], bounding_radius[shape_j], skin)):
                 pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, positions[j], r_j,
-                                       penalty, node_offset, nodes, tet_offset, tets,
-                                       barycentric, triangle_offset, triangles, triangle_normals,
-                                       signed, moments, vertices, lam, normal, polygons, res,
-                                       cache_pieces, cache_bounds[idx, 0], cache_bounds[idx, 1],
-                                       cache_bounds[idx, 2], out)
+                                       penalty, mesh, work, cache_pieces, cache_bounds[idx, 0],
+                                       cache_bounds[idx, 1], cache_bounds[idx, 2], out)
                 source[k] = SOURCE_OLD
                 for c in range(3):
                     bounds[k, c] = cache_bounds[idx, c]
                 poses[k] = cache_poses[idx]
                 overflow = 0.0
             else:
-                pieces = scratch[18]
+                pieces = scratch.pieces
                 split, end, overflow = collect_pair_pieces(shape_i, shape_j, positions[i], r_i,
-                                                           positions[j], r_j, skin, shape_arrays,
+                                                           positions[j], r_j, skin, shapes,
                                                            scratch, pieces, 0)
                 pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, positions[j], r_j,
-                                       penalty, node_offset, nodes, tet_offset, tets,
-                                       barycentric, triangle_offset, triangles, triangle_normals,
-                                       signed, moments, vertices, lam, normal, polygons, res,
-                                       pieces, 0, split, end, out)
+                                       penalty, mesh, work, pieces, 0, split, end, out)
                 if skin > 0.0 and overflow == 0.0 and used + end <= capacity:
                     row = buffer_start + used
                     for r in range(end):
@@ -262,15 +262,13 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, positions, quate
             mj = wall_materials[wall]
             r_i = rotation_matrix(quaternions[i])
             wall_potential_force(shape_index[i], positions[i], r_i, wall_points[wall],
-                                 wall_normals[wall], pair_penalty[mi, mj], shape_arrays, scratch,
-                                 out)
+                                 wall_normals[wall], pair_penalty[mi, mj], shapes, scratch, out)
             key = i * key_stride + (key_stride - 1 - wall)
             inv_j = 0.0
             overflow = out[13]
         results[k, C_OVERFLOW] = overflow
-        _contact_law(k, i, j, key, inv_j, mi, mj, positions, velocities, omegas, inverse_masses,
-                     pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys,
-                     history_springs, step, out, results)
+        _contact_law(Candidate(k, i, j, key, inv_j, mi, mj), positions, velocities, omegas,
+                     inverse_masses, laws, history, step, out, results)
 
 
 @kernel
@@ -303,11 +301,18 @@ def _within_skin(rotation, translation, pose, radius_a, radius_b, skin):
 
 
 @kernel
-def _contact_law(k, i, j, key, inv_j, mi, mj, positions, velocities, omegas, inverse_masses,
-                 pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys,
-                 history_springs, step, out, results):
-    """Normal damping, tangential and twisting friction of candidate ``k`` from its potential
-    force ``out``; writes row ``k`` of ``results``."""
+def _contact_law(candidate, positions, velocities, omegas, inverse_masses, laws, history, step,
+                 out, results):
+    """Normal damping, tangential and twisting friction of ``candidate``
+    (:class:`~riprap.solid.kernels.bundles.Candidate`) from its potential force ``out``, with the
+    pair laws ``laws`` (``PairLaws``) and the springs of ``history`` (``History``); writes the
+    candidate's row of ``results``. Takes the few arrays it reads rather than the whole bundles:
+    it runs once per pair, and every array it is given costs a reference count each way."""
+    k, i, j, key, inv_j, mi, mj = candidate
+    pair_friction = laws.friction
+    pair_damping_ratio = laws.damping_ratio
+    pair_tangential_ratio = laws.tangential_ratio
+    history_keys, history_springs = history
     f_mag = np.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
     if f_mag <= 0.0:
         return

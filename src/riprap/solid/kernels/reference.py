@@ -331,6 +331,8 @@ def _accumulate_tet_pair_contact(tet_c, tet_t, sub_c, sub_t, grads_c, grads_t, c
     ``result[0:3] += sum over c ∩ t of (grad phi_c - grad phi_t) dV`` (m^2) and
     ``result[3:6] +=`` the same with ``y ×`` (m^3), ``y`` in the frame of ``tet_c``/``tet_t``.
     Returns the overflow flag.
+
+    16 arguments: the reference evaluation's work arrays one by one, as :func:`_sum_body_contact`.
     """
     _potential_gradients(tet_c, centroid_c, grads_c)
     _potential_gradients(tet_t, centroid_t, grads_t)
@@ -371,6 +373,9 @@ def _sum_body_contact(nodes_a, tets_a, nodes_b, tets_b, pairs, tet_c, tet_t, sub
     ``total[0:3]`` is the force integral (m^2), ``total[3:6]`` the moment integral about the world
     origin (m^3); multiply by the penalty for N and N m. Returns the index of the pair that
     overflowed the soup buffers, or -1.
+
+    22 arguments: the reference (volume-form) evaluation for the tests, which passes its work
+    arrays one by one to a compiled loop; it is not on the run's path.
     """
     for axis in range(6):
         total[axis] = 0.0
@@ -411,6 +416,8 @@ def _sum_wall_contact(nodes, tets, point, normal, wall_potential_depth, tet_c, s
 
     Same units and layout as :func:`_sum_body_contact`. Returns the index of the tetrahedron that
     overflowed the soup buffers, or -1.
+
+    17 arguments: the reference evaluation's work arrays one by one, as :func:`_sum_body_contact`.
     """
     for axis in range(6):
         total[axis] = 0.0

@@ -4,6 +4,7 @@ import numpy as np
 
 from riprap._jit import kernel
 from riprap.solid.kernels import broad_phase, integrate, interactions
+from riprap.solid.kernels.bundles import History
 
 STATUS_OK = 0
 STATUS_NOT_FINITE = 1
@@ -11,24 +12,23 @@ STATUS_OVERFLOW = 2
 
 
 @kernel
-def compute_forces(positions, quaternions, velocities, angular_momenta, forces, torques, masses,
-                   inverse_masses, inverse_principal_inertia, fixed, shape_index, material_index,
-                   gravity, wall_points, wall_normals, wall_materials, bounding_radius,
-                   pair_penalty, pair_friction, pair_damping_ratio, pair_tangential_ratio,
-                   external_loads, history_keys, history_springs, margin, step, piece_cache, skin,
-                   shape_arrays):
-    """Forces and torques of every body at the current positions (gravity + contacts + the
-    external loads (n, 6): force and torque held on each free body, e.g. a fluid's).
+def compute_forces(system, motion, history, settings, piece_cache):
+    """Forces and torques of every body of ``system`` (:class:`~riprap.solid.kernels.bundles.
+    RigidSystem`) at ``motion`` (``Motion``; its forces and torques are written): gravity +
+    contacts + the external loads of ``settings`` (``StepSettings``), force and torque held on
+    each free body, e.g. a fluid's. ``history``: the contacts' springs (``History``).
 
-    Returns (history_keys, history_springs, results, body_pairs, wall_pairs, omegas, overflow,
-    piece_cache).
+    Returns (history, results, body_pairs, wall_pairs, omegas, overflow, piece_cache).
     """
-    # positions of the shape boxes in ShapeTable.kernel_arrays()
-    local_box_min = shape_arrays[24]
-    local_box_max = shape_arrays[25]
+    positions, quaternions, _, angular_momenta, forces, torques = motion
+    masses, _, inverse_principal_inertia, fixed, shape_index, _ = system.bodies
+    lookup = system.shapes.lookup
+    bounding_radius = lookup.bounding_radius
+    wall_points, wall_normals, _ = system.walls
+    gravity, external_loads, margin, _, _, _ = settings
     n = positions.shape[0]
-    lo, hi = broad_phase.world_boxes(positions, quaternions, shape_index, local_box_min,
-                                     local_box_max, margin)
+    lo, hi = broad_phase.world_boxes(positions, quaternions, shape_index, lookup.local_box_min,
+                                     lookup.local_box_max, margin)
     radii = np.empty(n)
     for b in range(n):
         radii[b] = bounding_radius[shape_index[b]] + margin
@@ -38,10 +38,7 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
     omegas = integrate.angular_velocities(quaternions, angular_momenta, inverse_principal_inertia)
     key_stride = n + wall_points.shape[0]
     results, piece_cache = interactions.evaluate_candidates(
-        body_pairs, wall_pairs, positions, quaternions, velocities, omegas, shape_index,
-        material_index, inverse_masses, wall_points, wall_normals, wall_materials, pair_penalty,
-        pair_friction, pair_damping_ratio, pair_tangential_ratio, history_keys, history_springs,
-        key_stride, step, piece_cache, skin, bounding_radius, shape_arrays)
+        body_pairs, wall_pairs, system, motion, omegas, history, settings, piece_cache)
     overflow = False
     for b in range(n):
         for c in range(3):
@@ -70,18 +67,19 @@ def compute_forces(positions, quaternions, velocities, angular_momenta, forces, 
             springs[m, c] = results[k, interactions.C_SPRING + c]
         m += 1
     order = np.argsort(keys)
-    return keys[order], springs[order], results, body_pairs, wall_pairs, omegas, overflow, piece_cache
+    return (History(keys[order], springs[order]), results, body_pairs, wall_pairs, omegas, overflow,
+            piece_cache)
 
 
 @kernel
-def advance(n_steps, positions, quaternions, velocities, angular_momenta, forces, torques, omegas,
-            masses, inverse_masses, inverse_principal_inertia, fixed, shape_index, material_index,
-            gravity, wall_points, wall_normals, wall_materials, bounding_radius, pair_penalty,
-            pair_friction, pair_damping_ratio, pair_tangential_ratio, external_loads, history_keys,
-            history_springs, margin, step, local_damping, piece_cache, skin, shape_arrays):
-    """Advance ``n_steps`` velocity-Verlet steps. Returns (steps done, status, history_keys,
-    history_springs, results, body_pairs, wall_pairs, omegas, piece_cache) of the last force
-    evaluation."""
+def advance(n_steps, system, motion, omegas, history, settings, piece_cache):
+    """Advance ``motion`` (``Motion``, in place) of ``system`` (``RigidSystem``) by ``n_steps``
+    velocity-Verlet steps of ``settings.step``; ``omegas``: the angular velocities of the last
+    force evaluation. Returns (steps done, status, history, results, body_pairs, wall_pairs,
+    omegas, piece_cache) of the last force evaluation."""
+    positions, quaternions, velocities, angular_momenta, forces, torques = motion
+    _, inverse_masses, inverse_principal_inertia, _, _, _ = system.bodies
+    _, _, _, step, local_damping, _ = settings
     results = np.zeros((0, interactions.C_SIZE))
     body_pairs = np.zeros((0, 2), dtype=np.int64)
     wall_pairs = np.zeros((0, 2), dtype=np.int64)
@@ -90,17 +88,12 @@ def advance(n_steps, positions, quaternions, velocities, angular_momenta, forces
                        0.5 * step, local_damping)
         integrate.drift(positions, quaternions, velocities, angular_momenta, inverse_masses,
                         inverse_principal_inertia, step)
-        (history_keys, history_springs, results, body_pairs, wall_pairs, omegas,
-         overflow, piece_cache) = compute_forces(
-            positions, quaternions, velocities, angular_momenta, forces, torques, masses,
-            inverse_masses, inverse_principal_inertia, fixed, shape_index, material_index,
-            gravity, wall_points, wall_normals, wall_materials, bounding_radius, pair_penalty,
-            pair_friction, pair_damping_ratio, pair_tangential_ratio, external_loads, history_keys,
-            history_springs, margin, step, piece_cache, skin, shape_arrays)
+        history, results, body_pairs, wall_pairs, omegas, overflow, piece_cache = compute_forces(
+            system, motion, history, settings, piece_cache)
         integrate.kick(velocities, angular_momenta, omegas, forces, torques, inverse_masses,
                        0.5 * step, local_damping)
         if overflow:
-            return s + 1, STATUS_OVERFLOW, history_keys, history_springs, results, body_pairs, wall_pairs, omegas, piece_cache
+            return s + 1, STATUS_OVERFLOW, history, results, body_pairs, wall_pairs, omegas, piece_cache
         for b in range(positions.shape[0]):
             finite = True
             for c in range(3):
@@ -108,5 +101,5 @@ def advance(n_steps, positions, quaternions, velocities, angular_momenta, forces
                         and np.isfinite(angular_momenta[b, c])):
                     finite = False
             if not finite:
-                return s + 1, STATUS_NOT_FINITE, history_keys, history_springs, results, body_pairs, wall_pairs, omegas, piece_cache
-    return n_steps, STATUS_OK, history_keys, history_springs, results, body_pairs, wall_pairs, omegas, piece_cache
+                return s + 1, STATUS_NOT_FINITE, history, results, body_pairs, wall_pairs, omegas, piece_cache
+    return n_steps, STATUS_OK, history, results, body_pairs, wall_pairs, omegas, piece_cache
