@@ -27,6 +27,7 @@ from riprap.case.load import load_case
 from riprap.errors import CaseFileError, RiprapError, plain_numbers
 from riprap.io.json_files import read_json_object
 from riprap.io.output_folder import describe_os_error
+from riprap.solid.kernels.pair_rule import PAIR_RULE_TEXT
 from riprap.work_estimate import RiprapWarning
 from riprap.workflows.analyse import analyse, compare_layers
 from riprap.workflows.check import check_case
@@ -53,8 +54,7 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
               f"{len(case.walls)} wall entries")
         sim = build_simulation(case, output_directory=out, progress=not quiet)
     if sim.solver.n_bodies:
-        print("riprap: contact pairs combine materials by the smaller friction coefficient, the "
-              "smaller restitution and the smaller contact_penalty")
+        print(f"riprap: {PAIR_RULE_TEXT}")
     summary = sim.run(restart_from=restart)
     print(f"riprap: {summary.end_reason} at t = {summary.simulated_time:.4f} s after "
           f"{summary.steps} steps in {summary.wall_time:.1f} s")

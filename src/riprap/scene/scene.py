@@ -4,6 +4,8 @@ is :class:`riprap.simulation.Simulation`) and it does not choose the model
 (:mod:`riprap.scene.choose_model` does, from what :meth:`Scene.holds`)."""
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -15,6 +17,7 @@ from riprap.errors import CaseFileError
 from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.tetmesh import TetMesh
 from riprap.io.contact_history import ContactHistory
+from riprap.solid.kernels.pair_rule import pair_friction
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
 from riprap.solid.solver import SolidSolver
@@ -193,7 +196,9 @@ class Scene:
         walls = [(wall.point, wall.normal,
                   solver.materials[solver.material_index(wall.material)].friction_coefficient)
                  for wall in solver.walls]
-        friction = min(b.material.friction_coefficient for b in self.deformable_bodies)
+        # a wall added for the deformable bodies meets each of them: the pair rule over them all
+        friction = functools.reduce(pair_friction.py_func, (b.material.friction_coefficient
+                                                             for b in self.deformable_bodies))
         walls += [(wall.point, wall.normal, friction) for wall in extra_walls
                   if not any(_same_plane(wall, other) for other in solver.walls)]
         return DeformableSystem(self.deformable_bodies, walls=walls,
