@@ -1,12 +1,12 @@
 """A script and a case file with "the same" settings behave the same: every keyword of the Python
 API that has a case-file key of the same meaning has the schema's default (one source for each
-default, ``riprap.case.schema``)."""
+default, ``riprap.schema``)."""
 import inspect
 
 import numpy as np
 import pytest
 
-from riprap.case import schema
+from riprap import schema
 from riprap.fluid.solver import FluidSolver
 from riprap.geometry.rock_grading import rock_library
 from riprap.placement.place import build_underlayer, place_units, unit_orientations

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from riprap.case.build import SMOKE_END_TIME, build_material, smoke_mode
-from riprap.case.schema import MAXIMUM_BODY_COUNT
+from riprap.schema import MAXIMUM_BODY_COUNT
 from riprap.errors import CaseFileError
 from riprap.placement.checks import check_filter_rule, check_row_fits
 from riprap.placement.place import UNIT_SHAPE_NAME, rock_lattice, rock_shapes

@@ -1,9 +1,9 @@
 """Load and validate a case file into a frozen :class:`Case`.
 
-Every check comes from the key table in :mod:`riprap.case.schema`. All problems found are
+Every check comes from the key table in :mod:`riprap.schema`. All problems found are
 collected and raised together as one :class:`~riprap.errors.CaseFileError`; each line of its
 message reads ``<file>:<line>: <key path> = <value>: <what was expected>``, sorted by line, at most
-:data:`~riprap.case.schema.MAXIMUM_REPORTED_PROBLEMS` of them. The error's ``problems`` attribute
+:data:`~riprap.schema.MAXIMUM_REPORTED_PROBLEMS` of them. The error's ``problems`` attribute
 holds every message, including those left out of the text.
 
 ``tomllib`` keeps no line numbers, so :class:`_LineLocator` scans the (already valid) TOML text
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from riprap.case.cross_rules import check_cross_rules
-from riprap.case import schema
-from riprap.case.schema import Key, Table, describe_expected, format_toml_value
+from riprap import schema
+from riprap.schema import Key, Table, describe_expected, format_toml_value
 from riprap.errors import CaseFileError
 from riprap.io.case_text import read_case_text
 
@@ -315,7 +315,7 @@ class Case:
     Attributes
     ----------
     format_version : int
-        Always :data:`riprap.case.schema.FORMAT_VERSION`.
+        Always :data:`riprap.schema.FORMAT_VERSION`.
     source : str
         The file name as given, or ``"<string>"``; used in later error messages.
     base_dir : pathlib.Path

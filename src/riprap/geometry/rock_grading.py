@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from riprap.case.schema import default_of
+from riprap.schema import default_of
 from riprap.errors import CaseFileError
 from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.shapes import random_rock

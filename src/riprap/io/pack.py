@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riprap.case import schema
+from riprap import schema
 from riprap.errors import CaseFileError
 from riprap.io.case_text import PACK_HEADER
 from riprap.geometry.tetmesh import TetMesh
@@ -98,7 +98,7 @@ class PackBody:
         A fixed body never moves.
 
     Vectors are stored as tuples of float; the quaternion's norm must be at least
-    :data:`~riprap.case.schema.MINIMUM_QUATERNION_NORM` (it is written as given and normalised
+    :data:`~riprap.schema.MINIMUM_QUATERNION_NORM` (it is written as given and normalised
     when the pack is loaded).
     """
 

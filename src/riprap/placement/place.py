@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from riprap.case.schema import MAXIMUM_BODY_COUNT, default_of
+from riprap.schema import MAXIMUM_BODY_COUNT, default_of
 from riprap.errors import CaseFileError, OverlapError
 from riprap.placement import layer_metrics
 from riprap.placement.lowering import Surface, VerticalLowering
