@@ -25,6 +25,7 @@ import math
 from dataclasses import dataclass
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 
 #: Names of the constitutive models, in the integer code order the kernels use.
 CONSTITUTIVE_MODELS = ("neo_hookean_seed", "neo_hookean", "neo_hookean_decoupled")
@@ -59,15 +60,18 @@ class ElasticMaterial:
         of their normal dashpot as for rigid bodies; a pair takes the smaller damping.
     """
 
+    # Defaults: the case file's [deformable] and [[materials]] keys (riprap.schema), but for the
+    # density, concrete's rather than rock's (the unit a deformable body mostly is), and the
+    # tensile strength, None for "none given" where the case file writes 0.
     name: str = "concrete"
     density: float = 2400.0
-    young_modulus: float = 30.0e9
-    poisson_ratio: float = 0.2
-    viscosity: float = 0.0
-    constitutive_model: str = "neo_hookean_seed"
+    young_modulus: float = default_of("deformable", "young_modulus")
+    poisson_ratio: float = default_of("deformable", "poisson_ratio")
+    viscosity: float = default_of("deformable", "viscosity")
+    constitutive_model: str = default_of("deformable", "constitutive_model")
     tensile_strength: float | None = None
-    friction_coefficient: float = 0.6
-    restitution: float = 0.5
+    friction_coefficient: float = default_of("materials", "friction_coefficient")
+    restitution: float = default_of("materials", "restitution")
 
     def __post_init__(self):
         checks = [

@@ -39,6 +39,7 @@ from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.kernels import momentum
 from riprap.fluid.phases import AIR_20C, WATER_20C, Phase
+from riprap.schema import default_of
 from riprap.work_estimate import check_fluid_grid
 
 __all__ = ["FluidSolver", "StepReport"]
@@ -95,9 +96,12 @@ class FluidSolver:
     """
 
     def __init__(self, grid: FluidGrid, *, water: Phase = WATER_20C, air: Phase = AIR_20C,
-                 gravity=(0.0, 0.0, -9.81), courant_number: float = 0.3,
-                 pressure_tolerance: float = 1e-8, max_time_step: float = 0.01,
-                 surface_tension: float = 0.0728, limit_air_speed: bool = False):
+                 gravity=default_of("simulation", "gravity"),
+                 courant_number: float = default_of("fluid", "courant_number"),
+                 pressure_tolerance: float = default_of("fluid", "pressure_tolerance"),
+                 max_time_step: float = default_of("fluid", "max_time_step"),
+                 surface_tension: float = default_of("fluid", "surface_tension"),
+                 limit_air_speed: bool = default_of("fluid", "limit_air_speed")):
         from riprap.fluid.pressure import PressureSolver
 
         if not 0.0 < courant_number <= 0.5:

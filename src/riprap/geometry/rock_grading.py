@@ -197,7 +197,7 @@ def rock_library(
     *,
     n_shapes: int,
     n_size_classes: int = default_of("underlayer", "size_classes"),
-    seed: int = 0,
+    seed: int = default_of("underlayer", "seed"),
     elongation: tuple[float, float] = (1.0, 1.6),
     mesh_size: float | None = None,
 ) -> list[GradedRock]:

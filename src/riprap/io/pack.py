@@ -105,10 +105,10 @@ class PackBody:
     shape: str
     material: str
     position: tuple
-    orientation: tuple = (1.0, 0.0, 0.0, 0.0)
-    velocity: tuple = (0.0, 0.0, 0.0)
-    angular_velocity: tuple = (0.0, 0.0, 0.0)
-    fixed: bool = False
+    orientation: tuple = schema.default_of("bodies", "orientation")
+    velocity: tuple = schema.default_of("bodies", "velocity")
+    angular_velocity: tuple = schema.default_of("bodies", "angular_velocity")
+    fixed: bool = schema.default_of("bodies", "fixed")
 
     def __post_init__(self) -> None:
         label = f"pack body (shape '{self.shape}')"
