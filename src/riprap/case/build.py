@@ -13,10 +13,12 @@ from scipy.spatial.transform import Rotation
 
 from riprap.case.body_start import check_body_starts, check_coordinates, shape_radius
 from riprap.case.run_record import RunDefinition
+from riprap.case.specs import keywords_for
 from riprap.errors import RiprapError
 from riprap.geometry import shapes as builtin_shapes
 from riprap.geometry.armour_units import armour_unit
 from riprap.geometry.tetmesh import TetMesh
+from riprap.schema import default_of
 from riprap.simulation import Simulation
 from riprap.solid import walls as wall_builders
 from riprap.solid.materials import Material
@@ -24,10 +26,7 @@ from riprap.solid.materials import Material
 
 def build_material(spec) -> Material:
     """The :class:`Material` of a ``[[materials]]`` entry."""
-    return Material(name=spec.name, density=spec.density,
-                    friction_coefficient=spec.friction_coefficient, restitution=spec.restitution,
-                    contact_penalty=spec.contact_penalty,
-                    tangential_stiffness_ratio=spec.tangential_stiffness_ratio)
+    return Material(**keywords_for(Material, spec))
 
 
 def build_shape(spec) -> TetMesh:
@@ -198,8 +197,11 @@ class _BodyPlacer:
             fracture_energy_mode_ii=spec.fracture_energy_mode_ii,
             joint_penalty=penalty)
 
-    def __call__(self, *, shape, material, position, orientation=(1.0, 0.0, 0.0, 0.0),
-                 velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0), fixed=False) -> None:
+    def __call__(self, *, shape, material, position,
+                 orientation=default_of("bodies", "orientation"),
+                 velocity=default_of("bodies", "velocity"),
+                 angular_velocity=default_of("bodies", "angular_velocity"),
+                 fixed=default_of("bodies", "fixed")) -> None:
         index = self.count
         self.count += 1
         if self.spec is not None and self.spec.selects(index):

@@ -33,6 +33,7 @@ __all__ = [
     "PorousZoneSpec",
     "OutputSettings",
     "spec_class",
+    "keywords_for",
 ]
 
 Vector = tuple[float, float, float]
@@ -86,6 +87,17 @@ def spec_class(class_name: str, table_name: str, *, methods: dict | None = None,
                                       kw_only=True)
     made.__module__ = __name__
     return made
+
+
+def keywords_for(function, spec) -> dict:
+    """The fields of ``spec`` that ``function`` takes as keywords of the same name (a key's name
+    is its parameter's name across riprap), so a builder passes a table on without naming each
+    key again."""
+    import inspect
+
+    parameters = inspect.signature(function).parameters
+    return {field.name: getattr(spec, field.name) for field in dataclasses.fields(spec)
+            if field.name in parameters}
 
 
 def _body_count(self) -> int:
