@@ -228,6 +228,20 @@ class Key:
         """Whether the case file must give this key."""
         return self.default is REQUIRED
 
+    def allows(self, value: float) -> bool:
+        """Whether a number is finite and within :attr:`valid_range` (for the API's own checks of
+        a keyword that is this key, so that its range is written here only)."""
+        return math.isfinite(value) and (self.valid_range is None
+                                         or self.valid_range.contains(value))
+
+    def stated_range(self) -> str:
+        """The allowed numbers with the unit, as a message says them: ``in (0, 0.5]``,
+        ``>= 0 N/m``, ``> 0 s``."""
+        text = self.valid_range.describe() if self.valid_range is not None else "any"
+        if text.startswith(("(", "[")):
+            text = "in " + text
+        return text if self.unit == "-" else f"{text} {self.unit}"
+
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise ValueError(f"schema key {self.table}.{self.name}: unknown kind {self.kind!r}")

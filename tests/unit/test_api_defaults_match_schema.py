@@ -37,7 +37,7 @@ from riprap.waves.theory import IrregularWave, LinearWave, StokesSecondOrderWave
 # the name}); other parameters are compared with the key of the same name in the first table that
 # has one.
 API_TABLES = [
-    (Simulation, ("simulation", "output"), {}),
+    (Simulation, ("simulation", "output"), {"output_directory": "directory"}),
     (FluidRun, ("simulation", "output"), {"output_directory": "directory"}),
     (Material, ("materials",), {}),
     (SolidSolver, ("simulation",), {}),

@@ -55,6 +55,11 @@ _TYPES = {
 }
 
 
+def _type_of(entry: schema.Key) -> object:
+    """The annotation of a key's field; ``object`` for a kind added to the schema since."""
+    return _TYPES.get(entry.kind, object)
+
+
 def spec_class(class_name: str, table_name: str, *, methods: dict | None = None,
                doc: str | None = None):
     """A frozen, keyword-only dataclass of the common keys of ``table_name``.
@@ -70,19 +75,19 @@ def spec_class(class_name: str, table_name: str, *, methods: dict | None = None,
     doc : str, optional
         The class's docstring; by default the table's header and meaning.
     """
+    part = schema.table(table_name)
     fields = []
     for entry in schema.keys_of(table_name):
         if entry.required:
-            fields.append((entry.name, _TYPES[entry.kind]))
+            fields.append((entry.name, _type_of(entry)))
         else:
-            fields.append((entry.name, _TYPES[entry.kind], dataclasses.field(default=entry.default)))
-    if schema.table(table_name).variant_key is not None:
+            fields.append((entry.name, _type_of(entry), dataclasses.field(default=entry.default)))
+    if part.variant_key is not None:
         fields.append(("parameters", dict))
-    part = schema.table(table_name)
+    typed = ", and ``parameters``, the keys of its type" if part.variant_key else ""
     namespace = dict(methods or {})
     namespace["__doc__"] = doc or (f"``{part.header}``: {part.meaning} Fields: the table's keys "
-                            "(docs/case-file.md)" + (", and ``parameters``, the keys of its "
-                                                     "type" if part.variant_key else "") + ".")
+                                   f"(docs/case-file.md){typed}.")
     made = dataclasses.make_dataclass(class_name, fields, namespace=namespace, frozen=True,
                                       kw_only=True)
     made.__module__ = __name__

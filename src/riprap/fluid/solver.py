@@ -39,7 +39,7 @@ from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.kernels import momentum
 from riprap.fluid.phases import AIR_20C, WATER_20C, Phase
-from riprap.schema import default_of
+from riprap.schema import default_of, key
 from riprap.work_estimate import check_fluid_grid
 
 __all__ = ["FluidSolver", "StepReport"]
@@ -104,14 +104,20 @@ class FluidSolver:
                  limit_air_speed: bool = default_of("fluid", "limit_air_speed")):
         from riprap.fluid.pressure import PressureSolver
 
-        if not 0.0 < courant_number <= 0.5:
-            raise CaseFileError(f"fluid: courant_number = {courant_number!r} must be in (0, 0.5] "
-                                "(the volume-of-fluid sweeps are bounded only up to 0.5)")
-        if not (math.isfinite(surface_tension) and surface_tension >= 0):
-            raise CaseFileError(f"fluid: surface_tension = {surface_tension!r} must be >= 0 N/m "
-                                "(0.0728 for clean water and air at 20 degrees C)")
-        if not (math.isfinite(max_time_step) and max_time_step > 0):
-            raise CaseFileError(f"fluid: max_time_step = {max_time_step!r} must be > 0 s")
+        # The ranges are the [fluid] keys' (riprap.schema); the API checks them as the loader does.
+        courant, tension, longest = (key("fluid", name) for name in
+                                     ("courant_number", "surface_tension", "max_time_step"))
+        if not courant.allows(courant_number):
+            raise CaseFileError(f"fluid: courant_number = {courant_number!r} must be "
+                                f"{courant.stated_range()} (the volume-of-fluid sweeps are "
+                                "bounded only up to 0.5)")
+        if not tension.allows(surface_tension):
+            raise CaseFileError(f"fluid: surface_tension = {surface_tension!r} must be "
+                                f"{tension.stated_range()} (0.0728 for clean water and air at 20 "
+                                "degrees C)")
+        if not longest.allows(max_time_step):
+            raise CaseFileError(f"fluid: max_time_step = {max_time_step!r} must be "
+                                f"{longest.stated_range()}")
         self.grid = grid
         self.water = water
         self.air = air
