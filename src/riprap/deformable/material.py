@@ -25,7 +25,7 @@ import math
 from dataclasses import dataclass
 
 from riprap.errors import CaseFileError
-from riprap.schema import default_of
+from riprap.schema import default_of, key
 
 #: Names of the constitutive models, in the integer code order the kernels use.
 CONSTITUTIVE_MODELS = ("neo_hookean_seed", "neo_hookean", "neo_hookean_decoupled")
@@ -74,18 +74,14 @@ class ElasticMaterial:
     restitution: float = default_of("materials", "restitution")
 
     def __post_init__(self):
-        checks = [
-            ("restitution", 0 < self.restitution <= 1, "in (0, 1]"),
-            ("friction_coefficient", self.friction_coefficient >= 0, ">= 0"),
-            ("density", self.density > 0, "> 0 kg/m^3"),
-            ("young_modulus", self.young_modulus > 0, "> 0 Pa"),
-            ("poisson_ratio", -1.0 < self.poisson_ratio < 0.5, "in (-1, 0.5)"),
-            ("viscosity", self.viscosity >= 0, ">= 0 Pa s"),
-        ]
-        for key, ok, expected in checks:
-            value = getattr(self, key)
-            if not (ok and math.isfinite(value)):
-                raise CaseFileError(f"material '{self.name}': {key} = {value!r} must be {expected}")
+        # The ranges are the case file's keys' (riprap.schema), checked as the loader does.
+        for table, name in (("materials", "restitution"), ("materials", "friction_coefficient"),
+                            ("materials", "density"), ("deformable", "young_modulus"),
+                            ("deformable", "poisson_ratio"), ("deformable", "viscosity")):
+            value, entry = getattr(self, name), key(table, name)
+            if not entry.allows(value):
+                raise CaseFileError(f"material '{self.name}': {name} = {value!r} must be "
+                                    f"{entry.stated_range()}")
         if self.constitutive_model not in CONSTITUTIVE_MODELS:
             raise CaseFileError(
                 f"material '{self.name}': constitutive_model = {self.constitutive_model!r} is not "
