@@ -76,6 +76,9 @@ class FluidSolver:
 
     Parameters
     ----------
+    Every keyword that is a ``[fluid]`` key (and ``gravity``, the ``[simulation]`` key) has that
+    key's default, unit and range (``docs/case-file.md``, from :mod:`riprap.schema`).
+
     grid : FluidGrid
     water, air : Phase
         Densities and viscosities (defaults: fresh water and air at 20 degrees C).
@@ -88,8 +91,7 @@ class FluidSolver:
     max_time_step : float
         Upper bound on dt (s).
     surface_tension : float
-        Air-water surface tension sigma (N/m; default 0.0728, clean water at 20 degrees C; 0
-        leaves it out).
+        Air-water surface tension sigma (N/m; 0 leaves it out).
     limit_air_speed : bool
         Take the Courant number only on the faces that touch water, and cap the speed of the
         other faces (air away from the water) at what that step carries (``limit_air``).
