@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from riprap.case import schema
+from riprap import schema
 from riprap.case.load import (
     BodyGridSpec,
     BodySpec,
@@ -416,12 +416,12 @@ def test_case_file_every_schema_key_has_a_documented_unit_and_meaning():
 def test_case_file_docs_are_up_to_date():
     documented = (REPOSITORY / "docs" / "case-file.md").read_text(encoding="utf-8")
     assert documented == schema.render_markdown(), (
-        "docs/case-file.md is out of date: run python -m riprap.case.schema > docs/case-file.md"
+        "docs/case-file.md is out of date: run python -m riprap.schema > docs/case-file.md"
     )
 
 
 def test_case_file_schema_module_prints_the_docs():
     printed = subprocess.run(
-        [sys.executable, "-m", "riprap.case.schema"], capture_output=True, text=True, check=True
+        [sys.executable, "-m", "riprap.schema"], capture_output=True, text=True, check=True
     ).stdout
     assert printed == schema.render_markdown()

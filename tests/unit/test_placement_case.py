@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from riprap.case import schema
+from riprap import schema
 from riprap.case.load import load_case, parse_case
 from riprap.errors import CaseFileError
 

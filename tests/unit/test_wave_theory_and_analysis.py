@@ -234,7 +234,7 @@ def test_every_case_file_wave_type_has_a_theory_and_each_says_what_it_is():
     """The schema's [waves] type choices are the registry's names (one place to add a theory),
     and each theory states whether it is regular, how its height is named and whether the
     Ursell limit applies (the flume checks and the report read these, not the class)."""
-    from riprap.case.schema import key
+    from riprap.schema import key
     from riprap.waves.theories import WAVE_THEORIES, make_wave
 
     assert set(key("waves", "type").choices) == set(WAVE_THEORIES)

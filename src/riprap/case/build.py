@@ -13,6 +13,7 @@ from scipy.spatial.transform import Rotation
 
 from riprap.case.body_start import check_body_starts, check_coordinates, shape_radius
 from riprap.case.run_record import RunDefinition
+from riprap.case.specs import keywords_for
 from riprap.deformable import ElasticMaterial
 from riprap.deformable.joints import JointMaterial
 from riprap.errors import RiprapError
@@ -22,6 +23,7 @@ from riprap.geometry.meshing import check_body_length
 from riprap.geometry.tetmesh import TetMesh
 from riprap.io.contact_history import ContactHistory, read_contact_history
 from riprap.io.mesh_files import read_mesh
+from riprap.schema import default_of
 from riprap.simulation import Simulation
 from riprap.solid import walls as wall_builders
 from riprap.solid.materials import Material
@@ -29,10 +31,7 @@ from riprap.solid.materials import Material
 
 def build_material(spec) -> Material:
     """The :class:`Material` of a ``[[materials]]`` entry."""
-    return Material(name=spec.name, density=spec.density,
-                    friction_coefficient=spec.friction_coefficient, restitution=spec.restitution,
-                    contact_penalty=spec.contact_penalty,
-                    tangential_stiffness_ratio=spec.tangential_stiffness_ratio)
+    return Material(**keywords_for(Material, spec))
 
 
 def build_shape(spec) -> TetMesh:
@@ -193,8 +192,11 @@ class _BodyPlacer:
             fracture_energy_mode_ii=spec.fracture_energy_mode_ii,
             joint_penalty=penalty)
 
-    def __call__(self, *, shape, material, position, orientation=(1.0, 0.0, 0.0, 0.0),
-                 velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0), fixed=False) -> None:
+    def __call__(self, *, shape, material, position,
+                 orientation=default_of("bodies", "orientation"),
+                 velocity=default_of("bodies", "velocity"),
+                 angular_velocity=default_of("bodies", "angular_velocity"),
+                 fixed=default_of("bodies", "fixed")) -> None:
         index = self.count
         self.count += 1
         if self.spec is not None and self.spec.selects(index):

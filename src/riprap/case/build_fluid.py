@@ -8,6 +8,7 @@ from riprap.case.body_start import check_coordinates
 from riprap.case.build import SMOKE_END_TIME, build_simulation, smoke_mode
 from riprap.case.build_waves import build_waves
 from riprap.case.run_record import RunDefinition
+from riprap.case.specs import keywords_for
 from riprap.coupling.coupled import MINIMUM_DENSITY_RATIO
 from riprap.errors import CaseFileError
 from riprap.fluid.grid import SIDES, FluidGrid
@@ -35,10 +36,8 @@ def build_fluid_solver(case) -> FluidSolver:
         raise CaseFileError(f"{where}: {error}") from None
     solver = FluidSolver(grid, water=Phase("water", spec.water_density, spec.water_viscosity),
                          air=Phase("air", spec.air_density, spec.air_viscosity),
-                         gravity=case.simulation.gravity, courant_number=spec.courant_number,
-                         pressure_tolerance=spec.pressure_tolerance,
-                         max_time_step=spec.max_time_step, surface_tension=spec.surface_tension,
-                         limit_air_speed=spec.limit_air_speed)
+                         gravity=case.simulation.gravity,
+                         **keywords_for(FluidSolver, spec))   # the solver's [fluid] keys
     for number, region in enumerate(case.water_regions):
         try:
             if region.type == "level":

@@ -1,6 +1,6 @@
 """Rules that join several keys or tables of a case file.
 
-The schema (:mod:`riprap.case.schema`) judges each key alone; these rules judge keys together, so
+The schema (:mod:`riprap.schema`) judges each key alone; these rules judge keys together, so
 that ``riprap check`` refuses every combination that ``riprap run`` or ``riprap place`` would
 refuse or, worse, silently ignore. Each rule adds a problem at the line of the key that has to
 change, through ``add(path, message, value)`` of the case loader.

@@ -19,6 +19,7 @@ from riprap.deformable.kernels import finite_strain
 from riprap.deformable.kernels.bundles import ContactState, ElementState, JointData, NodeState
 from riprap.deformable.material import ElasticMaterial
 from riprap.errors import CaseFileError, InstabilityError
+from riprap.schema import default_of
 
 #: The step used by default is this fraction of the stable step.
 TIME_STEP_SAFETY = 0.9
@@ -80,8 +81,10 @@ class DeformableBody:
     0.0
     """
 
-    def __init__(self, nodes, tets, material: ElasticMaterial, *, element_type: str = "tet4",
-                 name: str = "body", gravity=(0.0, 0.0, 0.0), mass_damping: float = 0.0):
+    def __init__(self, nodes, tets, material: ElasticMaterial, *,
+                 element_type: str = default_of("deformable", "element_type"),
+                 name: str = "body", gravity=(0.0, 0.0, 0.0),
+                 mass_damping: float = default_of("deformable", "mass_damping")):
         if not isinstance(material, ElasticMaterial):
             raise CaseFileError(f"deformable body '{name}': material must be an ElasticMaterial")
         if not (mass_damping >= 0 and math.isfinite(mass_damping)):

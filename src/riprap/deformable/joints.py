@@ -30,6 +30,7 @@ from scipy.sparse.csgraph import connected_components, reverse_cuthill_mckee
 from riprap.deformable.body import DeformableBody, stable_step_for
 from riprap.deformable.kernels import joints as joint_kernels
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 
 __all__ = ["JointMaterial", "ExplodedMesh", "explode_mesh", "FracturingBody", "SOFTENING_AREA"]
 
@@ -243,7 +244,8 @@ class FracturingBody(DeformableBody):
     """
 
     def __init__(self, nodes, tets, material, joint_material: JointMaterial, *,
-                 name: str = "body", gravity=(0.0, 0.0, 0.0), mass_damping: float = 0.0,
+                 name: str = "body", gravity=(0.0, 0.0, 0.0),
+                 mass_damping: float = default_of("deformable", "mass_damping"),
                  cracking=None):
         if not isinstance(joint_material, JointMaterial):
             raise CaseFileError(f"deformable body '{name}': joint_material must be a JointMaterial")

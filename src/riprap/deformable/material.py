@@ -25,6 +25,7 @@ import math
 from dataclasses import dataclass
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of, key
 from riprap.solid.materials import damping_ratio_for_restitution
 
 #: Names of the constitutive models, in the integer code order the kernels use.
@@ -60,29 +61,28 @@ class ElasticMaterial:
         of their normal dashpot as for rigid bodies; a pair takes the smaller damping.
     """
 
+    # Defaults: the case file's [deformable] and [[materials]] keys (riprap.schema), but for the
+    # density, concrete's rather than rock's (the unit a deformable body mostly is), and the
+    # tensile strength, None for "none given" where the case file writes 0.
     name: str = "concrete"
     density: float = 2400.0
-    young_modulus: float = 30.0e9
-    poisson_ratio: float = 0.2
-    viscosity: float = 0.0
-    constitutive_model: str = "neo_hookean_seed"
+    young_modulus: float = default_of("deformable", "young_modulus")
+    poisson_ratio: float = default_of("deformable", "poisson_ratio")
+    viscosity: float = default_of("deformable", "viscosity")
+    constitutive_model: str = default_of("deformable", "constitutive_model")
     tensile_strength: float | None = None
-    friction_coefficient: float = 0.6
-    restitution: float = 0.5
+    friction_coefficient: float = default_of("materials", "friction_coefficient")
+    restitution: float = default_of("materials", "restitution")
 
     def __post_init__(self):
-        checks = [
-            ("restitution", 0 < self.restitution <= 1, "in (0, 1]"),
-            ("friction_coefficient", self.friction_coefficient >= 0, ">= 0"),
-            ("density", self.density > 0, "> 0 kg/m^3"),
-            ("young_modulus", self.young_modulus > 0, "> 0 Pa"),
-            ("poisson_ratio", -1.0 < self.poisson_ratio < 0.5, "in (-1, 0.5)"),
-            ("viscosity", self.viscosity >= 0, ">= 0 Pa s"),
-        ]
-        for key, ok, expected in checks:
-            value = getattr(self, key)
-            if not (ok and math.isfinite(value)):
-                raise CaseFileError(f"material '{self.name}': {key} = {value!r} must be {expected}")
+        # The ranges are the case file's keys' (riprap.schema), checked as the loader does.
+        for table, name in (("materials", "restitution"), ("materials", "friction_coefficient"),
+                            ("materials", "density"), ("deformable", "young_modulus"),
+                            ("deformable", "poisson_ratio"), ("deformable", "viscosity")):
+            value, entry = getattr(self, name), key(table, name)
+            if not entry.allows(value):
+                raise CaseFileError(f"material '{self.name}': {name} = {value!r} must be "
+                                    f"{entry.stated_range()}")
         if self.constitutive_model not in CONSTITUTIVE_MODELS:
             raise CaseFileError(
                 f"material '{self.name}': constitutive_model = {self.constitutive_model!r} is not "

@@ -27,6 +27,7 @@ from riprap.deformable.kernels.bundles import ContactState, ElementState, JointD
 from riprap.errors import CaseFileError
 from riprap.geometry.meshing import boundary_tet_heights
 from riprap.geometry.tetmesh import TetMesh
+from riprap.schema import default_of
 
 # A stable step below this (s) comes from a key in the wrong unit, not from a mesh: a millimetre
 # element of the stiffest concrete takes about 1e-7 s.
@@ -62,8 +63,10 @@ class DeformableSystem:
     """
 
     def __init__(self, bodies, walls=(), *, contact_penalty=None, gravity=(0.0, 0.0, 0.0),
-                 mass_damping: float = 0.0, rigid_surfaces=(),
-                 tangential_stiffness_ratio: float = 2.0 / 7.0):
+                 mass_damping: float = default_of("deformable", "mass_damping"),
+                 rigid_surfaces=(),
+                 tangential_stiffness_ratio: float = default_of("materials",
+                                                                "tangential_stiffness_ratio")):
         bodies = list(bodies)
         if not bodies:
             raise CaseFileError("a deformable system needs at least one body")

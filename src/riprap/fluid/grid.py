@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 
 __all__ = ["FluidGrid", "BOUNDARY_KINDS", "SIDES"]
 
@@ -36,8 +37,8 @@ _MINIMUM_CELLS = 2
 
 
 def _default_boundaries() -> dict:
-    return {"x_low": "no_slip", "x_high": "no_slip", "y_low": "no_slip", "y_high": "no_slip",
-            "z_low": "no_slip", "z_high": "open"}
+    """Each side's kind when not given: the case file's [fluid] default (riprap.schema)."""
+    return {side: default_of("fluid", side) for side in SIDES}
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 
 __all__ = ["Phase", "WATER_20C", "AIR_20C", "SEA_WATER_20C"]
 
@@ -39,6 +40,8 @@ class Phase:
         return self.dynamic_viscosity / self.density
 
 
-WATER_20C = Phase("water", 998.2, 1.002e-3)
+#: The case file's [fluid] defaults (riprap.schema): fresh water and air at 20 C.
+WATER_20C = Phase("water", default_of("fluid", "water_density"),
+                  default_of("fluid", "water_viscosity"))
 SEA_WATER_20C = Phase("sea water", 1024.8, 1.08e-3)
-AIR_20C = Phase("air", 1.204, 1.825e-5)
+AIR_20C = Phase("air", default_of("fluid", "air_density"), default_of("fluid", "air_viscosity"))

@@ -34,13 +34,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 
 __all__ = ["PorousZone", "PorousMedium", "face_means", "DEFAULT_LINEAR", "DEFAULT_QUADRATIC",
            "DEFAULT_ADDED_MASS"]
 
-DEFAULT_LINEAR = 50.0
-DEFAULT_QUADRATIC = 2.0
-DEFAULT_ADDED_MASS = 0.34
+# The case file's [[porous_zones]] defaults (riprap.schema).
+DEFAULT_LINEAR = default_of("porous_zones", "linear_friction")
+DEFAULT_QUADRATIC = default_of("porous_zones", "quadratic_friction")
+DEFAULT_ADDED_MASS = default_of("porous_zones", "added_mass")
 # Sub-samples per cell and axis for the cover of a polygon zone.
 _SAMPLES = 4
 

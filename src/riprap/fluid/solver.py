@@ -45,6 +45,7 @@ from riprap.fluid.kernels.surface_tension import face_forces
 from riprap.fluid.phases import AIR_20C, WATER_20C, Phase
 from riprap.fluid.porous import PorousMedium
 from riprap.fluid.pressure import PressureSolver
+from riprap.schema import default_of, key
 from riprap.work_estimate import check_fluid_grid
 
 __all__ = ["FluidSolver", "StepReport"]
@@ -81,6 +82,9 @@ class FluidSolver:
 
     Parameters
     ----------
+    Every keyword that is a ``[fluid]`` key (and ``gravity``, the ``[simulation]`` key) has that
+    key's default, unit and range (``docs/case-file.md``, from :mod:`riprap.schema`).
+
     grid : FluidGrid
     water, air : Phase
         Densities and viscosities (defaults: fresh water and air at 20 degrees C).
@@ -93,25 +97,33 @@ class FluidSolver:
     max_time_step : float
         Upper bound on dt (s).
     surface_tension : float
-        Air-water surface tension sigma (N/m; default 0.0728, clean water at 20 degrees C; 0
-        leaves it out).
+        Air-water surface tension sigma (N/m; 0 leaves it out).
     limit_air_speed : bool
         Take the Courant number only on the faces that touch water, and cap the speed of the
         other faces (air away from the water) at what that step carries (``limit_air``).
     """
 
     def __init__(self, grid: FluidGrid, *, water: Phase = WATER_20C, air: Phase = AIR_20C,
-                 gravity=(0.0, 0.0, -9.81), courant_number: float = 0.3,
-                 pressure_tolerance: float = 1e-8, max_time_step: float = 0.01,
-                 surface_tension: float = 0.0728, limit_air_speed: bool = False):
-        if not 0.0 < courant_number <= 0.5:
-            raise CaseFileError(f"fluid: courant_number = {courant_number!r} must be in (0, 0.5] "
-                                "(the volume-of-fluid sweeps are bounded only up to 0.5)")
-        if not (math.isfinite(surface_tension) and surface_tension >= 0):
-            raise CaseFileError(f"fluid: surface_tension = {surface_tension!r} must be >= 0 N/m "
-                                "(0.0728 for clean water and air at 20 degrees C)")
-        if not (math.isfinite(max_time_step) and max_time_step > 0):
-            raise CaseFileError(f"fluid: max_time_step = {max_time_step!r} must be > 0 s")
+                 gravity=default_of("simulation", "gravity"),
+                 courant_number: float = default_of("fluid", "courant_number"),
+                 pressure_tolerance: float = default_of("fluid", "pressure_tolerance"),
+                 max_time_step: float = default_of("fluid", "max_time_step"),
+                 surface_tension: float = default_of("fluid", "surface_tension"),
+                 limit_air_speed: bool = default_of("fluid", "limit_air_speed")):
+        # The ranges are the [fluid] keys' (riprap.schema); the API checks them as the loader does.
+        courant, tension, longest = (key("fluid", name) for name in
+                                     ("courant_number", "surface_tension", "max_time_step"))
+        if not courant.allows(courant_number):
+            raise CaseFileError(f"fluid: courant_number = {courant_number!r} must be "
+                                f"{courant.stated_range()} (the volume-of-fluid sweeps are "
+                                "bounded only up to 0.5)")
+        if not tension.allows(surface_tension):
+            raise CaseFileError(f"fluid: surface_tension = {surface_tension!r} must be "
+                                f"{tension.stated_range()} (0.0728 for clean water and air at 20 "
+                                "degrees C)")
+        if not longest.allows(max_time_step):
+            raise CaseFileError(f"fluid: max_time_step = {max_time_step!r} must be "
+                                f"{longest.stated_range()}")
         self.grid = grid
         self.water = water
         self.air = air

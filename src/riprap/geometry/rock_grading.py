@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from riprap.case.schema import default_of
+from riprap.schema import default_of
 from riprap.errors import CaseFileError
 from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.shapes import random_rock
@@ -197,7 +197,7 @@ def rock_library(
     *,
     n_shapes: int,
     n_size_classes: int = default_of("underlayer", "size_classes"),
-    seed: int = 0,
+    seed: int = default_of("underlayer", "seed"),
     elongation: tuple[float, float] = (1.0, 1.6),
     mesh_size: float | None = None,
 ) -> list[GradedRock]:

@@ -25,6 +25,7 @@ from riprap.geometry.meshing import (
     tetrahedralize_surface,
 )
 from riprap.geometry.tetmesh import TetMesh
+from riprap.schema import default_of
 
 # Sphere element size as a fraction of the radius. The generic rule (nominal diameter / 3.8 =
 # 0.42 r) would lose about 6 % of the volume to the inscribed polyhedral surface; 0.3 r keeps the
@@ -208,10 +209,10 @@ def _surface_volume_and_centroid(vertices: np.ndarray, triangles: np.ndarray) ->
 def random_rock(
     *,
     size: float,
-    elongation: float = 1.0,
-    flatness: float = 1.0,
-    seed: int = 0,
-    n_vertices: int = 24,
+    elongation: float = default_of("shapes", "elongation"),
+    flatness: float = default_of("shapes", "flatness"),
+    seed: int = default_of("shapes", "seed"),
+    n_vertices: int = default_of("shapes", "n_vertices"),
     mesh_size: float | None = None,
 ) -> TetMesh:
     """A random convex rock: the convex hull of points near an ellipsoid.

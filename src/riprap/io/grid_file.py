@@ -14,7 +14,7 @@ Rules
   around them ignored.
 - ``x, y, z`` (m, the unit's centroid) are required.
 - Optional orientation, either ``qw, qx, qy, qz`` (a quaternion (w, x, y, z), all four or none,
-  normalised on reading, norm at least :data:`~riprap.case.schema.MINIMUM_QUATERNION_NORM`) or
+  normalised on reading, norm at least :data:`~riprap.schema.MINIMUM_QUATERNION_NORM`) or
   ``roll, pitch, yaw`` in degrees (all three or none), never both. Roll, pitch and yaw are the
   aerospace (Tait-Bryan) angles: intrinsic rotations about z by yaw, then about the new y by
   pitch, then about the newest x by roll, so that the rotation from the unit's own frame to the
@@ -24,7 +24,7 @@ Rules
 - Every row has as many comma-separated fields as the header, each a finite number.
 
 All problems are reported at once by one :class:`~riprap.errors.CaseFileError`, each as
-``<file>:<line>: <what is wrong>`` (at most :data:`~riprap.case.schema.MAXIMUM_REPORTED_PROBLEMS`
+``<file>:<line>: <what is wrong>`` (at most :data:`~riprap.schema.MAXIMUM_REPORTED_PROBLEMS`
 lines, then a count); its ``problems`` attribute holds every message.
 """
 from __future__ import annotations
@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riprap.case import schema
+from riprap import schema
 from riprap.errors import CaseFileError
 from riprap.io.case_text import read_text_file
 
@@ -346,7 +346,7 @@ def write_grid_file(path: str | os.PathLike, positions, orientations=None,
     orientations : array_like, shape (n, 4), optional
         Quaternions (w, x, y, z) rotating each unit's own frame into the world, written as given
         (columns ``qw, qx, qy, qz``); each norm must be at least
-        :data:`~riprap.case.schema.MINIMUM_QUATERNION_NORM`.
+        :data:`~riprap.schema.MINIMUM_QUATERNION_NORM`.
     velocities : array_like, shape (n, 3), optional
         Initial velocities (m/s), columns ``vx, vy, vz``.
 

@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riprap.case import schema
+from riprap import schema
 from riprap.errors import CaseFileError
 from riprap.geometry.tetmesh import TetMesh
 from riprap.io.case_text import PACK_HEADER
@@ -100,17 +100,17 @@ class PackBody:
         A fixed body never moves.
 
     Vectors are stored as tuples of float; the quaternion's norm must be at least
-    :data:`~riprap.case.schema.MINIMUM_QUATERNION_NORM` (it is written as given and normalised
+    :data:`~riprap.schema.MINIMUM_QUATERNION_NORM` (it is written as given and normalised
     when the pack is loaded).
     """
 
     shape: str
     material: str
     position: tuple
-    orientation: tuple = (1.0, 0.0, 0.0, 0.0)
-    velocity: tuple = (0.0, 0.0, 0.0)
-    angular_velocity: tuple = (0.0, 0.0, 0.0)
-    fixed: bool = False
+    orientation: tuple = schema.default_of("bodies", "orientation")
+    velocity: tuple = schema.default_of("bodies", "velocity")
+    angular_velocity: tuple = schema.default_of("bodies", "angular_velocity")
+    fixed: bool = schema.default_of("bodies", "fixed")
 
     def __post_init__(self) -> None:
         label = f"pack body (shape '{self.shape}')"

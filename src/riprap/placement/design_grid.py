@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 
 
 @dataclass(frozen=True)
@@ -32,7 +33,8 @@ class DesignGrid:
 
 def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12, 11),
                 packing_density_coefficient: float, first_row_s: float,
-                centroid_height: float, drop_height: float = 0.0) -> DesignGrid:
+                centroid_height: float,
+                drop_height: float = default_of("placement", "drop_height")) -> DesignGrid:
     """Staggered rows of unit centroids: the design centroids lie ``centroid_height`` (m) above the
     face along its normal, and the units start ``drop_height`` (m) straight above them."""
     counts = tuple(int(n) for n in np.atleast_1d(units_per_row))

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from riprap.case.schema import MAXIMUM_BODY_COUNT, default_of
+from riprap.schema import MAXIMUM_BODY_COUNT, default_of
 from riprap.errors import CaseFileError, OverlapError
 from riprap.limits import START_OVERLAP_FRACTION as _START_OVERLAP_FRACTION
 from riprap.placement import layer_metrics
@@ -103,8 +103,9 @@ def _run_settings(kwargs: dict) -> dict:
     return {k: v for k, v in kwargs.items() if k in keys}
 
 
-def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range, layers: int = 2,
-                     seed: int = 0, **run) -> Underlayer:
+def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range,
+                     layers: int = default_of("underlayer", "layers"),
+                     seed: int = default_of("underlayer", "seed"), **run) -> Underlayer:
     """Drop graded rocks on the face between ``s_range`` = (s_low, s_high) (m along the face).
 
     ``rocks``: sequence of objects with ``mesh`` (TetMesh), ``nominal_diameter`` and
@@ -218,7 +219,8 @@ def _stick_to_face(sim: Simulation) -> bool:
     return bool(solver.fixed.all())
 
 
-def unit_orientations(count: int, *, mode: str, slope, seed: int = 0,
+def unit_orientations(count: int, *, mode: str, slope,
+                      seed: int = default_of("placement", "seed"),
                       max_tilt_deg: float = default_of("placement", "max_tilt_deg"),
                       user=None) -> np.ndarray:
     """Quaternions (w, x, y, z) rotating the unit as built into the world.
@@ -251,7 +253,8 @@ def unit_orientations(count: int, *, mode: str, slope, seed: int = 0,
 
 def place_units(slope, unit, underlayer: Underlayer, *, positions, orientations, materials,
                 velocities=None, grid_lines=None, lift_overlapping: bool = False,
-                initial_velocity=(0.0, 0.0, 0.0), deposition: str = "all_at_once", rows=None,
+                initial_velocity=default_of("placement", "initial_velocity"),
+                deposition: str = default_of("placement", "deposition"), rows=None,
                 release: str = default_of("placement", "release"), **run) -> PlacementResult:
     """Deposit the units on the fixed underlayer and run until they rest.
 

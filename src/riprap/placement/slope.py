@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 from riprap.solid import walls
 from riprap.solid.walls import Wall
 
@@ -47,9 +48,9 @@ class Slope:
     cotangent: float
     width: float
     length: float
-    toe_x: float = 0.0
-    toe_level: float = 0.0
-    toe_stop_distance: float = 0.0
+    toe_x: float = default_of("slope", "toe_x")
+    toe_level: float = default_of("slope", "toe_level")
+    toe_stop_distance: float = default_of("slope", "toe_stop_distance")
 
     def __post_init__(self):
         for name in ("cotangent", "width", "length"):

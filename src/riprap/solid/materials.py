@@ -10,6 +10,7 @@ import numpy as np
 from scipy import optimize
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 from riprap.solid.kernels import pair_rule
 
 
@@ -36,11 +37,12 @@ class Material:
     """
 
     name: str
-    density: float = 2650.0
-    friction_coefficient: float = 0.6
-    restitution: float = 0.5
-    contact_penalty: float = 1.0e9
-    tangential_stiffness_ratio: float = 2.0 / 7.0
+    # Defaults: the case file's [[materials]] keys (riprap.schema), written once there.
+    density: float = default_of("materials", "density")
+    friction_coefficient: float = default_of("materials", "friction_coefficient")
+    restitution: float = default_of("materials", "restitution")
+    contact_penalty: float = default_of("materials", "contact_penalty")
+    tangential_stiffness_ratio: float = default_of("materials", "tangential_stiffness_ratio")
 
     def __post_init__(self):
         checks = [

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, KernelOverflowError, OverlapError
+from riprap.schema import default_of
 from riprap.solid.kernels import integrate, interactions, stepper
 from riprap.solid.kernels.bundles import (Bodies, History, Motion, PairLaws, RigidSystem,
                                           StepSettings, Walls)
@@ -54,7 +55,8 @@ class ContactRecords:
 class SolidSolver:
     """Rigid bodies with tetrahedral shapes, walls, gravity and Munjiza potential contact."""
 
-    def __init__(self, *, gravity=(0.0, 0.0, -9.81), local_damping: float = 0.0,
+    def __init__(self, *, gravity=default_of("simulation", "gravity"),
+                 local_damping: float = default_of("simulation", "local_damping"),
                  contact_skin: float | None = None):
         """``contact_skin`` (m): how far two bodies may move relative to each other before the
         list of (triangle, tet) pieces of their contact is made again; it changes the speed only,

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 
 
 @dataclass(frozen=True)
@@ -29,7 +30,8 @@ def plane(*, point, normal, material: str) -> list[Wall]:
     return [Wall(point=tuple(point), normal=tuple(normal), material=material)]
 
 
-def box(*, min, max, material: str, open_top: bool = True) -> list[Wall]:
+def box(*, min, max, material: str,
+        open_top: bool = default_of("walls", "open_top")) -> list[Wall]:
     """A container: the inside of the box [min, max] is free space."""
     lo = np.asarray(min, dtype=float)
     hi = np.asarray(max, dtype=float)

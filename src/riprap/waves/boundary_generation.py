@@ -42,6 +42,7 @@ import math
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 from riprap.waves.theory import ramp
 
 __all__ = ["BoundaryWaveMaker"]
@@ -70,7 +71,8 @@ class BoundaryWaveMaker:
     zones: tuple = ()
 
     def __init__(self, wave, still_water_level: float, *, ramp_time: float = 0.0,
-                 active_absorption: bool = True, gravity: float = 9.81):
+                 active_absorption: bool = default_of("waves", "active_absorption"),
+                 gravity: float = 9.81):
         if not math.isfinite(ramp_time) or ramp_time < 0:
             raise CaseFileError(f"waves: ramp_time must be >= 0 s, got {ramp_time!r}")
         self.wave = wave

@@ -28,6 +28,7 @@ from typing import ClassVar
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 from riprap.waves.theory import GRAVITY, wave_number
 
 __all__ = ["StreamFunctionWave", "NO_MASS_TRANSPORT", "NO_EULERIAN_CURRENT"]
@@ -62,7 +63,7 @@ class StreamFunctionWave:
     height: float
     period: float
     depth: float
-    phase: float = 0.0
+    phase: float = default_of("waves", "phase")
     terms: int = DEFAULT_TERMS
     current: str = NO_MASS_TRANSPORT
     gravity: float = GRAVITY

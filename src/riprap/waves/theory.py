@@ -20,6 +20,7 @@ from typing import ClassVar
 import numpy as np
 
 from riprap.errors import CaseFileError
+from riprap.schema import default_of
 
 __all__ = ["wave_number", "wave_length", "group_velocity", "LinearWave", "StokesSecondOrderWave", "IrregularWave",
            "jonswap_spectrum", "ramp"]
@@ -87,7 +88,7 @@ class LinearWave:
     height: float
     period: float
     depth: float
-    phase: float = 0.0
+    phase: float = default_of("waves", "phase")
     gravity: float = GRAVITY
 
     def __post_init__(self):
@@ -181,7 +182,7 @@ class StokesSecondOrderWave(LinearWave):
 
 
 def jonswap_spectrum(frequencies, significant_height: float, peak_period: float,
-                     peak_enhancement: float = 3.3):
+                     peak_enhancement: float = default_of("waves", "peak_enhancement")):
     """JONSWAP variance density S(f) (m^2 s) scaled so that 4 sqrt(m0) over ``frequencies`` is
     ``significant_height`` (Hm0; Hasselmann et al. 1973; sigma = 0.07 below the peak, 0.09 above).
     ``frequencies`` must be evenly spaced (Hz)."""
@@ -224,8 +225,8 @@ class IrregularWave:
     peak_period: float
     depth: float
     duration: float
-    peak_enhancement: float = 3.3
-    seed: int = 0
+    peak_enhancement: float = default_of("waves", "peak_enhancement")
+    seed: int = default_of("waves", "seed")
     gravity: float = GRAVITY
 
     def __post_init__(self):

@@ -22,7 +22,6 @@ from riprap.analysis.layer_state import LayerDescription
 from riprap.case.body_start import check_grid_starts
 from riprap.case.build import SMOKE_END_TIME, build_material, smoke_mode
 from riprap.case.load import parse_case
-from riprap.case.schema import MAXIMUM_BODY_COUNT
 from riprap.errors import CaseFileError
 from riprap.geometry.armour_units import armour_unit
 from riprap.geometry.rock_grading import RockGrading, rock_library
@@ -38,6 +37,7 @@ from riprap.placement.checks import check_filter_rule, check_row_fits
 from riprap.placement.place import (UNIT_SHAPE_NAME, check_generated_positions,
                                     check_start_positions, free_body_time_step, rock_lattice,
                                     rock_shapes)
+from riprap.schema import MAXIMUM_BODY_COUNT
 from riprap.solid.shape import RigidShape
 from riprap.work_estimate import RiprapWarning, check_rigid_run
 
