@@ -16,7 +16,7 @@ from riprap.deformable.system import DeformableSystem
 from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.phases import AIR_20C, WATER_20C
 from riprap.fluid.porous import PorousZone
-from riprap.fluid.run import FluidRun
+from riprap.simulation import FluidRun
 from riprap.fluid.solver import FluidSolver
 from riprap.geometry import shapes
 from riprap.geometry.armour_units import armour_unit
