@@ -306,6 +306,7 @@ class OutputSettings:
     directory: str = _default("output", "directory")
     paraview: bool = _default("output", "paraview")
     picture: bool = _default("output", "picture")
+    body_forces_interval: float = _default("output", "body_forces_interval")
 
 
 @dataclass(frozen=True, kw_only=True)

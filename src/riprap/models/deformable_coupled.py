@@ -10,6 +10,7 @@ import numpy as np
 
 from riprap.models.deformable import RECORD_EVERY_STEPS
 from riprap.models.fluid import CoupledModel, FluidModel
+from riprap.outputs.stresses import StressesWriter
 
 __all__ = ["DeformableCoupledModel"]
 
@@ -80,6 +81,10 @@ class DeformableCoupledModel(CoupledModel):
                                                       "rigid_bodies": metadata.get("rigid_bodies", 0)})
 
     # ------------------------------------------------------------------ outputs
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        return (super().default_writers(paraview=paraview, picture=picture)
+                + [StressesWriter(self.stresses, picture=picture)])
+
     def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
         from riprap.io import vtk
 
@@ -100,12 +105,12 @@ class DeformableCoupledModel(CoupledModel):
     def _write_bodies(self) -> None:
         self.stresses.write_frame(0)
 
-    def _body_force_rows(self) -> list[str]:
+    def body_force_rows(self) -> list[str]:
         """As a coupled run's, with each body's number in the case (the coupling puts the rigid
         bodies first)."""
         deformable, rigid = self.stresses.case_numbers
         numbers = list(rigid[:self.solids.n_rigid]) + list(deformable)
-        rows = super()._body_force_rows()
+        rows = super().body_force_rows()
         return [f"{numbers[int(row.split(',', 1)[0])]},{row.split(',', 1)[1]}" for row in rows]
 
     def close_outputs(self) -> dict:

@@ -17,6 +17,10 @@ import numpy as np
 
 from riprap.errors import InstabilityError, RiprapError
 from riprap.models.base import Model
+from riprap.models.body_frames import rigid_frame_fields
+from riprap.outputs.body_forces import BodyForcesWriter
+from riprap.outputs.gauges import GaugesWriter
+from riprap.waves.report import flume_report
 
 __all__ = ["FluidModel", "CoupledModel", "step_towards"]
 
@@ -123,15 +127,19 @@ class FluidModel(Model):
     def _body_fraction(self):
         return None
 
-    def _write_gauges(self) -> None:
-        if self.fluid.gauges is not None and self._directory is not None:
-            from riprap.io.gauge_files import write_gauges_csv
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        return (super().default_writers(paraview=paraview, picture=picture)
+                + [GaugesWriter(picture=picture)])
 
-            write_gauges_csv(self._directory / "gauges.csv", self.fluid.gauges)
+    def waves_report(self) -> dict:
+        """The waves the gauges measured, against the wave maker's target
+        (:func:`riprap.waves.report.flume_report`)."""
+        from riprap.waves.report import flume_report
+
+        return flume_report(self.fluid.gauges, self.fluid.wave_source, self.fluid.water.density)
 
     def write_frame(self, frame_index: int) -> None:
         s = self.fluid
-        self._write_gauges()
         velocity = s.cell_velocity()
         if self._series is not None:
             self._series.add_image(s.time, origin=s.grid.lower, spacing=s.h, cells=s.grid.cells,
@@ -146,19 +154,6 @@ class FluidModel(Model):
 
     def close_outputs(self) -> dict:
         outputs = {}
-        gauges = self.fluid.gauges
-        if gauges is not None and self._directory is not None:
-            from riprap.io.gauge_files import gauges_png, write_waves_report
-            from riprap.waves.report import flume_report
-
-            self._write_gauges()
-            outputs["gauges"] = str(self._directory / "gauges.csv")
-            report = flume_report(gauges, self.fluid.wave_source, self.fluid.water.density)
-            outputs["waves_report"] = str(write_waves_report(self._directory / "waves_report.json",
-                                                             report))
-            if self._picture:
-                outputs["gauges_picture"] = str(gauges_png(self._directory / "gauges.png", gauges,
-                                                           report))
         if self._series is not None:
             outputs["paraview"] = str(self._series.pvd_path)
         if self._picture:
@@ -207,7 +202,6 @@ class CoupledModel(FluidModel):
         self._body_series = None
         self._contact_series = None
         self._append = False
-        self._forces = None
         self._combined = None
         self.substeps = 0
         self.fastest = 0.0
@@ -260,9 +254,11 @@ class CoupledModel(FluidModel):
             raise InstabilityError(f"body {body} moves at {speeds[body]:.3g} m/s in {where} at "
                                    f"t = {self.time:.6g} s ({why})")
 
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        return super().default_writers(paraview=paraview, picture=picture) + [BodyForcesWriter()]
+
     def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
         from riprap.io import vtk
-        from riprap.io.body_forces import BodyForceTable
 
         super().open_outputs(directory, append=append, paraview=paraview, picture=picture)
         self._append = append
@@ -270,7 +266,6 @@ class CoupledModel(FluidModel):
             self._body_series = vtk.ParaViewSeries(directory, "bodies", append=append)
             self._combined = vtk.CombinedSeries(directory / "run.pvd",
                                                 [self._series, self._body_series])
-        self._forces = BodyForceTable(directory / "body_forces.csv", append=append)
 
     def _body_fraction(self):
         return self.solver.body_fraction()
@@ -281,7 +276,6 @@ class CoupledModel(FluidModel):
         super().write_frame(frame_index)
         if self._combined is not None:
             self._combined.write()
-        self._forces.append(self._body_force_rows())
 
     def _write_bodies(self) -> None:
         """The bodies' surfaces with velocity, the fluid's force on each body and the contact
@@ -289,28 +283,13 @@ class CoupledModel(FluidModel):
         and the frame of ``contacts.pvd`` (the last contact sub-step's contacts), so that
         ``riprap analyse`` gets coordination numbers, contact forces and factors of safety under
         wave load as it does dry."""
-        from riprap.analysis.unit_contacts import solver_contact_statistics
         from riprap.io import vtk
-        from riprap.solid.surfaces import surface_arrays
 
         coupled, solids = self.solver, self.solids
-        points, triangles, owners = surface_arrays(solids)
-        fluid_force = coupled.fluid_loads[:, :3] + coupled.fixed_body_loads[:, :3]
-        contact = solids.contact_forces()
-        statistics = solver_contact_statistics(solids)
-        # ParaView colours inf badly; a huge finite number reads as "nothing pushes it sideways".
-        safety = np.minimum(statistics["factor_of_safety_sliding"], 1.0e30)
-        self._body_series.add(coupled.time, points=points, cells=triangles, cell_type="triangle",
-                              cell_data={"body_id": owners, "velocity": solids.velocities[owners],
-                                         "speed": np.linalg.norm(solids.velocities, axis=1)[owners],
-                                         "angular_velocity": solids.angular_velocities[owners],
-                                         "fluid_force": fluid_force[owners],
-                                         "contact_force": contact[owners],
-                                         "fixed": solids.fixed[owners].astype(np.int64),
-                                         "coordination_number":
-                                             statistics["coordination_number"][owners],
-                                         "max_contact_force": statistics["max_contact_force"][owners],
-                                         "factor_of_safety_sliding": safety[owners]})
+        fields = rigid_frame_fields(solids, fluid_force=coupled.fluid_loads[:, :3]
+                                    + coupled.fixed_body_loads[:, :3])
+        self._body_series.add(coupled.time, points=fields["points"], cells=fields["cells"],
+                              cell_type="triangle", cell_data=fields["cell_data"])
         if self._contact_series is None:
             # opened with the first frame: a run whose bodies write their own frames (deformable
             # bodies in water) has no such series
@@ -318,8 +297,9 @@ class CoupledModel(FluidModel):
                                                       append=self._append)
         self._contact_series.add_contacts(coupled.time, solids.contacts)
 
-    def _body_force_rows(self) -> list[str]:
-        """Rows of ``body_forces.csv`` for the present time (one per body)."""
+    def body_force_rows(self) -> list[str]:
+        """Rows of ``body_forces.csv`` for the present time (one per body); the peak fluid force
+        of each is the largest since the previous call."""
         coupled, solids = self.solver, self.solids
         contact = solids.contact_forces()
         pressure, viscous = coupled.pressure_loads[:, :3], coupled.viscous_loads[:, :3]
@@ -346,7 +326,6 @@ class CoupledModel(FluidModel):
             outputs["fluid_and_bodies"] = str(self._combined.path)
         if self._contact_series is not None:
             outputs["contacts"] = str(self._contact_series.pvd_path)
-        outputs["body_forces"] = str(self._forces.path)
         return outputs
 
     def progress_text(self) -> str:

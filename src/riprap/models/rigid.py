@@ -10,6 +10,8 @@ import numpy as np
 
 from riprap.errors import RiprapError
 from riprap.models.base import Model
+from riprap.models.body_frames import rigid_frame_fields
+from riprap.outputs.bodies import RigidBodiesWriter
 from riprap.solid.kernels import interactions
 
 __all__ = ["RigidModel"]
@@ -42,9 +44,6 @@ class RigidModel(Model):
         self._estimate = 0.0
         self.smallest_step = self.largest_step = 0.0
         self.cuts = 0
-        self._series = self._contact_series = None
-        self._picture = False
-        self._directory = None
 
     # ------------------------------------------------------------------ clock
     @property
@@ -162,27 +161,16 @@ class RigidModel(Model):
         s._contacts = None
 
     # ------------------------------------------------------------------ outputs
-    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
-        from riprap.io import vtk
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        return [RigidBodiesWriter(paraview=paraview, picture=picture)]
 
-        self._directory = directory
-        self._picture = picture
-        if paraview:
-            self._series = vtk.ParaViewSeries(directory, "bodies", append=append)
-            self._contact_series = vtk.ParaViewSeries(directory, "contacts", append=append)
+    def frame_fields(self) -> dict:
+        """The bodies' surfaces now with their fields (:func:`rigid_frame_fields`)."""
+        return rigid_frame_fields(self.solver)
 
-    def write_frame(self, frame_index: int) -> None:
-        if self._series is not None:
-            self.simulation._write_frame(self._series, self._contact_series)
-
-    def close_outputs(self) -> dict:
-        outputs = {}
-        if self._series is not None:
-            outputs["paraview"] = str(self._series.pvd_path)
-            outputs["contacts"] = str(self._contact_series.pvd_path)
-        if self._picture:
-            outputs["picture"] = str(self.simulation.write_picture(self._directory / "final_state.png"))
-        return outputs
+    def picture(self, path):
+        """A picture of the bodies now (:meth:`riprap.simulation.Simulation.write_picture`)."""
+        return self.simulation.write_picture(path)
 
     def progress_text(self) -> str:
         return (f"KE {self.solver.kinetic_energy():.3g} J  {len(self.solver.contacts)} contacts  "
