@@ -94,7 +94,11 @@ def test_a_user_writer_attached_from_the_api_writes_at_its_own_times(tmp_path):
                            progress=False)
     writer = HeightOfOneBody(body=0)
     sim.add_writer(writer)
+    by_steps = HeightOfOneBody(body=0)            # 500 steps of 2e-5 s: the same times
+    by_steps.name, by_steps.schedule = "height_by_steps", Every(steps=500)
+    sim.add_writer(by_steps)
     summary = sim.run()
+    assert by_steps.rows == writer.rows
     assert [entry for entry, _, _ in writer.rows] == [0, 1, 2, 3, 4, 5]
     assert [t for _, t, _ in writer.rows] == pytest.approx([0.0, 0.01, 0.02, 0.03, 0.04, 0.05],
                                                            abs=1e-12)
@@ -138,6 +142,10 @@ def test_a_bad_schedule_is_refused_naming_its_key(tmp_path):
         Every()
     with pytest.raises(CaseFileError, match="steps=0"):
         Every(steps=0)
+    sim = Simulation(end_time=1.0)
+    sim.add_writer(HeightOfOneBody(body=0))
+    with pytest.raises(Exception, match="named 'height' is there already"):
+        sim.add_writer(HeightOfOneBody(body=0))
 
 
 def test_a_restart_goes_on_with_each_writers_schedule_bit_for_bit(tmp_path):
