@@ -596,6 +596,7 @@ class Simulation:
         is kept even with no writer on it: its times are where a fluid's steps land). A restart
         takes each schedule's entry from the checkpoint; a schedule the checkpoint does not know
         starts at its first entry not reached."""
+        self.frame_schedule.seconds = self.output_interval      # as set now, not at __init__
         schedules = {id(self.frame_schedule): (self.frame_schedule, [])}
         self._scheduled_writers = [writer for writer in writers if writer.schedule is not None]
         for writer in writers:
