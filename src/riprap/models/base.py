@@ -2,10 +2,6 @@
 bodies next)."""
 from __future__ import annotations
 
-from pathlib import Path
-
-from riprap.outputs.base import ModelFrames
-
 __all__ = ["Model"]
 
 
@@ -81,19 +77,10 @@ class Model:
 
     # ------------------------------------------------------------------ outputs
     def default_writers(self, *, paraview: bool, picture: bool) -> list:
-        """The writers of this model's outputs (``[output]`` paraview and picture), with no
-        schedule of their own (the run gives each its interval)."""
-        return [ModelFrames(paraview=paraview, picture=picture)]
-
-    def open_outputs(self, directory: Path, *, append: bool, paraview: bool, picture: bool) -> None:
-        """Open the series and tables written at every frame (append after a restart)."""
-
-    def write_frame(self, frame_index: int) -> None:
-        """Write one frame of every output at the present time."""
-
-    def close_outputs(self) -> dict:
-        """Final outputs (pictures); returns {name: path} of everything written."""
-        return {}
+        """The writers of this model's outputs (:mod:`riprap.outputs`; ``[output]`` paraview and
+        picture), with no schedule of their own (the run gives each its interval). The model
+        gives them data (its solver, data methods); it writes no file itself."""
+        return []
 
     def progress_text(self) -> str:
         """One line of the model's figures for the progress bar."""

@@ -13,7 +13,7 @@ from riprap.deformable.stresses import principal_stresses, von_mises
 from riprap.errors import InstabilityError, OverlapError, RiprapError
 from riprap.models.base import Model
 from riprap.models.body_frames import rigid_frame_fields
-from riprap.outputs.stresses import StressesWriter
+from riprap.outputs.stresses import DeformableFramesWriter, StressesWriter
 
 __all__ = ["DeformableModel", "UnitStressRecord"]
 
@@ -65,17 +65,12 @@ class DeformableModel(Model):
                                              list(range(len(system.bodies), len(system.bodies) + n_rigid)))
         self.accepted_depths = dict(accepted_depths or {})
         self.body_names = list(body_names or [b.name for b in system.bodies])
-        self._rigid_series = self._rigid_contact_series = None
         self._chunk = 10
-        self._series = None
-        self._directory = None
         self.records = UnitStressRecord(len(system.bodies))
-        self._picture = False
         # (time, positions, sigma_1 of every element) when the largest tensile stress of the run
         # so far was found: the state the picture shows
         self._peak = None
         self._surfaces = None
-        self._crack_series = None
 
     # ------------------------------------------------------------------ clock
     @property
@@ -319,20 +314,6 @@ class DeformableModel(Model):
         self.load_state_arrays(arrays)
 
     # ------------------------------------------------------------------ outputs
-    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
-        from riprap.io import vtk
-
-        self._directory = directory
-        self._picture = picture
-        if paraview:
-            self._series = vtk.ParaViewSeries(directory, "bodies", append=append)
-            if self.system.fracturing_bodies:
-                self._crack_series = vtk.ParaViewSeries(directory, "cracks", append=append)
-            if self.rigid is not None:
-                self._rigid_series = vtk.ParaViewSeries(directory, "rigid_bodies", append=append)
-                self._rigid_contact_series = vtk.ParaViewSeries(directory, "rigid_contacts",
-                                                                append=append)
-
     def frame_fields(self) -> dict:
         """Points, corner tets and the per-element stress fields of all bodies (ParaView names)."""
         s = self.system
@@ -400,24 +381,6 @@ class DeformableModel(Model):
                               "broken": s.joint_broken[damaged].astype(np.int64),
                               "opening": opening, "body": joint_body}}
 
-    def write_frame(self, frame_index: int) -> None:
-        if self._series is not None:
-            fields = self.frame_fields()
-            n = self.system.n_deformable_nodes
-            self._series.add(self.time, points=fields["points"][:n], cells=fields["cells"],
-                             cell_data=fields["cell_data"],
-                             point_data={k: v[:n] for k, v in fields["point_data"].items()})
-        if self._crack_series is not None:
-            cracks = self.crack_fields()
-            self._crack_series.add(self.time, points=cracks["points"], cells=cracks["cells"],
-                                   cell_type="triangle", cell_data=cracks["cell_data"])
-        if self._rigid_series is not None:
-            solver = self.rigid.solver
-            rigid = rigid_frame_fields(solver)
-            self._rigid_series.add(self.time, points=rigid["points"], cells=rigid["cells"],
-                                   cell_type="triangle", cell_data=rigid["cell_data"])
-            self._rigid_contact_series.add_contacts(self.time, solver.contacts)
-
     def unit_rows(self) -> list[dict]:
         """One row per body for ``units.csv``."""
         rows = []
@@ -442,19 +405,14 @@ class DeformableModel(Model):
             })
         return rows
 
-    def close_outputs(self) -> dict:
-        outputs = {}
-        if self._series is not None:
-            outputs["paraview"] = str(self._series.pvd_path)
-        if self._crack_series is not None:
-            outputs["cracks"] = str(self._crack_series.pvd_path)
-        if self._rigid_series is not None:
-            outputs["rigid_bodies"] = str(self._rigid_series.pvd_path)
-        return outputs
-
     def default_writers(self, *, paraview: bool, picture: bool) -> list:
-        return (super().default_writers(paraview=paraview, picture=picture)
-                + [StressesWriter(self, picture=picture)])
+        return [DeformableFramesWriter(self, paraview=paraview),
+                StressesWriter(self, picture=picture)]
+
+    def rigid_frame(self):
+        """(frame fields, contacts) of the rigid bodies now (with rigid bodies only)."""
+        solver = self.rigid.solver
+        return rigid_frame_fields(solver), solver.contacts
 
     def peak_state(self):
         """(time, positions, sigma_1 of every element) when the largest tensile stress of the run

@@ -1,5 +1,5 @@
 """The interface between the run loop and a writer (one output family: a ParaView series, a
-table, pictures), and the writer of the outputs a model still writes itself.
+table, pictures), and the writer of a model of the older interface that wrote its own outputs.
 
 A writer has a :attr:`Writer.schedule` (:class:`riprap.schedules.Every`, or None for the run's frame
 schedule, ``[simulation] output_interval``). The loop calls :meth:`Writer.open` once (``append``
@@ -38,9 +38,9 @@ class Writer:
 
 
 class ModelFrames(Writer):
-    """The outputs a model writes at every frame itself (``open_outputs``, ``write_frame``,
-    ``close_outputs``): ParaView series, free-surface pictures, gauges, the final pictures and
-    tables. The families taken out of the models so far have writers of their own."""
+    """The outputs of a model of the older interface, which writes them itself
+    (``open_outputs``, ``write_frame``, ``close_outputs``); riprap's models give data to the
+    writers of :mod:`riprap.outputs` instead."""
 
     name = "frames"
 

@@ -1,17 +1,81 @@
 """The stresses of deformable bodies, at the end of a run: ``units.csv`` (per unit the largest
 tensile stress of the run, where and when, and its breakage), ``fragments.csv`` (every piece of a
 cracking unit), and the pictures ``peak_stress.png``, ``final_stress.png`` and ``fragments.png``.
-The frames of the stresses (``bodies.pvd``, ``cracks.pvd``) are still written by the model."""
+At every entry: ``bodies.pvd`` (the stresses inside every body), ``cracks.pvd`` (the damaged
+joints) and, with rigid bodies too, ``rigid_bodies.pvd`` and ``rigid_contacts.pvd``."""
 from __future__ import annotations
 
 import numpy as np
 
 from riprap.deformable.elements import boundary_faces_with_owners
+from riprap.io import vtk
 from riprap.io.deformable_outputs import write_fragments_csv, write_units_csv
 from riprap.io.picture import render_bodies_png
 from riprap.outputs.base import Writer
 
-__all__ = ["StressesWriter", "stress_picture", "fragment_picture"]
+__all__ = ["DeformableFramesWriter", "StressesWriter", "stress_picture", "fragment_picture"]
+
+
+class DeformableFramesWriter(Writer):
+    """Frames of ``stresses`` (a :class:`riprap.models.deformable.DeformableModel`:
+    ``frame_fields()``, ``crack_fields()``, ``rigid_frame()``), at its own clock. ``cracks``:
+    write ``cracks.pvd`` for cracking bodies; ``key``: summary.json's name of ``bodies.pvd``."""
+
+    name = "deformable_bodies"
+
+    def __init__(self, stresses, *, paraview: bool = True, cracks: bool = True,
+                 key: str = "paraview", schedule=None):
+        super().__init__(schedule)
+        self.stresses = stresses
+        self.paraview = paraview
+        self.cracks = cracks
+        self.key = key
+        self.series = self._crack_series = self._rigid_series = self._rigid_contact_series = None
+
+    def open(self, model, directory, *, append):
+        if not self.paraview:
+            return
+        stresses = self.stresses
+        self.series = vtk.ParaViewSeries(directory, "bodies", append=append)
+        if self.cracks and stresses.system.fracturing_bodies:
+            self._crack_series = vtk.ParaViewSeries(directory, "cracks", append=append)
+        if stresses.rigid is not None:
+            self._rigid_series = vtk.ParaViewSeries(directory, "rigid_bodies", append=append)
+            self._rigid_contact_series = vtk.ParaViewSeries(directory, "rigid_contacts",
+                                                            append=append)
+
+    def combined_series(self) -> list:
+        return [self.series] + ([self._rigid_series] if self._rigid_series is not None else [])
+
+    def write(self, model, entry):
+        stresses = self.stresses
+        time = stresses.time
+        if self.series is not None:
+            fields = stresses.frame_fields()
+            n = stresses.system.n_deformable_nodes
+            self.series.add(time, points=fields["points"][:n], cells=fields["cells"],
+                            cell_data=fields["cell_data"],
+                            point_data={k: v[:n] for k, v in fields["point_data"].items()})
+        if self._crack_series is not None:
+            cracks = stresses.crack_fields()
+            self._crack_series.add(time, points=cracks["points"], cells=cracks["cells"],
+                                   cell_type="triangle", cell_data=cracks["cell_data"])
+        if self._rigid_series is not None:
+            rigid, contacts = stresses.rigid_frame()
+            self._rigid_series.add(time, points=rigid["points"], cells=rigid["cells"],
+                                   cell_type="triangle", cell_data=rigid["cell_data"])
+            self._rigid_contact_series.add_contacts(time, contacts)
+
+    def close(self, model):
+        outputs = {}
+        if self.series is not None:
+            outputs[self.key] = str(self.series.pvd_path)
+        if self._crack_series is not None:
+            outputs["cracks"] = str(self._crack_series.pvd_path)
+        if self._rigid_series is not None:
+            outputs["rigid_bodies"] = str(self._rigid_series.pvd_path)
+            outputs["rigid_contacts"] = str(self._rigid_contact_series.pvd_path)
+        return outputs
 
 
 class StressesWriter(Writer):
