@@ -780,6 +780,10 @@ KEYS: tuple[Key, ...] = (
         default=True),
     Key("output", "picture", "boolean", "-", "Write a PNG picture of the final state.",
         default=True),
+    Key("output", "body_forces_interval", "number", "s",
+        "Simulated time between the rows of body_forces.csv (bodies in a flow); 0 writes them at "
+        f"the frames ([simulation] output_interval); at most {MAX_FRAMES:,} rows per body in a run.",
+        default=0.0, valid_range=_NON_NEGATIVE),
 )
 
 

@@ -25,6 +25,8 @@ from riprap.models.base import Model
 from riprap.models.settings import ModelSettings
 from riprap.scene import DEFAULT_GRAVITY, Scene
 from riprap.scene.choose_model import build_model
+from riprap.schedules import Every
+from riprap.schema import default_of
 from riprap.work_estimate import MAX_CHECKPOINTS, MAX_FRAMES, schedule_problems
 
 __all__ = ["FluidRun", "FluidRunSummary", "RunSummary", "Simulation"]
@@ -151,6 +153,9 @@ class Simulation:
     output_directory : str or Path
     paraview, picture : bool
         Write a ``.pvd`` series / a PNG of the final state.
+    body_forces_interval : float
+        Simulated seconds between the rows of ``body_forces.csv`` (bodies in a flow); 0: at the
+        frames (``output_interval``).
     progress : bool
         Show a progress bar on the terminal.
     fluid : FluidSolver, optional
@@ -159,13 +164,20 @@ class Simulation:
         sub-step inside each fluid step (the fluid's own step follows its Courant number).
     """
 
-    def __init__(self, scene=None, *, end_time: float, time_step: float = 0.0,
-                 time_step_safety: float = 0.2, gravity=DEFAULT_GRAVITY,
-                 output_interval: float = 0.05, checkpoint_interval: float = 0.0,
-                 local_damping: float = 0.0, rest_speed: float = 0.0,
-                 output_directory="riprap-out", paraview: bool = True, picture: bool = True,
-                 progress: bool = True, rest_kinetic_energy: float = 0.0,
-                 adaptive_time_step: bool = False, fluid=None):
+    def __init__(self, scene=None, *, end_time: float,
+                 time_step: float = default_of("simulation", "time_step"),
+                 time_step_safety: float = default_of("simulation", "time_step_safety"),
+                 gravity=DEFAULT_GRAVITY,
+                 output_interval: float = default_of("simulation", "output_interval"),
+                 checkpoint_interval: float = default_of("simulation", "checkpoint_interval"),
+                 local_damping: float = default_of("simulation", "local_damping"),
+                 rest_speed: float = default_of("simulation", "rest_speed"),
+                 output_directory=default_of("output", "directory"),
+                 paraview: bool = default_of("output", "paraview"),
+                 picture: bool = default_of("output", "picture"), progress: bool = True,
+                 rest_kinetic_energy: float = default_of("placement", "rest_kinetic_energy"),
+                 adaptive_time_step: bool = False, fluid=None,
+                 body_forces_interval: float = default_of("output", "body_forces_interval")):
         _require(end_time > 0, "end_time", end_time, "> 0 s")
         _require(time_step >= 0, "time_step", time_step, ">= 0 s (0 = automatic)")
         _require(0 < time_step_safety <= 1, "time_step_safety", time_step_safety, "in (0, 1]")
@@ -185,6 +197,9 @@ class Simulation:
         self.output_interval = float(output_interval)
         self.checkpoint_interval = float(checkpoint_interval)
         self.rest_speed = float(rest_speed)
+        #: Each default writer's own interval (s) where it has one ([output] *_interval keys).
+        self.output_intervals = {}
+        self.set_output_interval("body_forces", body_forces_interval)
         self.output_directory = Path(output_directory)
         self.paraview = bool(paraview)
         self.picture = bool(picture)
@@ -196,7 +211,11 @@ class Simulation:
         # refused. None for a run built in Python: its restarts are not checked.
         self.run_definition = None
         self.progress = bool(progress)
-        self._frame_index = 0            # frames written on the schedule (next at index * interval)
+        #: The run's frames: every ``output_interval`` s (writers with no schedule of their own).
+        self.frame_schedule = Every(seconds=self.output_interval)
+        self._writers = []               # added with add_writer, written after the model's own
+        self._restored_schedules = {}    # {writer name: entry due next} from a restart's checkpoint
+        self._scheduled_writers = []     # the run's writers with a schedule of their own
         self._checkpoints_written = 0    # periodic checkpoints (next at (count + 1) * interval)
         self._restarted = False
         self._model = None
@@ -312,11 +331,12 @@ class Simulation:
             self.restart(restart_from)
         self.prepare()
         model = self.model
-        model.open_outputs(out, append=self._restarted, paraview=self.paraview,
-                           picture=self.picture)
-        last_frame_time = model.time
+        writers = self.writers(model)
+        schedules = self._open_writers(model, writers, out)
+        last_written = {id(schedule): model.time for schedule, _ in schedules}
         if not self._restarted:
-            self._write_scheduled_frame(model)
+            for schedule, due in schedules:
+                self._write_entry(model, schedule, due)
         start_wall = wallclock.perf_counter()
         start_steps = model.step_count
         end_reason = "end_time"
@@ -324,7 +344,8 @@ class Simulation:
         with _Progress(self.progress, self.end_time, model.name) as progress:
             stalled = 0
             while not model.reached(self.end_time):
-                until = min(time for time in self._scheduled_times() if not model.reached(time))
+                until = min(time for time in self._scheduled_times(model, schedules)
+                            if not model.reached(time))
                 before = (model.time, model.step_count)
                 try:
                     model.advance(until)
@@ -344,9 +365,10 @@ class Simulation:
                         f"the clock nor the step count (time step {model.last_time_step():.3g} "
                         "s); check [simulation] time_step and the intervals")
                 good = model.state_arrays()
-                if model.reached(self._frame_index * self.output_interval):
-                    self._write_scheduled_frame(model)
-                    last_frame_time = model.time
+                for schedule, due in schedules:
+                    if schedule.due(model):
+                        self._write_entry(model, schedule, due)
+                        last_written[id(schedule)] = model.time
                 if (self.checkpoint_interval > 0 and model.reached(
                         (self._checkpoints_written + 1) * self.checkpoint_interval)):
                     self._checkpoints_written = _first_not_reached(
@@ -365,13 +387,17 @@ class Simulation:
                 model.after_good_chunk()
         wall = wallclock.perf_counter() - start_wall
         frames = self._frame_index
-        if model.time - last_frame_time > 0.5 * model.last_time_step():
-            # The run ended between frame times (at rest, or an end time off the schedule): its
-            # last state is a frame too, outside the schedule a restart counts on.
-            model.write_frame(frames)
-            frames += 1
+        for schedule, due in schedules:
+            if model.time - last_written[id(schedule)] > 0.5 * model.last_time_step():
+                # The run ended between entries (at rest, or an end time off the schedule): its
+                # last state is an entry too, outside the schedule a restart counts on.
+                for writer in due:
+                    writer.write(model, schedule.index)
+                if schedule is self.frame_schedule:
+                    frames += 1
         outputs = {"checkpoint": str(self._save_checkpoint("checkpoint.npz", model.state_arrays()))}
-        outputs.update(model.close_outputs())
+        for writer in writers:
+            outputs.update(writer.close(model))
         steps = model.step_count - start_steps
         summary = RunSummary(model=model.name, end_reason=end_reason, simulated_time=model.time,
                              steps=steps, wall_time=wall, frames=frames, outputs=outputs,
@@ -381,22 +407,96 @@ class Simulation:
         write_json(out / "summary.json", summary.as_dict())
         return summary
 
-    def _scheduled_times(self) -> list[float]:
-        times = [self.end_time, self._frame_index * self.output_interval]
+    def _open_writers(self, model, writers, directory) -> list:
+        """Open every writer; returns [(schedule, its writers)], the frames' schedule first (it
+        is kept even with no writer on it: its times are where a fluid's steps land). A restart
+        takes each schedule's entry from the checkpoint; a schedule the checkpoint does not know
+        starts at its first entry not reached."""
+        self.frame_schedule.seconds = self.output_interval      # as set now, not at __init__
+        schedules = {id(self.frame_schedule): (self.frame_schedule, [])}
+        self._scheduled_writers = [writer for writer in writers if writer.schedule is not None]
+        for writer in writers:
+            schedule = writer.schedule or self.frame_schedule
+            if id(schedule) not in schedules:
+                schedules[id(schedule)] = (schedule, [])
+                if self._restarted:
+                    schedule.index = self._restored_schedules.get(writer.name, 0)
+                    while schedule.due(model) and schedule.index <= MAX_FRAMES:
+                        schedule.index += 1
+            schedules[id(schedule)][1].append(writer)
+            writer.open(model, directory, append=self._restarted)
+        return list(schedules.values())
+
+    def _scheduled_times(self, model, schedules) -> list[float]:
+        times = [self.end_time] + [schedule.next_time(model) for schedule, _ in schedules]
         if self.checkpoint_interval > 0:
             times.append((self._checkpoints_written + 1) * self.checkpoint_interval)
         return times
 
-    def _write_scheduled_frame(self, model) -> None:
-        model.write_frame(self._frame_index)
-        self._frame_index += 1
-        if not model.reached(self.end_time):
-            # a chunk longer than a frame interval: no frame twice
-            self._frame_index = _first_not_reached(model, self._frame_index, self.output_interval,
-                                                   MAX_FRAMES, "output_interval")
+    def _write_entry(self, model, schedule, writers) -> None:
+        for writer in writers:
+            writer.write(model, schedule.index)
+        if model.reached(self.end_time):
+            schedule.index += 1
+        else:
+            # a chunk longer than the interval: no entry twice
+            name = ("simulation.output_interval" if schedule is self.frame_schedule
+                    else f"the writer {writers[0].name!r}")
+            schedule.written(model, MAX_FRAMES, name)
 
     # ------------------------------------------------------------------ outputs
     # ------------------------------------------------------------------ outputs
+    @property
+    def _frame_index(self) -> int:
+        """Frames written on the schedule (the next at index * output_interval)."""
+        return self.frame_schedule.index
+
+    @_frame_index.setter
+    def _frame_index(self, index: int) -> None:
+        self.frame_schedule.index = int(index)
+
+    def add_writer(self, writer) -> None:
+        """Write one more output family during the run: a :class:`riprap.outputs.Writer` (its
+        ``schedule`` a :class:`riprap.schedules.Every`, or None for the frames), written after the
+        model's own outputs at the same times."""
+        if any(writer.name == other.name for other in self._writers):
+            raise RiprapError(f"add_writer: a writer named {writer.name!r} is there already; give "
+                              "each writer its own name (it keys the writer's schedule in "
+                              "checkpoints)")
+        self._writers.append(writer)
+
+    def set_output_interval(self, name: str, interval: float) -> None:
+        """Give the default writer ``name`` (``"body_forces"``) an interval of its own (s); 0
+        writes it at the frames. A bad value is refused naming ``[output] {name}_interval``."""
+        key = f"output.{name}_interval"
+        if not (isinstance(interval, (int, float)) and not isinstance(interval, bool)
+                and np.isfinite(interval) and interval >= 0):
+            raise CaseFileError(f"{key} = {interval!r}: expected a number >= 0 s (0 = at the "
+                                "frames, every output_interval)")
+        if interval > 0 and self.end_time / interval > MAX_FRAMES:
+            raise CaseFileError(
+                f"{key} = {interval:g}: {self.end_time / interval:.3g} entries in end_time = "
+                f"{self.end_time:g} s, more than the {MAX_FRAMES} a run may write; set it >= "
+                f"{self.end_time / MAX_FRAMES:.3g} s (end_time / {MAX_FRAMES})")
+        if interval > 0:
+            self.output_intervals[name] = float(interval)
+        else:
+            self.output_intervals.pop(name, None)
+
+    def writers(self, model) -> list:
+        """Every writer of the run: the model's defaults (``[output]`` paraview, picture and
+        the intervals), then the ones added with :meth:`add_writer`."""
+        from riprap.outputs.base import ModelFrames
+
+        if hasattr(model, "default_writers"):
+            defaults = model.default_writers(paraview=self.paraview, picture=self.picture)
+        else:       # a model of the older interface: its outputs in its own three methods
+            defaults = [ModelFrames(paraview=self.paraview, picture=self.picture)]
+        for writer in defaults:
+            if writer.name in self.output_intervals:
+                writer.schedule = Every(seconds=self.output_intervals[writer.name])
+        return defaults + self._writers
+
     def surface_arrays(self):
         """World boundary surfaces of all bodies: points (n, 3), triangles (m, 3), body of each
         triangle (m,)."""
@@ -414,7 +514,6 @@ class Simulation:
         from riprap.solid.contact_statistics import solver_contact_statistics
 
         return solver_contact_statistics(self.solver)
-
 
     def write_picture(self, path, *, show_fixed: bool = False, planes=None, view=(25, -60),
                       title: str | None = None) -> Path:
@@ -438,6 +537,9 @@ class Simulation:
         metadata.update({"kind": model.kind, "frame_index": self._frame_index,
                          "checkpoints_written": self._checkpoints_written,
                          "time": float(state["clock"][0])})
+        own = {writer.name: writer.schedule.index for writer in self._scheduled_writers}
+        if own:
+            metadata["schedules"] = own
         if self.run_definition is not None:
             metadata["case_record"] = self.run_definition.values
         return save_checkpoint(self.output_directory / name, arrays=arrays, metadata=metadata)
@@ -467,6 +569,7 @@ class Simulation:
         kind = metadata.get("kind")
         model.restore(arrays)
         self._frame_index = int(metadata["frame_index"])
+        self._restored_schedules = dict(metadata.get("schedules", {}))
         if "checkpoints_written" in metadata:
             self._checkpoints_written = int(metadata["checkpoints_written"])
         else:
@@ -601,9 +704,12 @@ class FluidRun(Simulation):
     :class:`riprap.coupling.coupled.CoupledSolver`. The fluid is ``run.fluid`` and, for a coupled
     run, the bodies' solver is ``run.solver`` (as in every Simulation)."""
 
-    def __init__(self, solver, *, end_time: float, output_interval: float = 0.05,
-                 checkpoint_interval: float = 0.0, output_directory="riprap-out",
-                 paraview: bool = True, picture: bool = True, progress: bool = True,
+    def __init__(self, solver, *, end_time: float,
+                 output_interval: float = default_of("simulation", "output_interval"),
+                 checkpoint_interval: float = default_of("simulation", "checkpoint_interval"),
+                 output_directory=default_of("output", "directory"),
+                 paraview: bool = default_of("output", "paraview"),
+                 picture: bool = default_of("output", "picture"), progress: bool = True,
                  case_file: str = ""):
         super().__init__(end_time=end_time, output_interval=output_interval,
                          checkpoint_interval=checkpoint_interval,

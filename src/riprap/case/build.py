@@ -85,7 +85,8 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
         output_interval=settings.output_interval, checkpoint_interval=settings.checkpoint_interval,
         local_damping=settings.local_damping, rest_speed=settings.rest_speed,
         output_directory=output_directory or case.output.directory,
-        paraview=case.output.paraview, picture=case.output.picture, progress=progress)
+        paraview=case.output.paraview, picture=case.output.picture, progress=progress,
+        body_forces_interval=case.output.body_forces_interval)
     if case.source and Path(case.source).is_file():
         sim.case_file = str(Path(case.source).resolve())
     sim.run_definition = RunDefinition.of(case)

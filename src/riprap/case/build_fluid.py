@@ -132,7 +132,8 @@ def build_fluid_run(case, *, output_directory=None, progress: bool = True):
         end_time=min(settings.end_time, SMOKE_END_TIME) if smoke_mode() else settings.end_time,
         output_interval=settings.output_interval, checkpoint_interval=settings.checkpoint_interval,
         output_directory=output_directory or case.output.directory, paraview=case.output.paraview,
-        picture=case.output.picture, progress=progress, fluid=fluid)
+        picture=case.output.picture, progress=progress, fluid=fluid,
+        body_forces_interval=case.output.body_forces_interval)
     simulation.case_file = str(source.resolve()) if source.is_file() else ""
     simulation.run_definition = RunDefinition.of(case)
     _warn_if_too_short_to_analyse(case, simulation)

@@ -44,6 +44,14 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
                 end_time=end_time, output_interval=simulation["output_interval"],
                 checkpoint_interval=simulation["checkpoint_interval"], end_key=end_key):
             add(("simulation", key), message, value)
+        output = tables.get("output")
+        interval = output.get("body_forces_interval") if output else None
+        if interval is not None and ok(interval) and interval > 0:
+            # the body forces' own schedule has the frames' limit
+            for _, value, message in schedule_problems(end_time=end_time, output_interval=interval,
+                                                       checkpoint_interval=0.0, end_key=end_key):
+                add(("output", "body_forces_interval"),
+                    message.replace("set output_interval", "set body_forces_interval"), value)
 
     for name in ("waves", "gauges", "porous_zones"):
         if tables.get(name) and tables.get("fluid") is None:

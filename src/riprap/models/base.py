@@ -2,18 +2,17 @@
 bodies next)."""
 from __future__ import annotations
 
-from pathlib import Path
-
 __all__ = ["Model"]
 
 
 class Model:
     """Base of every model the run loop drives. Subclasses fill in the methods that raise.
 
-    The loop calls, in this order: :meth:`prepare` once; :meth:`open_outputs`; then repeatedly
+    The loop calls, in this order: :meth:`prepare` once; it opens the writers
+    (:meth:`default_writers` and the user's, :mod:`riprap.outputs`); then repeatedly
     :meth:`advance` towards the next scheduled time, :meth:`state_arrays` after each good chunk,
-    :meth:`write_frame` when :meth:`reached` says a frame time has come; and at the end
-    :meth:`close_outputs` and :meth:`summary_fields`.
+    and the writers whose schedule :meth:`reached` says has come; and at the end it closes the
+    writers and asks for :meth:`summary_fields`.
     """
 
     #: Checkpoint kind: a checkpoint is restarted only by a model of the same kind.
@@ -77,15 +76,11 @@ class Model:
         self.load_state_arrays(arrays)
 
     # ------------------------------------------------------------------ outputs
-    def open_outputs(self, directory: Path, *, append: bool, paraview: bool, picture: bool) -> None:
-        """Open the series and tables written at every frame (append after a restart)."""
-
-    def write_frame(self, frame_index: int) -> None:
-        """Write one frame of every output at the present time."""
-
-    def close_outputs(self) -> dict:
-        """Final outputs (pictures); returns {name: path} of everything written."""
-        return {}
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        """The writers of this model's outputs (:mod:`riprap.outputs`; ``[output]`` paraview and
+        picture), with no schedule of their own (the run gives each its interval). The model
+        gives them data (its solver, data methods); it writes no file itself."""
+        return []
 
     def progress_text(self) -> str:
         """One line of the model's figures for the progress bar."""

@@ -15,6 +15,8 @@ from riprap.errors import InstabilityError, OverlapError, RiprapError
 from riprap.limits import PROGRESS_PERIOD
 from riprap.limits import START_OVERLAP_FRACTION as _START_OVERLAP_FRACTION
 from riprap.models.base import Model
+from riprap.models.body_frames import rigid_frame_fields
+from riprap.outputs.stresses import DeformableFramesWriter, StressesWriter
 
 __all__ = ["DeformableModel", "UnitStressRecord"]
 
@@ -62,17 +64,12 @@ class DeformableModel(Model):
                                              list(range(len(system.bodies), len(system.bodies) + n_rigid)))
         self.accepted_depths = dict(accepted_depths or {})
         self.body_names = list(body_names or [b.name for b in system.bodies])
-        self._rigid_series = self._rigid_contact_series = None
         self._chunk = 10
-        self._series = None
-        self._directory = None
         self.records = UnitStressRecord(len(system.bodies))
-        self._picture = False
         # (time, positions, sigma_1 of every element) when the largest tensile stress of the run
         # so far was found: the state the picture shows
         self._peak = None
         self._surfaces = None
-        self._crack_series = None
 
     # ------------------------------------------------------------------ clock
     @property
@@ -301,20 +298,6 @@ class DeformableModel(Model):
         self.load_state_arrays(arrays)
 
     # ------------------------------------------------------------------ outputs
-    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
-        from riprap.io import vtk
-
-        self._directory = directory
-        self._picture = picture
-        if paraview:
-            self._series = vtk.ParaViewSeries(directory, "bodies", append=append)
-            if self.system.fracturing_bodies:
-                self._crack_series = vtk.ParaViewSeries(directory, "cracks", append=append)
-            if self.rigid is not None:
-                self._rigid_series = vtk.ParaViewSeries(directory, "rigid_bodies", append=append)
-                self._rigid_contact_series = vtk.ParaViewSeries(directory, "rigid_contacts",
-                                                                append=append)
-
     def frame_fields(self) -> dict:
         """Points, corner tets and the per-element stress fields of all bodies (ParaView names)."""
         s = self.system
@@ -382,20 +365,6 @@ class DeformableModel(Model):
                               "broken": s.joint_broken[damaged].astype(np.int64),
                               "opening": opening, "body": joint_body}}
 
-    def write_frame(self, frame_index: int) -> None:
-        if self._series is not None:
-            fields = self.frame_fields()
-            n = self.system.n_deformable_nodes
-            self._series.add(self.time, points=fields["points"][:n], cells=fields["cells"],
-                             cell_data=fields["cell_data"],
-                             point_data={k: v[:n] for k, v in fields["point_data"].items()})
-        if self._crack_series is not None:
-            cracks = self.crack_fields()
-            self._crack_series.add(self.time, points=cracks["points"], cells=cracks["cells"],
-                                   cell_type="triangle", cell_data=cracks["cell_data"])
-        if self._rigid_series is not None:
-            self.rigid._write_frame(self._rigid_series, self._rigid_contact_series, time=self.time)
-
     def unit_rows(self) -> list[dict]:
         """One row per body for ``units.csv``."""
         rows = []
@@ -420,68 +389,25 @@ class DeformableModel(Model):
             })
         return rows
 
-    def close_outputs(self) -> dict:
-        from riprap.io.deformable_outputs import write_fragments_csv, write_units_csv
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        return [DeformableFramesWriter(self, paraview=paraview),
+                StressesWriter(self, picture=picture)]
 
-        outputs = {"units": str(write_units_csv(self._directory / "units.csv", self.unit_rows()))}
-        if self._series is not None:
-            outputs["paraview"] = str(self._series.pvd_path)
-        if self._crack_series is not None:
-            outputs["cracks"] = str(self._crack_series.pvd_path)
-        if self.system.fracturing_bodies:
-            outputs["fragments"] = str(write_fragments_csv(self._directory / "fragments.csv",
-                                                           self.fragment_rows()))
-            if self._picture:
-                outputs["fragments_picture"] = str(self.write_fragment_picture(
-                    self._directory / "fragments.png"))
-        if self._rigid_series is not None:
-            outputs["rigid_bodies"] = str(self._rigid_series.pvd_path)
-        if self._picture and self._peak is not None:
-            outputs["picture"] = str(self.write_stress_picture(self._directory / "peak_stress.png",
-                                                               self._peak, peak=True))
-            final = (self.system.time, self.system.positions.copy(),
-                     np.concatenate([principal_stresses(b.cauchy_stresses())[:, 0]
-                                     for b in self.system.bodies]))
-            outputs["final_picture"] = str(self.write_stress_picture(
-                self._directory / "final_stress.png", final, peak=False))
-        return outputs
+    def rigid_frame(self):
+        """(frame fields, contacts) of the rigid bodies now (with rigid bodies only)."""
+        solver = self.rigid.solver
+        return rigid_frame_fields(solver), solver.contacts
 
-    def write_stress_picture(self, path, snapshot, *, peak: bool):
-        """The bodies' surfaces coloured by the largest principal stress of the element under each
-        face in ``snapshot`` (time, positions, sigma_1 of every element): the moment the largest
-        tensile stress of the run was found (``peak``), or the end of the run."""
-        from riprap.deformable.elements import boundary_faces_with_owners
-        from riprap.io.picture import render_bodies_png
+    def peak_state(self):
+        """(time, positions, sigma_1 of every element) when the largest tensile stress of the run
+        so far was found; None before the first record."""
+        return self._peak
 
-        time, positions, sigma_1 = snapshot
-        s = self.system
-        triangles, values = [], []
-        for k, body in enumerate(s.bodies):
-            faces, owners = boundary_faces_with_owners(body.elements.corner_tets)
-            triangles.append(positions[faces + s.node_offsets[k]])
-            values.append(sigma_1[owners + s.element_offsets[k]])
-        triangles = np.concatenate(triangles)
-        values = np.concatenate(values) / 1e6
-        low, high = float(values.min()), float(values.max())
-        if low < 0.0 < high:
-            # tension and compression: white at zero
-            colour_map, value_range = "coolwarm", (-max(-low, high), max(-low, high))
-        else:
-            # one sign throughout (a body squeezed by the water all round): its own range
-            colour_map, value_range = "viridis", (low, high if high > low else low + 1e-9)
-        if peak:
-            worst = int(np.argmax(self.records.stress))
-            what = ("largest tensile stress of the run" if self.records.stress[worst] > 0.0
-                    else "least compression of the run (no tension)")
-            title = (f"t = {time:.4g} s: {what}, {self.records.stress[worst] / 1e6:.3g} MPa in "
-                     f"{self.body_names[worst]}")
-        else:
-            what = "largest tensile stress" if sigma_1.max() > 0.0 else "all in compression, sigma_1 up to"
-            title = f"end of the run, t = {time:.4g} s: {what} {float(sigma_1.max()) / 1e6:.3g} MPa"
-        return render_bodies_png(
-            path, triangles_world=triangles, body_ids=np.arange(len(triangles)), values=values,
-            value_label="largest principal stress sigma_1 (MPa, tension +)", colour_map=colour_map,
-            value_range=value_range, title=title)
+    def final_state(self):
+        """(time, positions, sigma_1 of every element) now."""
+        return (self.system.time, self.system.positions.copy(),
+                np.concatenate([principal_stresses(b.cauchy_stresses())[:, 0]
+                                for b in self.system.bodies]))
 
     def fragment_rows(self) -> list[dict]:
         """Every piece of every cracking body, a body of its own: the unit it came from, its tets,
@@ -499,24 +425,6 @@ class DeformableModel(Model):
                              "x_m": float(x), "y_m": float(y), "z_m": float(z),
                              "vx_m_s": float(vx), "vy_m_s": float(vy), "vz_m_s": float(vz)})
         return rows
-
-    def write_fragment_picture(self, path):
-        """The bodies' surfaces now, the crack faces included, one colour per fragment (the
-        rigid bodies grey)."""
-        from riprap.io.picture import render_bodies_png
-
-        s = self.system
-        triangles = s.positions[s.triangles]
-        # one id per (body, fragment): the contact groups are exactly that
-        ids = s.triangle_group
-        rigid = np.unique(ids[s.triangle_body >= s.first_rigid_body])
-        pieces = int(s.first_rigid_group)
-        broken = sum(self.system.bodies[k].breakage_summary()["fragments"] - 1
-                     for k in s.fracturing_bodies)
-        return render_bodies_png(
-            path, triangles_world=triangles, body_ids=ids, grey_bodies=rigid,
-            title=f"t = {s.time:.4g} s: {pieces} pieces of {len(s.bodies)} deformable "
-                  f"bod{'y' if len(s.bodies) == 1 else 'ies'} ({broken} broken off), one colour each")
 
     def progress_text(self) -> str:
         s = self.system

@@ -10,6 +10,7 @@ import numpy as np
 
 from riprap.models.deformable import RECORD_EVERY_STEPS
 from riprap.models.fluid import CoupledModel, FluidModel
+from riprap.outputs.stresses import DeformableFramesWriter, StressesWriter
 
 __all__ = ["DeformableCoupledModel"]
 
@@ -80,42 +81,22 @@ class DeformableCoupledModel(CoupledModel):
                                                       "rigid_bodies": metadata.get("rigid_bodies", 0)})
 
     # ------------------------------------------------------------------ outputs
-    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
-        from riprap.io import vtk
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        return (super().default_writers(paraview=paraview, picture=picture)
+                + [StressesWriter(self.stresses, picture=picture)])
 
-        super().open_outputs(directory, append=append, paraview=paraview, picture=picture)
-        stresses = self.stresses
-        stresses._directory = directory
-        stresses._picture = picture
+    def _bodies_writer(self, paraview: bool):
         # the deformable bodies' frames carry the stresses, in the series run.pvd opens with the
-        # fluid's; rigid bodies have their own series, opened there too
-        stresses._series = self._body_series
-        if paraview and stresses.rigid is not None:
-            stresses._rigid_series = vtk.ParaViewSeries(directory, "rigid_bodies", append=append)
-            stresses._rigid_contact_series = vtk.ParaViewSeries(directory, "rigid_contacts",
-                                                                append=append)
-            self._combined = vtk.CombinedSeries(directory / "run.pvd", [
-                self._series, self._body_series, stresses._rigid_series])
+        # fluid's (rigid bodies have their own series, there too)
+        return DeformableFramesWriter(self.stresses, paraview=paraview, cracks=False, key="bodies")
 
-    def _write_bodies(self) -> None:
-        self.stresses.write_frame(0)
-
-    def _body_force_rows(self) -> list[str]:
+    def body_force_rows(self) -> list[str]:
         """As a coupled run's, with each body's number in the case (the coupling puts the rigid
         bodies first)."""
         deformable, rigid = self.stresses.case_numbers
         numbers = list(rigid[:self.solids.n_rigid]) + list(deformable)
-        rows = super()._body_force_rows()
+        rows = super().body_force_rows()
         return [f"{numbers[int(row.split(',', 1)[0])]},{row.split(',', 1)[1]}" for row in rows]
-
-    def close_outputs(self) -> dict:
-        outputs = super().close_outputs()
-        for key, value in self.stresses.close_outputs().items():
-            if key != "paraview":
-                outputs[key] = value
-        if self.stresses._rigid_contact_series is not None:
-            outputs["rigid_contacts"] = str(self.stresses._rigid_contact_series.pvd_path)
-        return outputs
 
     def progress_text(self) -> str:
         return super().progress_text() + "  " + self.stresses.progress_text().split("  dt")[0]

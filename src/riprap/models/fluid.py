@@ -18,6 +18,12 @@ import numpy as np
 from riprap.errors import InstabilityError, RiprapError
 from riprap.limits import RUNAWAY_SPEED
 from riprap.models.base import Model
+from riprap.models.body_frames import rigid_frame_fields
+from riprap.outputs.body_forces import BodyForcesWriter
+from riprap.outputs.bodies import BodiesInFlowWriter
+from riprap.outputs.fluid import CombinedSeriesWriter, FluidFieldsWriter
+from riprap.outputs.gauges import GaugesWriter
+from riprap.waves.report import flume_report
 
 __all__ = ["FluidModel", "CoupledModel", "step_towards"]
 
@@ -46,9 +52,6 @@ class FluidModel(Model):
     def __init__(self, solver):
         #: The solver stepped: a FluidSolver, or a CoupledSolver for :class:`CoupledModel`.
         self.solver = solver
-        self._series = None
-        self._picture = False
-        self._directory = None
         self._last_dt = 0.0
         self.smallest_step, self.largest_step, self.courant_max = np.inf, 0.0, 0.0
         self.iterations: list[int] = []
@@ -111,58 +114,18 @@ class FluidModel(Model):
                               f"has {self._bodies()}")
 
     # ------------------------------------------------------------------ outputs
-    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
-        from riprap.io import vtk
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        return [FluidFieldsWriter(paraview=paraview, picture=picture),
+                GaugesWriter(picture=picture)]
 
-        self._directory = directory
-        self._picture = picture
-        if paraview:
-            self._series = vtk.ParaViewSeries(directory, "fluid", append=append)
+    def waves_report(self) -> dict:
+        """The waves the gauges measured, against the wave maker's target
+        (:func:`riprap.waves.report.flume_report`)."""
+        return flume_report(self.fluid.gauges, self.fluid.wave_source, self.fluid.water.density)
 
-    def _body_fraction(self):
+    def body_fraction(self):
+        """The bodies' share of each cell, for the pictures (None: no bodies)."""
         return None
-
-    def _write_gauges(self) -> None:
-        if self.fluid.gauges is not None and self._directory is not None:
-            from riprap.io.gauge_files import write_gauges_csv
-
-            write_gauges_csv(self._directory / "gauges.csv", self.fluid.gauges)
-
-    def write_frame(self, frame_index: int) -> None:
-        s = self.fluid
-        self._write_gauges()
-        velocity = s.cell_velocity()
-        if self._series is not None:
-            self._series.add_image(s.time, origin=s.grid.lower, spacing=s.h, cells=s.grid.cells,
-                                   cell_data={"water_fraction": s.fraction, "pressure": s.pressure,
-                                              "velocity": velocity, "solid": s.solid.astype(float)})
-        if self._picture:
-            from riprap.io.fluid_picture import free_surface_png
-
-            free_surface_png(self._directory / "free_surface" / f"free_surface_{frame_index:04d}.png",
-                             grid=s.grid, fraction=s.fraction, velocity=velocity, solid=s.solid,
-                             time=s.time, bodies=self._body_fraction())
-
-    def close_outputs(self) -> dict:
-        outputs = {}
-        gauges = self.fluid.gauges
-        if gauges is not None and self._directory is not None:
-            from riprap.io.gauge_files import gauges_png, write_waves_report
-            from riprap.waves.report import flume_report
-
-            self._write_gauges()
-            outputs["gauges"] = str(self._directory / "gauges.csv")
-            report = flume_report(gauges, self.fluid.wave_source, self.fluid.water.density)
-            outputs["waves_report"] = str(write_waves_report(self._directory / "waves_report.json",
-                                                             report))
-            if self._picture:
-                outputs["gauges_picture"] = str(gauges_png(self._directory / "gauges.png", gauges,
-                                                           report))
-        if self._series is not None:
-            outputs["paraview"] = str(self._series.pvd_path)
-        if self._picture:
-            outputs["pictures"] = str(self._directory / "free_surface")
-        return outputs
 
     def progress_text(self) -> str:
         r = self._report
@@ -203,11 +166,6 @@ class CoupledModel(FluidModel):
 
     def __init__(self, coupled):
         super().__init__(coupled)
-        self._body_series = None
-        self._contact_series = None
-        self._append = False
-        self._forces = None
-        self._combined = None
         self.substeps = 0
         self.fastest = 0.0
         # The largest fluid force on each body (N) since the last row of body_forces.csv, and
@@ -259,66 +217,27 @@ class CoupledModel(FluidModel):
             raise InstabilityError(f"body {body} moves at {speeds[body]:.3g} m/s in {where} at "
                                    f"t = {self.time:.6g} s ({why})")
 
-    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
-        from riprap.io import vtk
-        from riprap.io.body_forces import BodyForceTable
+    # ------------------------------------------------------------------ outputs
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        fluid, gauges = super().default_writers(paraview=paraview, picture=picture)
+        bodies = self._bodies_writer(paraview)
+        return [bodies, fluid, CombinedSeriesWriter([fluid, bodies]), gauges, BodyForcesWriter()]
 
-        super().open_outputs(directory, append=append, paraview=paraview, picture=picture)
-        self._append = append
-        if paraview:
-            self._body_series = vtk.ParaViewSeries(directory, "bodies", append=append)
-            self._combined = vtk.CombinedSeries(directory / "run.pvd",
-                                                [self._series, self._body_series])
-        self._forces = BodyForceTable(directory / "body_forces.csv", append=append)
+    def _bodies_writer(self, paraview: bool):
+        return BodiesInFlowWriter(paraview=paraview)
 
-    def _body_fraction(self):
+    def frame_fields(self) -> dict:
+        """The bodies' surfaces now with their fields, the fluid's force on each among them."""
+        coupled = self.solver
+        return rigid_frame_fields(self.solids, fluid_force=coupled.fluid_loads[:, :3]
+                                  + coupled.fixed_body_loads[:, :3])
+
+    def body_fraction(self):
         return self.solver.body_fraction()
 
-    def write_frame(self, frame_index: int) -> None:
-        if self._body_series is not None:
-            self._write_bodies()
-        super().write_frame(frame_index)
-        if self._combined is not None:
-            self._combined.write()
-        self._forces.append(self._body_force_rows())
-
-    def _write_bodies(self) -> None:
-        """The bodies' surfaces with velocity, the fluid's force on each body and the contact
-        force, with the contact statistics a dry run's frames have, at the fluid frame's time;
-        and the frame of ``contacts.pvd`` (the last contact sub-step's contacts), so that
-        ``riprap analyse`` gets coordination numbers, contact forces and factors of safety under
-        wave load as it does dry."""
-        from riprap.solid.contact_statistics import solver_contact_statistics
-        from riprap.io import vtk
-        from riprap.solid.surfaces import surface_arrays
-
-        coupled, solids = self.solver, self.solids
-        points, triangles, owners = surface_arrays(solids)
-        fluid_force = coupled.fluid_loads[:, :3] + coupled.fixed_body_loads[:, :3]
-        contact = solids.contact_forces()
-        statistics = solver_contact_statistics(solids)
-        # ParaView colours inf badly; a huge finite number reads as "nothing pushes it sideways".
-        safety = np.minimum(statistics["factor_of_safety_sliding"], 1.0e30)
-        self._body_series.add(coupled.time, points=points, cells=triangles, cell_type="triangle",
-                              cell_data={"body_id": owners, "velocity": solids.velocities[owners],
-                                         "speed": np.linalg.norm(solids.velocities, axis=1)[owners],
-                                         "angular_velocity": solids.angular_velocities[owners],
-                                         "fluid_force": fluid_force[owners],
-                                         "contact_force": contact[owners],
-                                         "fixed": solids.fixed[owners].astype(np.int64),
-                                         "coordination_number":
-                                             statistics["coordination_number"][owners],
-                                         "max_contact_force": statistics["max_contact_force"][owners],
-                                         "factor_of_safety_sliding": safety[owners]})
-        if self._contact_series is None:
-            # opened with the first frame: a run whose bodies write their own frames (deformable
-            # bodies in water) has no such series
-            self._contact_series = vtk.ParaViewSeries(self._directory, "contacts",
-                                                      append=self._append)
-        self._contact_series.add_contacts(coupled.time, solids.contacts)
-
-    def _body_force_rows(self) -> list[str]:
-        """Rows of ``body_forces.csv`` for the present time (one per body)."""
+    def body_force_rows(self) -> list[str]:
+        """Rows of ``body_forces.csv`` for the present time (one per body); the peak fluid force
+        of each is the largest since the previous call."""
         coupled, solids = self.solver, self.solids
         contact = solids.contact_forces()
         pressure, viscous = coupled.pressure_loads[:, :3], coupled.viscous_loads[:, :3]
@@ -337,16 +256,6 @@ class CoupledModel(FluidModel):
         self._peak_force[:] = 0.0
         self._peak_time[:] = np.nan
         return rows
-
-    def close_outputs(self) -> dict:
-        outputs = super().close_outputs()
-        if self._body_series is not None:
-            outputs["bodies"] = str(self._body_series.pvd_path)
-            outputs["fluid_and_bodies"] = str(self._combined.path)
-        if self._contact_series is not None:
-            outputs["contacts"] = str(self._contact_series.pvd_path)
-        outputs["body_forces"] = str(self._forces.path)
-        return outputs
 
     def progress_text(self) -> str:
         r = self._report

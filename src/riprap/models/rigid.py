@@ -13,7 +13,9 @@ import numpy as np
 from riprap.errors import InstabilityError, RiprapError
 from riprap.limits import PROGRESS_PERIOD, RUNAWAY_SPEED, START_OVERLAP_FRACTION
 from riprap.models.base import Model
+from riprap.models.body_frames import rigid_frame_fields
 from riprap.models.settings import ModelSettings
+from riprap.outputs.bodies import RigidBodiesWriter
 from riprap.solid.kernels import interactions
 from riprap.work_estimate import check_rigid_run
 
@@ -204,9 +206,6 @@ class RigidModel(Model):
         self.cuts = 0
         self.last_stability_ratio = 0.0
         self.max_stability_ratio = 0.0
-        self._series = self._contact_series = None
-        self._picture = False
-        self._directory = None
 
     # ------------------------------------------------------------------ clock
     @property
@@ -340,54 +339,16 @@ class RigidModel(Model):
         s._contacts = None
 
     # ------------------------------------------------------------------ outputs
-    def open_outputs(self, directory, *, append: bool, paraview: bool, picture: bool) -> None:
-        from riprap.io import vtk
+    def default_writers(self, *, paraview: bool, picture: bool) -> list:
+        return [RigidBodiesWriter(paraview=paraview, picture=picture)]
 
-        self._directory = directory
-        self._picture = picture
-        if paraview:
-            self._series = vtk.ParaViewSeries(directory, "bodies", append=append)
-            self._contact_series = vtk.ParaViewSeries(directory, "contacts", append=append)
+    def frame_fields(self) -> dict:
+        """The bodies' surfaces now with their fields (:func:`rigid_frame_fields`)."""
+        return rigid_frame_fields(self.solver)
 
-    def write_frame(self, frame_index: int) -> None:
-        if self._series is not None:
-            self._write_frame(self._series, self._contact_series)
-
-    def _write_frame(self, series, contact_series, time: float | None = None) -> None:
-        """One frame of the rigid bodies and their contacts, at ``time`` (default the rigid
-        solver's clock; a run that steps them inside another model gives its own)."""
-        from riprap.solid.contact_statistics import solver_contact_statistics
-        from riprap.solid.surfaces import surface_arrays
-
-        s = self.solver
-        time = s.time if time is None else time
-        points, triangles, owners = surface_arrays(s)
-        omegas = s.angular_velocities
-        contact = s.contact_forces()
-        statistics = solver_contact_statistics(s)
-        # ParaView colours inf badly; a huge finite number reads as "nothing pushes it sideways".
-        safety = np.minimum(statistics["factor_of_safety_sliding"], 1.0e30)
-        series.add(time, points=points, cells=triangles, cell_type="triangle",
-                   cell_data={"body_id": owners, "velocity": s.velocities[owners],
-                              "speed": np.linalg.norm(s.velocities, axis=1)[owners],
-                              "angular_velocity": omegas[owners],
-                              "contact_force": contact[owners],
-                              "fixed": s.fixed[owners].astype(np.int64),
-                              "coordination_number": statistics["coordination_number"][owners],
-                              "max_contact_force": statistics["max_contact_force"][owners],
-                              "factor_of_safety_sliding": safety[owners]})
-        contact_series.add_contacts(time, s.contacts)
-
-    def close_outputs(self) -> dict:
-        outputs = {}
-        if self._series is not None:
-            outputs["paraview"] = str(self._series.pvd_path)
-            outputs["contacts"] = str(self._contact_series.pvd_path)
-        if self._picture:
-            outputs["picture"] = str(write_bodies_picture(self._directory / "final_state.png",
-                                                          self.solver,
-                                                          container_box=self.container_box))
-        return outputs
+    def picture(self, path):
+        """A picture of the bodies now (final_state.png)."""
+        return write_bodies_picture(path, self.solver, container_box=self.container_box)
 
     def progress_text(self) -> str:
         return (f"KE {self.solver.kinetic_energy():.3g} J  {len(self.solver.contacts)} contacts  "

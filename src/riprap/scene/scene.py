@@ -17,6 +17,7 @@ from riprap.errors import CaseFileError
 from riprap.geometry.mass_properties import mass_properties
 from riprap.geometry.tetmesh import TetMesh
 from riprap.io.contact_history import ContactHistory
+from riprap.schema import default_of
 from riprap.solid.kernels.pair_rule import pair_friction
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
@@ -26,7 +27,7 @@ from riprap.solid.walls import Wall
 __all__ = ["Scene", "DEFAULT_GRAVITY"]
 
 #: Gravity (m/s^2) when none is given; with a fluid and this default, the fluid's gravity is used.
-DEFAULT_GRAVITY = (0.0, 0.0, -9.81)
+DEFAULT_GRAVITY = default_of("simulation", "gravity")
 
 
 class Scene:
