@@ -20,14 +20,21 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, RiprapError
+from riprap.io.checkpoint import load_checkpoint, save_checkpoint
+from riprap.io.output_folder import prepare_output_folder
+from riprap.io.summary import write_json
 from riprap.models import rigid
 from riprap.models.base import Model
 from riprap.models.settings import ModelSettings
+from riprap.outputs.base import ModelFrames
 from riprap.scene import DEFAULT_GRAVITY, Scene
 from riprap.scene.choose_model import build_model
 from riprap.schedules import Every
 from riprap.schema import default_of
-from riprap.work_estimate import MAX_CHECKPOINTS, MAX_FRAMES, schedule_problems
+from riprap.solid.contact_statistics import solver_contact_statistics
+from riprap.solid.surfaces import surface_arrays
+from riprap.work_estimate import (MAX_CHECKPOINTS, MAX_FRAMES, RiprapWarning,
+                                   schedule_problems)
 
 __all__ = ["FluidRun", "FluidRunSummary", "RunSummary", "Simulation"]
 
@@ -322,8 +329,6 @@ class Simulation:
         every chunk of work (a few per second of wall time) and may change the state (e.g. fix
         bodies); the run stops with end reason "done" when it returns True.
         """
-        from riprap.io.output_folder import prepare_output_folder
-        from riprap.io.summary import write_json
 
         out = self.output_directory
         prepare_output_folder(out)
@@ -486,7 +491,6 @@ class Simulation:
     def writers(self, model) -> list:
         """Every writer of the run: the model's defaults (``[output]`` paraview, picture and
         the intervals), then the ones added with :meth:`add_writer`."""
-        from riprap.outputs.base import ModelFrames
 
         if hasattr(model, "default_writers"):
             defaults = model.default_writers(paraview=self.paraview, picture=self.picture)
@@ -500,7 +504,6 @@ class Simulation:
     def surface_arrays(self):
         """World boundary surfaces of all bodies: points (n, 3), triangles (m, 3), body of each
         triangle (m,)."""
-        from riprap.solid.surfaces import surface_arrays
 
         return surface_arrays(self.solver)
 
@@ -511,7 +514,6 @@ class Simulation:
     def contact_statistics(self) -> dict:
         """Per body: coordination number, largest contact force (N) and factor of safety against
         sliding (:func:`riprap.solid.contact_statistics.solver_contact_statistics`)."""
-        from riprap.solid.contact_statistics import solver_contact_statistics
 
         return solver_contact_statistics(self.solver)
 
@@ -530,7 +532,6 @@ class Simulation:
 
     # ------------------------------------------------------------------ checkpoints
     def _save_checkpoint(self, name: str, state: dict) -> Path:
-        from riprap.io.checkpoint import save_checkpoint
 
         model = self.model
         arrays, metadata = model.checkpoint_content(state)
@@ -549,7 +550,6 @@ class Simulation:
         readable checkpoint of this kind of run, of this case (nothing changed but what may
         change), with the model's own checks (meshes, cells, bodies). Returns its arrays and
         metadata."""
-        from riprap.io.checkpoint import load_checkpoint
 
         arrays, metadata = load_checkpoint(path)
         self._check_same_run(path, metadata)
@@ -588,8 +588,6 @@ class Simulation:
         recorded = metadata.get("case_record")
         if recorded is None:
             import warnings
-
-            from riprap.work_estimate import RiprapWarning
 
             warnings.warn(f"{path} was written by an older riprap and does not record the case it "
                           "was run with: restarting without checking that the case is unchanged "

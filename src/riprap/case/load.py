@@ -29,9 +29,9 @@ from riprap.case.specs import (ArmourSpec, BodyGridSpec, BodySpec, Case, Deforma
                                FluidSpec, GaugeSpec, MaterialSpec, OutputSettings, PlacementSpec,
                                PorousZoneSpec, RegionSpec, ShapeSpec, SimulationSettings,
                                SlopeSpec, UnderlayerSpec, WallSpec, WavesSpec)
-from riprap.schema import Key, Table, describe_expected, format_toml_value
 from riprap.errors import CaseFileError
-from riprap.io.case_text import read_case_text
+from riprap.io.case_text import PACK_HEADER, read_case_text
+from riprap.schema import Key, Table, describe_expected, format_toml_value
 
 __all__ = [
     "Case",
@@ -810,8 +810,6 @@ def _with_pack(case: Case, pack_path) -> Case:
     unless the case names one (the history's body and wall numbers are the pack's, which stay
     first)."""
     import dataclasses
-
-    from riprap.io.case_text import PACK_HEADER
 
     including = Path(case.source).resolve()
     chain = _PACKS_BEING_INCLUDED + [including]

@@ -11,12 +11,14 @@ import time as wallclock
 import numpy as np
 
 from riprap.errors import InstabilityError, RiprapError
+from riprap.io.picture import bodies_to_draw, render_bodies_png
 from riprap.limits import PROGRESS_PERIOD, RUNAWAY_SPEED, START_OVERLAP_FRACTION
 from riprap.models.base import Model
 from riprap.models.body_frames import rigid_frame_fields
 from riprap.models.settings import ModelSettings
 from riprap.outputs.bodies import RigidBodiesWriter
 from riprap.solid.kernels import interactions
+from riprap.solid.surfaces import surface_arrays
 from riprap.work_estimate import check_rigid_run
 
 __all__ = ["RigidModel", "at_rest", "body_setting_the_step", "build_bodies", "check_start_overlaps",
@@ -373,8 +375,6 @@ def write_bodies_picture(path, solver, *, container_box=None, show_fixed: bool =
     """Shaded PNG of the bodies now (:func:`riprap.io.picture.render_bodies_png`); the arguments
     are those of :meth:`riprap.simulation.Simulation.write_picture`, ``container_box`` the walls'
     box ((lower), (upper)) or None."""
-    from riprap.io.picture import bodies_to_draw, render_bodies_png
-    from riprap.solid.surfaces import surface_arrays
 
     s = solver
     points, triangles, owners = surface_arrays(s)
