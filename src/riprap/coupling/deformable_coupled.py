@@ -383,7 +383,7 @@ class DeformableBodies:
         if self.rigid is not None:
             self.rigid.load_state_arrays({key[len("rigid_"):]: value for key, value in arrays.items()
                                           if key.startswith("rigid_") and key != "rigid_contact_loads"})
-            self.rigid._contacts = None
+            self.rigid.clear_contact_records()
             self.rigid.external_loads[:] = arrays["rigid_external_loads"]
         self.refresh()
 

@@ -28,10 +28,7 @@ def add_obstacle_bodies(simulation, boxes, material: str | None = None) -> list[
     if not boxes:
         return []
     material = material or solver.materials[0].name
-    if solver._ready:
-        moving = [solver.shapes[s] for s, fixed in zip(solver.shape_index, solver.fixed) if not fixed]
-    else:
-        moving = [solver.shapes[row[0]] for row in solver._body_rows if not row[6]]
+    moving = solver.moving_shapes()
     nominal = min((shape.volume ** (1.0 / 3.0) for shape in moving), default=np.inf)
     indices = []
     for number, (lower, upper) in enumerate(boxes):

@@ -136,8 +136,7 @@ def rigid_body_cell_volumes(grid: FluidGrid, solver, bodies=None, poses=None) ->
     all of them, or those listed in ``bodies`` (the result's blocks are then in that order).
     ``poses`` (one row per chosen body: position (3), unit quaternion (4)) clips them there
     instead of at their present poses."""
-    if not solver._ready:
-        solver.finalize()
+    solver.finalize()
     table = solver.table
     node_parts, triangle_parts, triangle_start = [], [], [0]
     node_count = 0

@@ -270,7 +270,7 @@ class DeformableModel(Model):
             solver = self.rigid.solver
             solver.load_state_arrays(
                 {key[len("rigid_"):]: value for key, value in arrays.items() if key.startswith("rigid_")})
-            solver._contacts = None
+            solver.clear_contact_records()
             self.place_rigid()
 
     def checkpoint_content(self, state: dict) -> tuple[dict, dict]:

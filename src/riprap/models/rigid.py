@@ -5,7 +5,6 @@ model owns the rigid bodies' physics checks: the start overlaps, runaway bodies,
 stability ratio, rest, and the advice after a blow-up."""
 from __future__ import annotations
 
-import math
 import time as wallclock
 
 import numpy as np
@@ -17,7 +16,6 @@ from riprap.models.base import Model
 from riprap.models.body_frames import rigid_frame_fields
 from riprap.models.settings import ModelSettings
 from riprap.outputs.bodies import RigidBodiesWriter
-from riprap.solid.kernels import interactions
 from riprap.solid.surfaces import surface_arrays
 from riprap.work_estimate import check_rigid_run
 
@@ -51,7 +49,7 @@ _ABSURD_GRAVITY = 1000.0
 def build_bodies(solver, settings: ModelSettings) -> None:
     """Build the solver's arrays, choose the time step and evaluate the initial forces, without
     refusing overlaps (callers that resolve overlaps themselves use ``solver.overlaps``)."""
-    solver._build_arrays()
+    solver.build_arrays()
     if settings.time_step > 0:
         solver.time_step = settings.time_step
     else:
@@ -63,7 +61,7 @@ def prepare_bodies(solver, settings: ModelSettings, *, accepted_overlaps: dict,
                    restarted: bool) -> None:
     """Build the bodies (once), refuse absurd work, and refuse overlaps at the start of a new run
     beyond ``accepted_overlaps`` (a restart's overlaps are its own)."""
-    if solver._ready:
+    if solver.ready:
         return
     build_bodies(solver, settings)
     check_rigid_run(end_time=settings.end_time, time_step=solver.time_step,
@@ -218,15 +216,8 @@ class RigidModel(Model):
     def step_count(self) -> int:
         return self.solver.step_count
 
-    def _steps_at(self, time: float) -> int:
-        """The step count at which the clock reaches ``time`` (at the current time step)."""
-        s = self.solver
-        if s._time_origin is None:
-            return int(math.ceil(time / s.time_step - 1e-9))
-        return s._step_origin + int(math.ceil((time - s._time_origin) / s.time_step - 1e-9))
-
     def reached(self, time: float) -> bool:
-        return self.solver.step_count >= self._steps_at(time)
+        return self.solver.step_count >= self.solver.steps_at(time)
 
     def last_time_step(self) -> float:
         return self.solver.time_step
@@ -242,7 +233,7 @@ class RigidModel(Model):
 
     def advance(self, until: float) -> None:
         solver = self.solver
-        n = min(self._steps_at(until) - solver.step_count, self._chunk)
+        n = min(self.solver.steps_at(until) - solver.step_count, self._chunk)
         tick = wallclock.perf_counter()
         solver.advance(n)
         check_runaway(solver)
@@ -308,7 +299,7 @@ class RigidModel(Model):
 
     def check_checkpoint(self, path, arrays: dict, metadata: dict) -> None:
         s = self.solver
-        s._build_arrays()
+        s.build_arrays()
         problems = []
         if metadata.get("n_bodies") != s.n_bodies:
             problems.append(f"it has {metadata.get('n_bodies')} bodies, the case {s.n_bodies}")
@@ -326,9 +317,7 @@ class RigidModel(Model):
 
     def restore(self, arrays: dict) -> None:
         settings, s = self.settings, self.solver
-        s.time_step = float(arrays["clock"][2])
-        s._ready = True
-        s.load_state_arrays(arrays)
+        s.restore_state(arrays, float(arrays["clock"][2]))
         if not settings.adaptive_time_step:
             # The case's time step wins over the checkpoint's (the same case gives the same step, so
             # a restart stays bit for bit): after a blow-up a smaller step is the usual fix.
@@ -336,9 +325,7 @@ class RigidModel(Model):
                     else s.stable_time_step(settings.time_step_safety))
             if step != s.time_step:
                 s.set_time_step(step)
-        s._last = (np.zeros((0, interactions.C_SIZE)), np.zeros((0, 2), np.int64),
-                   np.zeros((0, 2), np.int64))
-        s._contacts = None
+        s.forget_contacts()
 
     # ------------------------------------------------------------------ outputs
     def default_writers(self, *, paraview: bool, picture: bool) -> list:

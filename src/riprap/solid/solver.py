@@ -6,6 +6,8 @@ Step (velocity Verlet): kick(dt/2) with the forces of the previous step, drift(d
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -135,6 +137,43 @@ class SolidSolver:
         return len(self._body_rows) - 1
 
     @property
+    def ready(self) -> bool:
+        """Whether the flat arrays are built and the first forces evaluated (:meth:`finalize`)."""
+        return self._ready
+
+    def steps_at(self, time: float) -> int:
+        """The step count at which the clock reaches ``time`` (s) at the current time step,
+        counted from the last change of step."""
+        if self._time_origin is None:
+            return int(math.ceil(time / self.time_step - 1e-9))
+        return self._step_origin + int(math.ceil((time - self._time_origin) / self.time_step - 1e-9))
+
+    def moving_shapes(self) -> list:
+        """The shapes of the bodies that are not fixed, before or after :meth:`finalize`."""
+        if self._ready:
+            return [self.shapes[s] for s, fixed in zip(self.shape_index, self.fixed) if not fixed]
+        return [self.shapes[row[0]] for row in self._body_rows if not row[6]]
+
+    def restore_state(self, arrays: dict, time_step: float) -> None:
+        """Continue from a checkpoint's state arrays at ``time_step`` (s): the arrays built and
+        the state loaded, without evaluating forces again."""
+        self.time_step = float(time_step)
+        self._ready = True
+        self.load_state_arrays(arrays)
+
+    def clear_contact_records(self) -> None:
+        """Make the contact records again from the last force evaluation when next asked (after
+        the state arrays were replaced)."""
+        self._contacts = None
+
+    def forget_contacts(self) -> None:
+        """Drop the last force evaluation's results (after the state was replaced): the contact
+        records are made again from the next evaluation."""
+        self._last = (np.zeros((0, interactions.C_SIZE)), np.zeros((0, 2), np.int64),
+                      np.zeros((0, 2), np.int64))
+        self._contacts = None
+
+    @property
     def n_bodies(self) -> int:
         return len(self._body_rows) if not self._ready else len(self.positions)
 
@@ -143,13 +182,14 @@ class SolidSolver:
         automatically before the first step."""
         if self._ready:
             return
-        self._build_arrays()
+        self.build_arrays()
         if self.time_step is None:
             self.time_step = self.stable_time_step()
         self._ready = True
         self._compute_forces(self.time_step)
 
-    def _build_arrays(self) -> None:
+    def build_arrays(self) -> None:
+        """Stack the bodies added so far into the flat arrays (again, if already built)."""
         if not self._body_rows:
             raise CaseFileError("no bodies: add at least one body")
         rows = self._body_rows
@@ -252,7 +292,7 @@ class SolidSolver:
         """Per body, the critical step 2 sqrt(m / k) of :meth:`stable_time_step` (inf for fixed
         bodies): the smallest names the body that sets the run's step."""
         if not self._ready:
-            self._build_arrays()
+            self.build_arrays()
         steps = np.full(len(self.shape_index), np.inf)
         for b in range(len(self.shape_index)):
             if self.fixed[b]:
