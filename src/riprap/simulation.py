@@ -11,6 +11,7 @@ are the scene's, offered here too so that a run is built in one object.
 """
 from __future__ import annotations
 
+import difflib
 import functools
 import os
 import time as wallclock
@@ -26,6 +27,7 @@ from riprap.io.summary import write_json
 from riprap.models import rigid
 from riprap.models.base import Model
 from riprap.models.settings import ModelSettings
+from riprap.outputs import DEFAULT_WRITER_NAMES
 from riprap.outputs.base import ModelFrames
 from riprap.scene import DEFAULT_GRAVITY, Scene
 from riprap.scene.choose_model import build_model
@@ -228,6 +230,11 @@ class Simulation:
         self._model = None
         if isinstance(scene, Model):
             self._model, scene = scene, None
+        if scene is not None and not isinstance(scene, Scene):
+            raise RiprapError(f"Simulation: the first argument is what to run, a "
+                              f"riprap.scene.Scene or a built model (riprap.models.base.Model), "
+                              f"or nothing (then add bodies and a fluid); got "
+                              f"{type(scene).__name__} {scene!r:.60}")
         if scene is None:
             scene = Scene(gravity=gravity, local_damping=local_damping, fluid=fluid)
         elif fluid is not None:
@@ -464,6 +471,16 @@ class Simulation:
         """Write one more output family during the run: a :class:`riprap.outputs.Writer` (its
         ``schedule`` a :class:`riprap.schedules.Every`, or None for the frames), written after the
         model's own outputs at the same times."""
+        missing = [part for part in ("name", "schedule", "open", "write", "close")
+                   if not hasattr(writer, part)]
+        if missing or not isinstance(writer.name, str):
+            raise RiprapError(f"add_writer: expected a writer (riprap.outputs.Writer: a name, a "
+                              f"schedule, open, write and close); {type(writer).__name__} has no "
+                              f"{', '.join(missing) or 'name that is a string'}")
+        if writer.schedule is not None and not isinstance(writer.schedule, Every):
+            raise RiprapError(f"add_writer: writer {writer.name!r} has schedule "
+                              f"{writer.schedule!r}; give riprap.schedules.Every(seconds=...) or "
+                              "Every(steps=...), or None to write at the frames")
         if any(writer.name == other.name for other in self._writers):
             raise RiprapError(f"add_writer: a writer named {writer.name!r} is there already; give "
                               "each writer its own name (it keys the writer's schedule in "
@@ -473,6 +490,12 @@ class Simulation:
     def set_output_interval(self, name: str, interval: float) -> None:
         """Give the default writer ``name`` (``"body_forces"``) an interval of its own (s); 0
         writes it at the frames. A bad value is refused naming ``[output] {name}_interval``."""
+        if name not in DEFAULT_WRITER_NAMES:
+            close = difflib.get_close_matches(str(name), DEFAULT_WRITER_NAMES, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise CaseFileError(f"set_output_interval: {name!r} is none of riprap's output "
+                                f"families ({', '.join(DEFAULT_WRITER_NAMES)}){hint}; a writer of "
+                                "your own takes its schedule when it is made (add_writer)")
         key = f"output.{name}_interval"
         if not (isinstance(interval, (int, float)) and not isinstance(interval, bool)
                 and np.isfinite(interval) and interval >= 0):
@@ -499,6 +522,13 @@ class Simulation:
         for writer in defaults:
             if writer.name in self.output_intervals:
                 writer.schedule = Every(seconds=self.output_intervals[writer.name])
+        written = {writer.name for writer in defaults}
+        for name, interval in self.output_intervals.items():
+            if name not in written:
+                # an interval for a family this run does not write would silently do nothing
+                raise CaseFileError(f"output.{name}_interval = {interval:g}: this run writes no "
+                                    f"{name} (its outputs: {', '.join(sorted(written))}); drop "
+                                    "the interval or set it to 0")
         return defaults + self._writers
 
     def surface_arrays(self):

@@ -7,7 +7,7 @@ import pytest
 from riprap.case.build import build_simulation
 from riprap.case.load import parse_case
 from riprap.cli import main
-from riprap.errors import CaseFileError
+from riprap.errors import CaseFileError, RiprapError
 from riprap.outputs import Writer
 from riprap.schedules import Every
 from riprap.simulation import Simulation
@@ -146,6 +146,31 @@ def test_a_bad_schedule_is_refused_naming_its_key(tmp_path):
     sim.add_writer(HeightOfOneBody(body=0))
     with pytest.raises(Exception, match="named 'height' is there already"):
         sim.add_writer(HeightOfOneBody(body=0))
+    with pytest.raises(RiprapError, match="object has no name, schedule, open, write, close"):
+        sim.add_writer(object())
+    wrong = HeightOfOneBody(body=0)
+    wrong.name, wrong.schedule = "height_2", 0.01
+    with pytest.raises(RiprapError, match="has schedule 0.01; give riprap.schedules.Every"):
+        sim.add_writer(wrong)
+    with pytest.raises(CaseFileError, match="'body_forse' is none of riprap's output families .*"
+                                            "did you mean 'body_forces'"):
+        sim.set_output_interval("body_forse", 0.01)
+    with pytest.raises(RiprapError, match="got str 'bodies.toml'"):
+        Simulation("bodies.toml", end_time=1.0)
+
+
+def test_an_interval_for_a_family_the_run_does_not_write_is_refused(tmp_path):
+    """A dry run writes no body_forces.csv: its interval would silently do nothing. The case
+    file is refused at load (it has no [fluid]); the API when the run starts."""
+    text = RIGID.replace("[[materials]]", "[output]\nbody_forces_interval = 0.01\n[[materials]]")
+    with pytest.raises(CaseFileError, match="rigid.toml.*body_forces_interval.*without a \\[fluid\\]"):
+        parse_case(text, source="rigid.toml")
+    sim = build_simulation(parse_case(RIGID, source="rigid.toml"), output_directory=tmp_path / "out",
+                           progress=False)
+    sim.set_output_interval("body_forces", 0.01)
+    with pytest.raises(CaseFileError, match="output.body_forces_interval = 0.01: this run writes no "
+                                            "body_forces"):
+        sim.run()
 
 
 def test_a_restart_goes_on_with_each_writers_schedule_bit_for_bit(tmp_path):

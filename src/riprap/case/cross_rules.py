@@ -53,6 +53,13 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
                 add(("output", "body_forces_interval"),
                     message.replace("set output_interval", "set body_forces_interval"), value)
 
+    output = tables.get("output")
+    interval = output.get("body_forces_interval") if output else None
+    if interval is not None and ok(interval) and interval > 0 and tables.get("fluid") is None:
+        add(("output", "body_forces_interval"), "body_forces.csv holds the flow's forces on the "
+            "bodies: a run without a [fluid] table writes none; drop the key or set it to 0",
+            interval)
+
     for name in ("waves", "gauges", "porous_zones"):
         if tables.get(name) and tables.get("fluid") is None:
             header = "[waves]" if name == "waves" else f"[[{name}]]"

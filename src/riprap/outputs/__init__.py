@@ -22,6 +22,12 @@ from riprap.outputs.fluid import CombinedSeriesWriter, FluidFieldsWriter
 from riprap.outputs.gauges import GaugesWriter
 from riprap.outputs.stresses import DeformableFramesWriter, StressesWriter
 
-__all__ = ["Writer", "ModelFrames", "RigidBodiesWriter", "BodiesInFlowWriter", "FluidFieldsWriter",
+#: The names of riprap's own writers: the output families a run's default writers come from, and
+#: what ``Simulation.set_output_interval`` (``[output] <name>_interval``) may name.
+DEFAULT_WRITER_NAMES = tuple(sorted({cls.name for cls in (
+    RigidBodiesWriter, BodiesInFlowWriter, FluidFieldsWriter, CombinedSeriesWriter, GaugesWriter,
+    BodyForcesWriter, DeformableFramesWriter, StressesWriter)}))
+
+__all__ = ["DEFAULT_WRITER_NAMES", "Writer", "ModelFrames", "RigidBodiesWriter", "BodiesInFlowWriter", "FluidFieldsWriter",
            "CombinedSeriesWriter", "GaugesWriter", "BodyForcesWriter", "DeformableFramesWriter",
            "StressesWriter"]
