@@ -98,8 +98,9 @@ def _say_if_smoke() -> None:
 def _place_case(path: Path, out: str | None, quiet: bool) -> int:
     case = load_case(path)
     _say_if_smoke()
-    print(f"riprap: placement case {path}: {case.armour.unit if case.armour else '?'} units on a "
-          f"1:{case.slope.cotangent if case.slope else '?'} slope")
+    if case.armour and case.slope:      # else run_placement says which tables are missing
+        print(f"riprap: placement case {path}: {case.armour.unit} units on a "
+              f"1:{case.slope.cotangent} slope")
     summary = run_placement(case, output_directory=out, progress=not quiet)
     if summary.get("smoke"):
         print(f"riprap: SMOKE MODE: {summary['units_placed']} units placed on "

@@ -108,6 +108,10 @@ class UnitKind:
     hudson_trunk_stability: float | None = None
 
 
+# Double-layer random cubes (Rock Manual p. 260): the plain and the Antifer cube share them.
+_DOUBLE_LAYER_CUBES = dict(layers=2, layer_thickness_coefficient=1.10, porosity=0.47,
+                           packing_density_coefficient=1.166)
+
 _X, _Y, _Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
 
 
@@ -219,10 +223,7 @@ UNIT_RECORDS: tuple[UnitKind, ...] = (
         build=unit_solids.build_cube,
         axes=_axes(nose=_Z, face_x=_X, face_y=_Y),
         design=UnitDesign(
-            layers=2,
-            layer_thickness_coefficient=1.10,
-            porosity=0.47,
-            packing_density_coefficient=1.166,
+            **_DOUBLE_LAYER_CUBES,
             source=(
                 "CIRIA, CUR, CETMEF (2007). The Rock Manual (C683), p. 260; Deltares coastal-"
                 "structures-toolbox cubes_double_layer_vandermeer1988.py (k_t, n_v); via "
@@ -239,10 +240,7 @@ UNIT_RECORDS: tuple[UnitKind, ...] = (
         build=unit_solids.build_antifer_cube,
         axes=_axes(nose=_Z, face_x=_X, face_y=_Y),
         design=UnitDesign(
-            layers=2,
-            layer_thickness_coefficient=1.10,
-            porosity=0.47,
-            packing_density_coefficient=1.166,
+            **_DOUBLE_LAYER_CUBES,
             source=(
                 "CIRIA, CUR, CETMEF (2007). The Rock Manual (C683), p. 260 (cubes, double layer); "
                 f"via {_ARMOUR_DESIGN_MD}"
