@@ -329,6 +329,11 @@ KEYS: tuple[Key, ...] = (
     Key("simulation", "time_step_safety", "number", "-",
         "Fraction of the critical time step used when the time step is automatic.",
         default=0.2, valid_range=_FRACTION),
+    Key("simulation", "adaptive_time_step", "boolean", "-",
+        "Let the contact step follow the contacts present, by their measured stability ratio "
+        "dt / (2 sqrt(m/k)): a dry run grows it below 0.2 and halves it above 0.5; bodies in a "
+        "flow take contact sub-steps that grow towards 0.25 and are cut to it at once. Starts "
+        "from time_step (or the automatic step); rigid bodies only.", default=False),
     Key("simulation", "gravity", "vector", "m/s^2", "Gravitational acceleration.",
         default=(0.0, 0.0, -9.81)),
     Key("simulation", "output_interval", "number", "s",
@@ -612,6 +617,11 @@ KEYS: tuple[Key, ...] = (
     Key("fluid", "pressure_tolerance", "number", "-",
         "Relative residual at which the pressure solve stops.", default=1.0e-8,
         valid_range=Range(minimum=0.0, maximum=1.0e-2, minimum_inclusive=False)),
+    Key("fluid", "pressure_volume_tolerance", "number", "-",
+        "The pressure solve also stops once no cell's volume changes by more than this fraction "
+        "over the step (|div u| dt, the divergence the solve leaves; Basilisk's TOLERANCE); 0 "
+        "leaves that test out.", default=0.0,
+        valid_range=Range(minimum=0.0, maximum=1.0e-2, maximum_inclusive=False)),
     # [[water_regions]]
     Key("water_regions", "type", "string", "-", "Kind of region; selects the keys below.",
         choices=("box", "level")),

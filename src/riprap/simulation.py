@@ -84,6 +84,8 @@ class RunSummary:
     pressure_iterations_mean: float | None = None
     pressure_iterations_max: int | None = None
     pressure_time_share: float | None = None
+    pressure_capped_solves: int | None = None    # solves stopped at their iteration cap
+    solver_log: list | None = None               # per frame: the rows of solver_log.csv
     # deformable bodies
     element_steps_per_second: float | None = None
     max_tensile_stress: float | None = None

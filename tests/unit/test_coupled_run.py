@@ -7,6 +7,7 @@ import numpy as np
 from riprap.cli import main
 from riprap.io.body_forces import BODY_FORCE_COLUMNS
 from riprap.io.checkpoint import load_checkpoint
+from riprap.io.solver_log import SOLVER_LOG_COLUMNS
 
 CASE = """format_version = 1
 [simulation]
@@ -70,3 +71,77 @@ def test_a_coupled_run_restarts_bit_for_bit(tmp_path):
                  "bodies_angular_momenta", "bodies_fluid_loads"):
         assert np.array_equal(a[name], b[name]), name
     assert (pieces / "body_forces.csv").read_text() == (unbroken / "body_forces.csv").read_text()
+
+
+def test_the_solver_log_has_a_row_per_frame_and_the_summary_has_them_too(tmp_path):
+    """Reference: issue 37 (pressure iterations, the volume error and the contact sub-steps per
+    fluid step logged per frame in the run's summary): one row per frame interval with a step in
+    it (t = 0.05, 0.1), the rows' fluid steps adding up to the run's, the same rows in
+    summary.json; iterations and sub-steps as the run's own totals give them."""
+    out = tmp_path / "run"
+    assert main(["run", str(_case(tmp_path, 0.1)), "--out", str(out), "--quiet"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    lines = (out / "solver_log.csv").read_text().splitlines()
+    assert tuple(lines[0].split(",")) == SOLVER_LOG_COLUMNS
+    rows = [dict(zip(SOLVER_LOG_COLUMNS, line.split(","))) for line in lines[1:]]
+    assert [float(r["time_s"]) for r in rows] == [0.05, 0.1]
+    assert sum(int(r["fluid_steps"]) for r in rows) == summary["steps"]
+    assert summary["solver_log"] == [
+        {k: (None if v == "" else json.loads(v)) for k, v in r.items()} for r in rows]
+    assert sum(r["contact_substeps_per_step"] * r["fluid_steps"]
+               for r in summary["solver_log"]) == summary["solid_substeps"]
+    assert max(r["pressure_iterations_max"] for r in summary["solver_log"]) \
+        == summary["pressure_iterations_max"]
+    assert summary["pressure_capped_solves"] == 0
+    assert all(r["pressure_capped_solves"] == 0 for r in summary["solver_log"])
+    assert abs(summary["solver_log"][-1]["water_volume_error"]) < 1e-9
+
+
+DROP = CASE.replace("position = [0.1, 0.1, 0.1]", "position = [0.1, 0.1, 0.06]").replace(
+    "output_interval = 0.05", "output_interval = 0.05\ncheckpoint_interval = 0.15\n{adaptive}")
+
+
+def _drop(tmp_path, end_time, adaptive):
+    path = tmp_path / f"drop_{end_time}_{adaptive}.toml"
+    path.write_text(DROP.format(end_time=end_time,
+                                adaptive="adaptive_time_step = true" if adaptive else ""))
+    return path
+
+
+def test_an_adaptive_substep_follows_the_contacts_and_lands_the_ball_where_a_fixed_one_does(
+        tmp_path):
+    """Reference: issue 37 (the contact sub-step adapts to the measured contact stability instead
+    of a hand-set factor) and riprap.coupling.coupled (target ratio 0.25). A ball of 2000 kg/m^3
+    falls 3 cm through water onto the floor and rests there. With the adaptive sub-step the
+    measured stability ratio dt / (2 sqrt(m/k)) stays below the rigid model's limit of 0.5 in
+    every frame, the run takes fewer sub-steps than with the fixed automatic step (0.2 of the
+    critical), and the ball rests where the fixed step puts it, within 1e-3 of its radius (the
+    rest depth is set by its weight and the contact stiffness, not the step)."""
+    runs = {}
+    for adaptive in (False, True):
+        out = tmp_path / f"adaptive_{adaptive}"
+        assert main(["run", str(_drop(tmp_path, 0.3, adaptive)), "--out", str(out), "--quiet"]) == 0
+        runs[adaptive] = (json.loads((out / "summary.json").read_text()),
+                          load_checkpoint(out / "checkpoint.npz")[0])
+    fixed, adaptive = runs[False][0], runs[True][0]
+    assert adaptive["solid_substeps"] < 0.5 * fixed["solid_substeps"]
+    ratios = [r["contact_stability_ratio_max"] for r in adaptive["solver_log"]]
+    assert max(ratios) <= 0.5 and max(ratios) > 0.0
+    z_fixed = runs[False][1]["bodies_positions"][0, 2]
+    z_adaptive = runs[True][1]["bodies_positions"][0, 2]
+    assert z_fixed < 0.035, "the ball has landed"
+    assert abs(z_adaptive - z_fixed) <= 1e-3 * 0.03
+
+
+def test_an_adaptive_substep_restarts_bit_for_bit(tmp_path):
+    unbroken = tmp_path / "unbroken"
+    assert main(["run", str(_drop(tmp_path, 0.3, True)), "--out", str(unbroken), "--quiet"]) == 0
+    pieces = tmp_path / "pieces"
+    assert main(["run", str(_drop(tmp_path, 0.15, True)), "--out", str(pieces), "--quiet"]) == 0
+    assert main(["run", str(_drop(tmp_path, 0.3, True)), "--out", str(pieces), "--quiet",
+                 "--restart", str(pieces / "checkpoint.npz")]) == 0
+    a, _ = load_checkpoint(unbroken / "checkpoint.npz")
+    b, _ = load_checkpoint(pieces / "checkpoint.npz")
+    for name in ("u", "w", "fraction", "pressure", "bodies_positions", "bodies_velocities",
+                 "coupling_substep"):
+        assert np.array_equal(a[name], b[name]), name

@@ -291,3 +291,47 @@ def test_listed_cells_of_heavy_bodies_in_air_save_iterations_and_keep_the_soluti
     assert np.linalg.norm(p_listed - p_plain) <= 1e-7 * np.linalg.norm(p_plain)
     with pytest.raises(CaseFileError, match="listed_cells"):
         solver.solve(*beta, rhs, listed_cells=[rhs.size])
+
+
+def test_volume_tolerance_stops_once_no_cell_changes_its_volume_beyond_it():
+    """Reference: the projection's rhs is div(u*)/dt, so the velocity it corrects keeps div u =
+    dt r and a cell's relative volume change over the step is dt^2 |r| (riprap/fluid/pressure.py).
+    With a volume tolerance the solve must stop with dt^2 max|r| (r evaluated here by the public
+    operator) at most that tolerance, and stop sooner than the 1e-8 relative residual does; the
+    report's figure must be the one evaluated here to 1e-9."""
+    shape, h, dt = (37, 23, 29), 0.02, 2e-3
+    beta = face_coefficients(blob_density(shape, 2))
+    # div(u*)/dt of a velocity of 1 m/s that varies over ten cells
+    rhs = np.random.default_rng(3).standard_normal(shape) / (10 * h) / dt
+    tight, tight_report = PressureSolver(shape, h).solve(*beta, rhs, time_step=dt)
+    for tolerance in (1e-4, 1e-6):
+        p, report = PressureSolver(shape, h, volume_tolerance=tolerance).solve(*beta, rhs,
+                                                                             time_step=dt)
+        change = dt ** 2 * np.abs(apply_operator(*beta, p, h) - rhs).max()
+        assert change <= tolerance
+        assert abs(report.volume_change - change) <= 1e-9 * change
+        assert report.iterations < tight_report.iterations
+        assert not report.capped
+    assert tight_report.volume_change <= 1e-6
+    # without a time step the volume test is left out: the relative residual decides
+    _, report = PressureSolver(shape, h, volume_tolerance=1e-4).solve(*beta, rhs)
+    assert report.volume_change is None
+    assert report.iterations == tight_report.iterations
+
+
+def test_a_solve_stopped_at_its_cap_is_kept_and_reported_unless_far_off():
+    """Reference: issue 37 (a projection that stops at its cap says so, it does not pass
+    silently) and STYLE (a solve far from converged is an instability, named): 12 iterations
+    reach a relative residual below CAPPED_RESIDUAL_LIMIT on this problem and are kept with
+    ``capped``; 1 iteration does not and raises with its figures."""
+    shape, h = (37, 23, 29), 0.02
+    beta = face_coefficients(blob_density(shape, 1))
+    rhs = np.random.default_rng(1).standard_normal(shape)
+    _, full = PressureSolver(shape, h).solve(*beta, rhs)
+    assert full.iterations > 12 and not full.capped
+    p, report = PressureSolver(shape, h, max_iterations=12).solve(*beta, rhs)
+    assert report.capped and report.iterations == 12
+    assert 1e-8 < report.relative_residual <= pressure_module.CAPPED_RESIDUAL_LIMIT
+    assert relative_residual(beta, p, rhs, h) == pytest.approx(report.relative_residual, rel=1e-6)
+    with pytest.raises(InstabilityError, match=r"after 1 iteration\(s\)"):
+        PressureSolver(shape, h, max_iterations=1).solve(*beta, rhs)

@@ -84,6 +84,7 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
         time_step_safety=settings.time_step_safety, gravity=settings.gravity,
         output_interval=settings.output_interval, checkpoint_interval=settings.checkpoint_interval,
         local_damping=settings.local_damping, rest_speed=settings.rest_speed,
+        adaptive_time_step=settings.adaptive_time_step,
         output_directory=output_directory or case.output.directory,
         paraview=case.output.paraview, picture=case.output.picture, progress=progress,
         body_forces_interval=case.output.body_forces_interval)

@@ -25,7 +25,15 @@ Conventions (uniform grid of cubic cells of side ``cell_size`` h, arrays [i, j, 
   over the active cells. One mean over all active cells: separate closed regions are not handled.
 
 Stopping: ``||r||_2 <= tolerance ||rhs||_2`` with r = rhs - A p over the active cells (and rhs
-its compatible part for a closed tank), the residual of the returned p evaluated directly.
+its compatible part for a closed tank), the residual of the returned p evaluated directly; or,
+given the step's ``time_step`` dt and a ``volume_tolerance``, as soon as ``dt^2 max|r| <=
+volume_tolerance``. Why that second test: the projection's rhs is div(u*)/dt, so the corrected
+velocity keeps div u = dt r and every cell's volume changes by dt^2 r of itself over the step;
+bounding that by a fraction stops the solve when the flow is as incompressible as the volume of
+fluid needs, not at a residual relative to a right-hand side that grows with the waves (Basilisk's
+``poisson.h`` stops at the same bound, 1e-3 there). A solve that reaches ``max_iterations`` keeps
+what it has and says so (``PressureSolveReport.capped``) unless it is still far off
+(``CAPPED_RESIDUAL_LIMIT``).
 """
 from __future__ import annotations
 
@@ -56,14 +64,21 @@ SMOOTHING_SWEEPS = 2
 # with 8. (With 2 sweeps on every level: 23 iterations without, 17 with 2 sweeps, 14 with an
 # exact solve on those cells.)
 LISTED_SWEEPS = 4
+# A solve stopped by its iteration cap is kept (and reported) while its relative residual is below
+# this; above it the step is refused as an instability: a pressure that far off is not a flow.
+CAPPED_RESIDUAL_LIMIT = 1e-3
 
 
 @dataclass(frozen=True)
 class PressureSolveReport:
-    """How a solve went: CG ``iterations`` and the final ``relative_residual`` ||r|| / ||rhs||."""
+    """How a solve went: CG ``iterations``, the final ``relative_residual`` ||r|| / ||rhs||, the
+    largest relative volume change of a cell over the step that the solve leaves (dt^2 max|r|;
+    None when no time step was given), and whether it stopped at its iteration cap (``capped``)."""
 
     iterations: int
     relative_residual: float
+    volume_change: float | None = None
+    capped: bool = False
 
 
 def _check_shapes(shape, beta_x, beta_y, beta_z, arrays):
@@ -131,13 +146,17 @@ class PressureSolver:
     tolerance : float
         Relative residual ||r||_2 / ||rhs||_2 at which a solve stops.
     max_iterations : int
-        CG iterations after which a solve that has not reached ``tolerance`` fails.
+        CG iterations at which a solve stops (``PressureSolveReport.capped``).
+    volume_tolerance : float
+        With ``solve(time_step=dt)``: a solve also stops once no cell's volume changes by more
+        than this fraction over the step (dt^2 max|r|); 0 leaves that test out.
 
     The multigrid levels are allocated here once; ``solve`` only refills them. One instance is not
     safe to use from two threads at the same time.
     """
 
-    def __init__(self, shape, cell_size, *, tolerance: float = 1e-8, max_iterations: int = 200):
+    def __init__(self, shape, cell_size, *, tolerance: float = 1e-8, max_iterations: int = 200,
+                 volume_tolerance: float = 0.0):
         shape = tuple(int(n) for n in shape)
         if len(shape) != 3 or min(shape) < 1:
             raise CaseFileError(f"PressureSolver: shape must be (nx, ny, nz) with every size >= 1, "
@@ -147,12 +166,16 @@ class PressureSolver:
                                 f"{cell_size}")
         if not 0.0 < tolerance < 1.0:
             raise CaseFileError(f"PressureSolver: tolerance must lie in (0, 1), got {tolerance}")
+        if not (0.0 <= volume_tolerance < 1.0):
+            raise CaseFileError(f"PressureSolver: volume_tolerance must lie in [0, 1), got "
+                                f"{volume_tolerance}")
         if int(max_iterations) < 1:
             raise CaseFileError(f"PressureSolver: max_iterations must be >= 1, got {max_iterations}")
         self.shape = shape
         self.cell_size = float(cell_size)
         self.tolerance = float(tolerance)
         self.max_iterations = int(max_iterations)
+        self.volume_tolerance = float(volume_tolerance)
 
         shapes = [shape]
         factors = []
@@ -230,18 +253,20 @@ class PressureSolver:
                                       listed.inverse_diagonal)
         return listed
 
-    def solve(self, beta_x, beta_y, beta_z, rhs, p_initial=None, listed_cells=None):
+    def solve(self, beta_x, beta_y, beta_z, rhs, p_initial=None, listed_cells=None,
+              time_step=None):
         """Solve div(beta grad p) = rhs; returns (p, PressureSolveReport).
 
         ``p_initial`` (optional, e.g. the previous step's pressure) is the starting guess; it is not
         modified. ``listed_cells`` (optional flat indices into the (nx, ny, nz) cells, C order) get
         ``LISTED_SWEEPS`` extra smoothing sweeps per V-cycle: give the cells of bodies much heavier
         than the fluid around them (the result is the same, it comes in fewer iterations). The
-        returned ``p`` is a new array, 0 on inactive cells.
+        returned ``p`` is a new array, 0 on inactive cells. ``time_step`` (s): the step whose
+        rhs this is (div(u*)/dt), for the volume test (module docstring).
 
         Raises InstabilityError if a coefficient is negative or not finite, if rhs or an iterate
-        becomes non-finite, or if the solve stops above ``tolerance`` (after ``max_iterations``, or
-        on a breakdown of CG); CaseFileError on wrong shapes.
+        becomes non-finite, on a breakdown of CG, or if the solve stops at ``max_iterations``
+        with a relative residual above ``CAPPED_RESIDUAL_LIMIT``; CaseFileError on wrong shapes.
         """
         arrays = {"rhs": rhs} if p_initial is None else {"rhs": rhs, "p_initial": p_initial}
         _check_shapes(self.shape, beta_x, beta_y, beta_z, arrays)
@@ -272,11 +297,16 @@ class PressureSolver:
                                          rhs_sum / active_cells)
             multigrid.subtract_on_active(view(0, 0), view(0, 1), view(0, 2), pressure,
                                          pressure_sum / active_cells)
-        iterations, relative_residual, outcome = multigrid.solve_pcg(
+        dt2 = float(time_step) ** 2 if time_step else 0.0
+        largest_residual = self.volume_tolerance / dt2 if dt2 > 0.0 else 0.0
+        iterations, relative_residual, largest, outcome = multigrid.solve_pcg(
             self._hierarchy, self._system_rhs, pressure, self._direction, self._product,
             self._row_sums, self.tolerance, self.max_iterations, SMOOTHING_SWEEPS, singular,
-            active_cells, listed, LISTED_SWEEPS)
-        if outcome != multigrid.CONVERGED:
+            active_cells, listed, LISTED_SWEEPS, largest_residual)
+        volume_change = float(dt2 * largest) if dt2 > 0.0 else None
+        capped = (outcome == multigrid.NOT_CONVERGED
+                  and relative_residual <= CAPPED_RESIDUAL_LIMIT)
+        if outcome != multigrid.CONVERGED and not capped:
             reason = {
                 multigrid.NOT_CONVERGED: "did not converge",
                 multigrid.NON_FINITE: "met a non-finite value (check rhs and the coefficients)",
@@ -287,4 +317,5 @@ class PressureSolver:
             raise InstabilityError(f"pressure solve {reason}: relative residual "
                                    f"{relative_residual:.3e} after {iterations} iteration(s), "
                                    f"tolerance {self.tolerance:.1e}, grid {self.shape}")
-        return pressure, PressureSolveReport(int(iterations), float(relative_residual))
+        return pressure, PressureSolveReport(int(iterations), float(relative_residual),
+                                             volume_change, bool(capped))

@@ -63,7 +63,18 @@ class StepReport:
     courant_number: float
     pressure_iterations: int
     pressure_residual: float
-    water_volume_error: float     # (V - V0) / V0
+    water_volume_error: float     # (V - V0 - water let in by the flume's boundary and zones) / V0
+    pressure_volume_change: float | None = None    # the largest |div u| dt the solve left
+    pressure_capped: bool = False                  # the solve stopped at its iteration cap
+
+
+def _boundary_inflow(fluxes) -> float:
+    """Water that came in through the box's sides in one advection (m^3): the fluxes (positive
+    along +axis) on the lower faces minus those on the upper faces; walls carry none."""
+    total = 0.0
+    for axis, flux in enumerate(fluxes[:3]):
+        total += float(np.take(flux, 0, axis=axis).sum()) - float(np.take(flux, -1, axis=axis).sum())
+    return total
 
 
 def _box_overlap_fractions(grid: FluidGrid, lower, upper) -> np.ndarray:
@@ -94,6 +105,9 @@ class FluidSolver:
         Largest max|u| dt / h (<= 0.5).
     pressure_tolerance : float
         Relative residual at which the pressure solve stops.
+    pressure_volume_tolerance : float
+        The pressure solve also stops once no cell's volume changes by more than this fraction
+        over the step (``riprap/fluid/pressure.py``); 0 leaves that test out.
     max_time_step : float
         Upper bound on dt (s).
     surface_tension : float
@@ -107,12 +121,14 @@ class FluidSolver:
                  gravity=default_of("simulation", "gravity"),
                  courant_number: float = default_of("fluid", "courant_number"),
                  pressure_tolerance: float = default_of("fluid", "pressure_tolerance"),
+                 pressure_volume_tolerance: float = default_of("fluid", "pressure_volume_tolerance"),
                  max_time_step: float = default_of("fluid", "max_time_step"),
                  surface_tension: float = default_of("fluid", "surface_tension"),
                  limit_air_speed: bool = default_of("fluid", "limit_air_speed")):
         # The ranges are the [fluid] keys' (riprap.schema); the API checks them as the loader does.
-        courant, tension, longest = (key("fluid", name) for name in
-                                     ("courant_number", "surface_tension", "max_time_step"))
+        courant, tension, longest, volume = (
+            key("fluid", name) for name in ("courant_number", "surface_tension", "max_time_step",
+                                            "pressure_volume_tolerance"))
         if not courant.allows(courant_number):
             raise CaseFileError(f"fluid: courant_number = {courant_number!r} must be "
                                 f"{courant.stated_range()} (the volume-of-fluid sweeps are "
@@ -124,6 +140,10 @@ class FluidSolver:
         if not longest.allows(max_time_step):
             raise CaseFileError(f"fluid: max_time_step = {max_time_step!r} must be "
                                 f"{longest.stated_range()}")
+        if not volume.allows(pressure_volume_tolerance):
+            raise CaseFileError(f"fluid: pressure_volume_tolerance = {pressure_volume_tolerance!r} "
+                                f"must be {volume.stated_range()} (a fraction of a cell's volume "
+                                "per step)")
         self.grid = grid
         self.water = water
         self.air = air
@@ -151,9 +171,14 @@ class FluidSolver:
         self.step_count = 0
         self.time_step = 0.0
         self.initial_water_volume = None
+        #: Water the flume let in since the start (m^3): through its open boundaries (a wave
+        #: maker's, an open top) and by its wave-making and absorbing zones; the volume error
+        #: counts what the water did beyond it.
+        self.water_added = 0.0
         self.boundary_code = np.array([_BOUNDARY_CODE[grid.boundaries[side]] for side in SIDES],
                                       dtype=np.int64)
-        self.pressure_solver = PressureSolver((nx, ny, nz), self.h, tolerance=pressure_tolerance)
+        self.pressure_solver = PressureSolver((nx, ny, nz), self.h, tolerance=pressure_tolerance,
+                                              volume_tolerance=pressure_volume_tolerance)
         self.last_report = None
         self.last_pressure_seconds = 0.0
         #: Wave-making and absorbing zones (``riprap.waves.relaxation.WaveRelaxation``) blended in
@@ -389,6 +414,7 @@ class FluidSolver:
         water_fluxes = self._advect_water(dt, carriers)
         #: The water volumes (m^3) that crossed every face in the last step (overtopping gauges).
         self.last_water_fluxes = water_fluxes
+        self.water_added += _boundary_inflow(water_fluxes)
         area = h * h
         masses = [momentum.mass_fluxes(water_fluxes[a], velocity, dt, area, self.water.density,
                                        self.air.density)
@@ -476,7 +502,7 @@ class FluidSolver:
         started = time.perf_counter()
         pressure, report = self.pressure_solver.solve(betas[0], betas[1], betas[2], rhs,
                                                       p_initial=self.pressure,
-                                                      listed_cells=listed_cells)
+                                                      listed_cells=listed_cells, time_step=dt)
         self.last_pressure_seconds = time.perf_counter() - started
         self._correct(u, v, w, pressure, betas, dt)
         return pressure, report
@@ -488,14 +514,19 @@ class FluidSolver:
         self.step_count += 1
         self.time_step = dt
         if self.relaxation is not None:
+            before = self.water_volume()
             self.relaxation.apply(self)
+            self.water_added += self.water_volume() - before
         if self.gauges is not None:
             self.gauges.record(self)
-        error = (self.water_volume() - self.initial_water_volume) / max(self.initial_water_volume, 1e-300)
+        error = ((self.water_volume() - self.initial_water_volume - self.water_added)
+                 / max(self.initial_water_volume, 1e-300))
         self.last_report = StepReport(time=self.time, time_step=dt, courant_number=courant,
                                       pressure_iterations=report.iterations,
                                       pressure_residual=report.relative_residual,
-                                      water_volume_error=error)
+                                      water_volume_error=error,
+                                      pressure_volume_change=report.volume_change,
+                                      pressure_capped=report.capped)
         self._check_finite()
         return self.last_report
 
@@ -552,7 +583,7 @@ class FluidSolver:
         arrays = {"fraction": self.fraction.copy(), "u": self.u.copy(), "v": self.v.copy(),
                   "w": self.w.copy(), "pressure": self.pressure.copy(), "solid": self.solid.copy(),
                   "clock": np.array([self.time, float(self.step_count), self.time_step,
-                                     self.initial_water_volume or 0.0])}
+                                     self.initial_water_volume or 0.0, self.water_added])}
         if self.gauges is not None:
             arrays.update(self.gauges.record_arrays())
         return arrays
@@ -570,5 +601,7 @@ class FluidSolver:
         self.step_count = int(arrays["clock"][1])
         self.time_step = float(arrays["clock"][2])
         self.initial_water_volume = float(arrays["clock"][3]) or None
+        # older checkpoints kept no count of the water let in
+        self.water_added = float(arrays["clock"][4]) if len(arrays["clock"]) > 4 else 0.0
         if self.gauges is not None:
             self.gauges.load_record_arrays(arrays)

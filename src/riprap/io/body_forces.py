@@ -14,7 +14,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 from riprap.io.case_text import read_text_file
-from riprap.io.output_folder import naming_the_file
+from riprap.io.appended_table import AppendedTable
 
 __all__ = ["BODY_FORCE_COLUMNS", "BodyForceTable", "read_peak_fluid_forces"]
 
@@ -27,27 +27,11 @@ BODY_FORCE_COLUMNS = ("body", "time_s", "x_m", "y_m", "z_m", "vx_m_per_s", "vy_m
 _OLDER_COLUMNS = BODY_FORCE_COLUMNS[:-2]
 
 
-class BodyForceTable:
+class BodyForceTable(AppendedTable):
     """Rows appended to ``path`` (written with its header unless ``append`` and it exists)."""
 
     def __init__(self, path, *, append: bool = False):
-        self.path = Path(path)
-        if append and self.path.is_file():
-            with open(self.path, encoding="utf-8", errors="replace") as stream:
-                header = tuple(stream.readline().strip().split(","))
-            if header != BODY_FORCE_COLUMNS:
-                raise CaseFileError(
-                    f"{self.path}: its columns are not those this riprap writes (an older run's "
-                    "file?); rows appended by the restart would not match them. Run the case "
-                    "again from the start, or move the file away to start a new one")
-        else:
-            with naming_the_file(self.path):
-                self.path.write_text(",".join(BODY_FORCE_COLUMNS) + "\n")
-
-    def append(self, rows) -> None:
-        with naming_the_file(self.path), open(self.path, "a") as stream:
-            stream.write("".join(row + "\n" for row in rows))
-            stream.flush()
+        super().__init__(path, BODY_FORCE_COLUMNS, append=append)
 
 
 def read_peak_fluid_forces(path, n_bodies: int, until: float = math.inf) -> dict | None:

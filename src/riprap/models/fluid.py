@@ -23,6 +23,7 @@ from riprap.outputs.body_forces import BodyForcesWriter
 from riprap.outputs.bodies import BodiesInFlowWriter
 from riprap.outputs.fluid import CombinedSeriesWriter, FluidFieldsWriter
 from riprap.outputs.gauges import GaugesWriter
+from riprap.outputs.solver_log import SolverLogWriter
 from riprap.waves.report import flume_report
 
 __all__ = ["FluidModel", "CoupledModel", "step_towards"]
@@ -43,6 +44,49 @@ def step_towards(stable: float, remaining: float) -> float:
     return remaining / math.ceil(remaining / stable)
 
 
+class _LogWindow:
+    """What the steps since the last row of ``solver_log.csv`` did."""
+
+    def __init__(self):
+        self.steps = 0
+        self.seconds = 0.0
+        self.shortest = math.inf
+        self.iterations = 0
+        self.most_iterations = 0
+        self.capped = 0
+        self.volume_change = 0.0
+        self.substeps = None
+        self.stability_ratio = None
+
+    def add(self, dt, iterations, capped, volume_change, substeps, stability_ratio) -> None:
+        self.steps += 1
+        self.seconds += dt
+        self.shortest = min(self.shortest, dt)
+        self.iterations += iterations
+        self.most_iterations = max(self.most_iterations, iterations)
+        self.capped += capped
+        if volume_change is not None:
+            self.volume_change = max(self.volume_change, volume_change)
+        if substeps is not None:
+            self.substeps = (self.substeps or 0) + substeps
+        if stability_ratio is not None:
+            self.stability_ratio = max(self.stability_ratio or 0.0, stability_ratio)
+
+    def row(self, time: float, report) -> dict | None:
+        if not self.steps:
+            return None
+        return {"time_s": float(time), "fluid_steps": self.steps,
+                "time_step_mean_s": self.seconds / self.steps, "time_step_min_s": self.shortest,
+                "pressure_iterations_mean": self.iterations / self.steps,
+                "pressure_iterations_max": self.most_iterations,
+                "pressure_capped_solves": self.capped,
+                "pressure_volume_change_max": self.volume_change,
+                "water_volume_error": float(report.water_volume_error),
+                "contact_substeps_per_step": (None if self.substeps is None
+                                              else self.substeps / self.steps),
+                "contact_stability_ratio_max": self.stability_ratio}
+
+
 class FluidModel(Model):
     """Air and water on a Cartesian grid."""
 
@@ -56,7 +100,11 @@ class FluidModel(Model):
         self.smallest_step, self.largest_step, self.courant_max = np.inf, 0.0, 0.0
         self.iterations: list[int] = []
         self.pressure_seconds = 0.0
+        self.capped_solves = 0
         self._report = None
+        #: The rows of ``solver_log.csv`` this run wrote (also in ``summary.json``).
+        self.solver_log: list[dict] = []
+        self._window = _LogWindow()
 
     @property
     def fluid(self):
@@ -90,6 +138,21 @@ class FluidModel(Model):
         self.smallest_step, self.largest_step = min(self.smallest_step, dt), max(self.largest_step, dt)
         self.courant_max = max(self.courant_max, report.courant_number)
         self.iterations.append(report.pressure_iterations)
+        capped = bool(getattr(self.fluid.last_report, "pressure_capped", False))
+        self.capped_solves += capped
+        self._window.add(dt, report.pressure_iterations, capped,
+                         self.fluid.last_report.pressure_volume_change,
+                         getattr(report, "solid_substeps", None),
+                         getattr(self.solver, "last_stability_ratio", None))
+
+    def take_solver_log_row(self) -> dict | None:
+        """What the solvers did since the last row (``riprap.io.solver_log``), and a new window;
+        None when no step was taken since."""
+        row = self._window.row(self.time, self.fluid.last_report)
+        self._window = _LogWindow()
+        if row is not None:
+            self.solver_log.append(row)
+        return row
 
     # ------------------------------------------------------------------ state
     def state_arrays(self) -> dict:
@@ -116,7 +179,7 @@ class FluidModel(Model):
     # ------------------------------------------------------------------ outputs
     def default_writers(self, *, paraview: bool, picture: bool) -> list:
         return [FluidFieldsWriter(paraview=paraview, picture=picture),
-                GaugesWriter(picture=picture)]
+                GaugesWriter(picture=picture), SolverLogWriter()]
 
     def waves_report(self) -> dict:
         """The waves the gauges measured, against the wave maker's target
@@ -133,6 +196,10 @@ class FluidModel(Model):
             return ""
         text = (f"dt {r.time_step:.2e}  CFL {r.courant_number:.2f}  water volume error "
                 f"{r.water_volume_error:.1e}  pressure iterations {r.pressure_iterations}")
+        if self.capped_solves:
+            capped = getattr(self.fluid.last_report, "pressure_capped", False)
+            text += (f" ({'CAPPED now, ' if capped else ''}{self.capped_solves} solve(s) stopped "
+                     "at the cap)")
         clipped, fastest = self.fluid.last_air_limit
         if clipped:
             text += f"  air capped on {clipped} faces (fastest {fastest:.3g} m/s)"
@@ -149,7 +216,9 @@ class FluidModel(Model):
                 "water_volume_error": float(report.water_volume_error if report else 0.0),
                 "pressure_iterations_mean": float(np.mean(self.iterations)) if self.iterations else 0.0,
                 "pressure_iterations_max": int(max(self.iterations, default=0)),
-                "pressure_time_share": float(self.pressure_seconds / max(wall_time, 1e-9))}
+                "pressure_time_share": float(self.pressure_seconds / max(wall_time, 1e-9)),
+                "pressure_capped_solves": int(self.capped_solves),
+                "solver_log": list(self.solver_log)}
 
     def failure_advice(self, good: dict) -> str:
         return ("Likely cause: a flow the grid or the time step cannot carry; lower [fluid] "
@@ -219,9 +288,10 @@ class CoupledModel(FluidModel):
 
     # ------------------------------------------------------------------ outputs
     def default_writers(self, *, paraview: bool, picture: bool) -> list:
-        fluid, gauges = super().default_writers(paraview=paraview, picture=picture)
+        fluid, gauges, log = super().default_writers(paraview=paraview, picture=picture)
         bodies = self._bodies_writer(paraview)
-        return [bodies, fluid, CombinedSeriesWriter([fluid, bodies]), gauges, BodyForcesWriter()]
+        return [bodies, fluid, CombinedSeriesWriter([fluid, bodies]), gauges, BodyForcesWriter(),
+                log]
 
     def _bodies_writer(self, paraview: bool):
         return BodiesInFlowWriter(paraview=paraview)

@@ -16,6 +16,7 @@ from riprap.models.base import Model
 from riprap.models.body_frames import rigid_frame_fields
 from riprap.models.settings import ModelSettings
 from riprap.outputs.bodies import RigidBodiesWriter
+from riprap.solid.stability import MAX_MOTION_PER_STEP, max_speed, stability_ratio
 from riprap.solid.surfaces import surface_arrays
 from riprap.work_estimate import check_rigid_run
 
@@ -38,8 +39,6 @@ _ADAPT_CHUNK_STEPS = 50
 _MAX_STABILITY_RATIO = 0.5
 # A body rests when its net force is below this fraction of its weight (and it is slow).
 _REST_FORCE_RATIO = 0.1
-# No body should move more than this fraction of the thinnest boundary layer of tets in a step.
-_MAX_MOTION_PER_STEP = 0.1
 # Gravity above this (m/s^2) is named as the likely cause of a blow-up (a centrifuge model runs
 # at tens of g; more is a typo).
 _ABSURD_GRAVITY = 1000.0
@@ -95,17 +94,6 @@ def check_start_overlaps(solver, accepted_overlaps: dict) -> None:
 
 
 # ---------------------------------------------------------------------- physics checks
-def max_speed(solver) -> float:
-    """Largest speed of a free body including rotation at its bounding radius (m/s)."""
-    free = ~solver.fixed
-    if not free.any():
-        return 0.0
-    radius = solver.bounding_radius[solver.shape_index]
-    speed = (np.linalg.norm(solver.velocities, axis=1)
-             + np.linalg.norm(solver.angular_velocities, axis=1) * radius)
-    return float(speed[free].max())
-
-
 def at_rest(solver, settings: ModelSettings) -> bool:
     """Every free body slower than ``rest_speed`` and, under gravity, with a net force below
     ``_REST_FORCE_RATIO`` of its weight (a body at the top of a bounce is slow but not at rest)."""
@@ -121,24 +109,6 @@ def at_rest(solver, settings: ModelSettings) -> bool:
     return bool(ratio.max() < _REST_FORCE_RATIO)
 
 
-def stability_ratio(solver) -> tuple[float, str]:
-    """(max over current contacts of dt / (2 sqrt(m_eff / k)), the pair where it is, in words);
-    k the contact's measured stiffness and m_eff the smaller of the translational and rotational
-    effective masses of the pair. (0, "") without contacts."""
-    c = solver.contacts
-    if len(c) == 0:
-        return 0.0, ""
-    shapes = solver.shape_index
-    rotational = solver.principal_inertia.min(axis=1) / solver.bounding_radius[shapes] ** 2
-    inverse = np.where(solver.fixed, 0.0, 1.0 / np.minimum(solver.masses, rotational))
-    inverse_j = np.where(c.body_j >= 0, inverse[np.maximum(c.body_j, 0)], 0.0)
-    ratio = solver.time_step * np.sqrt(c.stiffness * (inverse[c.body_i] + inverse_j)) / 2.0
-    worst = int(np.argmax(ratio))
-    j = int(c.body_j[worst])
-    pair = f"body {int(c.body_i[worst])} and " + (f"wall {-1 - j}" if j < 0 else f"body {j}")
-    return float(ratio[worst]), pair
-
-
 def check_runaway(solver) -> None:
     """A body faster than RUNAWAY_SPEED stops the run, named."""
     speeds = np.linalg.norm(solver.velocities, axis=1)
@@ -150,10 +120,10 @@ def check_runaway(solver) -> None:
 
 
 def step_keeps_motion_small(solver, time_step: float) -> bool:
-    """No body moves more than _MAX_MOTION_PER_STEP of the smallest boundary sub-tet height in
+    """No body moves more than MAX_MOTION_PER_STEP of the smallest boundary sub-tet height in
     one step, so that a contact cannot go from nothing to a deep overlap in one step."""
     smallest = min(shape.min_subtet_height for shape in solver.shapes)
-    return max_speed(solver) * time_step <= _MAX_MOTION_PER_STEP * smallest
+    return max_speed(solver) * time_step <= MAX_MOTION_PER_STEP * smallest
 
 
 def blow_up_advice(solver, settings: ModelSettings, good: dict) -> str:
@@ -168,7 +138,7 @@ def blow_up_advice(solver, settings: ModelSettings, good: dict) -> str:
     if gravity > _ABSURD_GRAVITY:
         causes.append(f"gravity is {gravity:.3g} m/s^2 (the earth's is 9.81): check "
                       "[simulation] gravity")
-    if speed * s.time_step > _MAX_MOTION_PER_STEP * smallest:
+    if speed * s.time_step > MAX_MOTION_PER_STEP * smallest:
         causes.append(f"a body moved {speed * s.time_step:.3g} m per step at {speed:.3g} m/s, "
                       f"more than a tenth of the thinnest boundary layer of tetrahedra "
                       f"({smallest:.3g} m), so contacts start too deep: check the start "

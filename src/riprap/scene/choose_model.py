@@ -89,12 +89,22 @@ def _coupled_model(scene: Scene, settings: ModelSettings, restarted: bool) -> Co
                        restarted=restarted)
     except OverlapError as error:
         raise name_obstacles_in_overlap(error, obstacle_bodies, boxes) from None
-    return CoupledModel(CoupledSolver(scene.fluid, scene.solver, obstacle_bodies=obstacle_bodies))
+    return CoupledModel(CoupledSolver(scene.fluid, scene.solver, obstacle_bodies=obstacle_bodies,
+                                      adaptive_substep=settings.adaptive_time_step))
+
+
+def _refuse_adaptive_step(settings: ModelSettings) -> None:
+    """Deformable bodies step at their own stable step: an adaptive one is not theirs."""
+    if settings.adaptive_time_step:
+        raise CaseFileError("[simulation] adaptive_time_step = true: deformable bodies take the "
+                            "stable step of their elements; the adaptive contact step is for "
+                            "rigid bodies, dry or in a flow. Leave it out (or false) for this case")
 
 
 def _deformable_model(scene: Scene, settings: ModelSettings, restarted: bool) -> DeformableModel:
     """Deformable bodies, and rigid ones if any: those keep their own solver, stepped with the
     deformable bodies' step, and meet the deformable bodies through their surface layers."""
+    _refuse_adaptive_step(settings)
     solver = scene.solver
     rigid = None
     if solver.n_bodies > 0:
@@ -117,6 +127,7 @@ def _deformable_coupled_model(scene: Scene, settings: ModelSettings,
     """Deformable bodies (and rigid ones, if any) in the flow
     (``riprap.coupling.deformable_coupled``); the fluid box's sides (all but an open top) and
     the case's walls bound them."""
+    _refuse_adaptive_step(settings)
     solver, fluid = scene.solver, scene.fluid
     if "coupled solver" in scene.holds():
         raise CaseFileError("deformable bodies cannot join a CoupledSolver built by the caller: "

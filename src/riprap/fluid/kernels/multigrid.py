@@ -377,11 +377,12 @@ def dot(a, b, row_sums):
 @parallel_kernel
 def compute_residual(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x,
                      residual, row_sums):
-    """residual = rhs - L x; returns ||residual||_2^2."""
+    """residual = rhs - L x; returns (||residual||_2^2, max |residual|)."""
     nx, ny, nz = x.shape
     two_dimensional = ny == 1
     for i in prange(nx):
         total = 0.0
+        largest = 0.0
         for j in range(ny):
             row_is_interior = interior_row(i, j, x.shape)
             for k in range(nz):
@@ -395,11 +396,10 @@ def compute_residual(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_h
                 value = rhs[i, j, k] - (diagonal * x[i, j, k] - neighbours)
                 residual[i, j, k] = value
                 total += value * value
+                largest = max(largest, abs(value))
         row_sums[i, 0] = total
-    total = 0.0
-    for i in range(nx):
-        total += row_sums[i, 0]
-    return total
+        row_sums[i, 1] = largest
+    return _summed_and_largest(row_sums, nx)
 
 
 @parallel_kernel
@@ -432,21 +432,33 @@ def apply_operator_and_dot(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inv
 
 @parallel_kernel
 def step_solution_and_residual(pressure, residual, direction, product, step, row_sums):
-    """pressure += step direction, residual -= step product; returns ||residual||_2^2."""
+    """pressure += step direction, residual -= step product; returns (||residual||_2^2,
+    max |residual|)."""
     nx, ny, nz = pressure.shape
     for i in prange(nx):
         total = 0.0
+        largest = 0.0
         for j in range(ny):
             for k in range(nz):
                 pressure[i, j, k] += step * direction[i, j, k]
                 value = residual[i, j, k] - step * product[i, j, k]
                 residual[i, j, k] = value
                 total += value * value
+                largest = max(largest, abs(value))
         row_sums[i, 0] = total
+        row_sums[i, 1] = largest
+    return _summed_and_largest(row_sums, nx)
+
+
+@kernel
+def _summed_and_largest(row_sums, n):
+    """(sum of row_sums[:n, 0] in order, max of row_sums[:n, 1]): the per-slab reductions."""
     total = 0.0
-    for i in range(nx):
+    largest = 0.0
+    for i in range(n):
         total += row_sums[i, 0]
-    return total
+        largest = max(largest, row_sums[i, 1])
+    return total, largest
 
 
 @parallel_kernel
@@ -855,14 +867,15 @@ def _precondition(hierarchy, sweeps, singular, active_cells, row_sums, listed, l
 
 @kernel
 def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tolerance,
-              max_iterations, sweeps, singular, active_cells, listed, listed_sweeps):
+              max_iterations, sweeps, singular, active_cells, listed, listed_sweeps, largest_residual):
     """Preconditioned conjugate gradients for L pressure = system_rhs, from the given pressure.
 
-    Stops when ||r||_2 <= tolerance ||system_rhs||_2, with r re-evaluated as system_rhs - L
-    pressure before stopping (CG restarts from it if the recurrence had drifted). Returns
-    (iterations, relative residual of the returned pressure, outcome code).
+    Stops when ||r||_2 <= tolerance ||system_rhs||_2 or max |r| <= ``largest_residual`` (> 0;
+    0 leaves that test out), with r re-evaluated as system_rhs - L pressure before stopping (CG
+    restarts from it if the recurrence had drifted). Returns (iterations, relative residual of
+    the returned pressure, its max |r|, outcome code).
 
-    13 arguments: the ``Hierarchy`` bundle, the CG's own work arrays (written) and its settings;
+    14 arguments: the ``Hierarchy`` bundle, the CG's own work arrays (written) and its settings;
     the work arrays are allocated once per solver, not per solve.
     """
     beta_x = face_array(hierarchy.beta_x, hierarchy, 0, 0)
@@ -876,23 +889,25 @@ def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tol
 
     rhs_norm = np.sqrt(dot(system_rhs, system_rhs, row_sums))
     if not np.isfinite(rhs_norm):
-        return 0, np.inf, NON_FINITE
+        return 0, np.inf, np.inf, NON_FINITE
     if rhs_norm == 0.0:
         pressure[:, :, :] = 0.0
-        return 0, 0.0, CONVERGED
-    relative = np.sqrt(compute_residual(beta_x, beta_y, beta_z, hx2, hy2, hz2, system_rhs, pressure,
-                                        residual, row_sums)) / rhs_norm
+        return 0, 0.0, 0.0, CONVERGED
+    squared, largest = compute_residual(beta_x, beta_y, beta_z, hx2, hy2, hz2, system_rhs,
+                                        pressure, residual, row_sums)
+    relative = np.sqrt(squared) / rhs_norm
     if not np.isfinite(relative):
-        return 0, relative, NON_FINITE
+        return 0, relative, largest, NON_FINITE
     iterations = 0
     restart = True
     curvature_product = 0.0
-    while relative > tolerance and iterations < max_iterations:
+    while (relative > tolerance and largest > largest_residual
+           and iterations < max_iterations):
         _precondition(hierarchy, sweeps, singular, active_cells, row_sums, listed,
                       listed_sweeps)
         new_product = dot(residual, preconditioned, row_sums)
         if not np.isfinite(new_product):
-            return iterations, relative, NON_FINITE
+            return iterations, relative, largest, NON_FINITE
         if restart:
             copy_into(preconditioned, direction)
             restart = False
@@ -902,23 +917,24 @@ def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tol
         curvature = apply_operator_and_dot(beta_x, beta_y, beta_z, hx2, hy2, hz2, direction,
                                            product, row_sums)
         if not np.isfinite(curvature):
-            return iterations, relative, NON_FINITE
+            return iterations, relative, largest, NON_FINITE
         if curvature <= 0.0 or curvature_product <= 0.0:
-            return iterations, relative, BREAKDOWN
+            return iterations, relative, largest, BREAKDOWN
         iterations += 1
-        relative = np.sqrt(step_solution_and_residual(
-            pressure, residual, direction, product, curvature_product / curvature,
-            row_sums)) / rhs_norm
+        squared, largest = step_solution_and_residual(
+            pressure, residual, direction, product, curvature_product / curvature, row_sums)
+        relative = np.sqrt(squared) / rhs_norm
         if not np.isfinite(relative):
-            return iterations, relative, NON_FINITE
-        if relative <= tolerance:
+            return iterations, relative, largest, NON_FINITE
+        if relative <= tolerance or largest <= largest_residual:
             # Confirm with the true residual; restart from it if the recurrence has drifted.
-            relative = np.sqrt(compute_residual(beta_x, beta_y, beta_z, hx2, hy2, hz2, system_rhs,
-                                                pressure, residual, row_sums)) / rhs_norm
+            squared, largest = compute_residual(beta_x, beta_y, beta_z, hx2, hy2, hz2,
+                                                system_rhs, pressure, residual, row_sums)
+            relative = np.sqrt(squared) / rhs_norm
             restart = True
     if singular:
         subtract_on_active(beta_x, beta_y, beta_z, pressure,
                            sum_of_entries(pressure, row_sums) / active_cells)
-    if relative <= tolerance:
-        return iterations, relative, CONVERGED
-    return iterations, relative, NOT_CONVERGED
+    if relative <= tolerance or largest <= largest_residual:
+        return iterations, relative, largest, CONVERGED
+    return iterations, relative, largest, NOT_CONVERGED
