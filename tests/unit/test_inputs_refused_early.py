@@ -90,6 +90,23 @@ BROKEN_CASES = {
     "wave_period_in_ms": (
         FLUID + '[waves]\ntype = "linear"\nstill_water_level = 0.05\nheight = 0.01\n'
         "period = 1200.0\n", "run", ("waves.period = 1200.0", "far outside")),
+    # the pressure solve's volume stop and the adaptive contact step (issue 37)
+    "pressure_volume_tolerance_of_a_tenth": (
+        _edit(FLUID, "cells = [20, 2, 10]", "cells = [20, 2, 10]\npressure_volume_tolerance = 0.1"),
+        "run", ("fluid.pressure_volume_tolerance = 0.1", "[0, 0.01)")),
+    "pressure_volume_tolerance_negative": (
+        _edit(FLUID, "cells = [20, 2, 10]", "cells = [20, 2, 10]\npressure_volume_tolerance = -1e-6"),
+        "run", ("fluid.pressure_volume_tolerance = -1e-06",)),
+    "adaptive_time_step_as_a_number": (
+        _edit(RIGID, "end_time = 0.01", "end_time = 0.01\nadaptive_time_step = 1"), "run",
+        ("simulation.adaptive_time_step",)),
+    "adaptive_time_step_for_deformable_bodies": (
+        _edit(RIGID, "end_time = 0.01", "end_time = 0.01\nadaptive_time_step = true")
+        + "[deformable]\n", "run", ("adaptive_time_step = true", "deformable bodies")),
+    "adaptive_time_step_for_deformable_bodies_in_water": (
+        _edit(_TINY_IN_WATER, "end_time = 1.0e4", "end_time = 0.01\nadaptive_time_step = true")
+        .replace("output_interval = 1.0", "output_interval = 0.005").replace("side = 2e-4", "side = 0.06")
+        + "[deformable]\n", "run", ("adaptive_time_step = true", "deformable bodies")),
     # placement cases that place used to refuse only after the underlayer run, or never
     "millimetre_flume": (_edit(PLACEMENT, "width = 3.0", "width = 0.001"), "place",
                          ("slope.width = 0.001", "far outside")),

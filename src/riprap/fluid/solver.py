@@ -40,7 +40,7 @@ from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.kernels import momentum, plic
 from riprap.fluid.kernels.face_speeds import largest_pore_speed, limit_air_faces
 from riprap.fluid.kernels.porous_faces import face_speeds_and_viscosities
-from riprap.fluid.kernels.sharp_density import face_densities
+from riprap.fluid.kernels.sharp_density import cell_planes, face_densities
 from riprap.fluid.kernels.surface_tension import face_forces
 from riprap.fluid.phases import AIR_20C, WATER_20C, Phase
 from riprap.fluid.porous import PorousMedium
@@ -194,6 +194,7 @@ class FluidSolver:
         self._open_part = np.ones((nx, ny, nz))
         self._porous_factors = None
         self.last_water_fluxes = None
+        self._planes = None          # the mixed cells' PLIC planes (kernels.sharp_density), per step
 
     # ------------------------------------------------------------------ set-up
     def add_water_box(self, lower, upper) -> None:
@@ -459,11 +460,15 @@ class FluidSolver:
         return u, v, w, densities
 
     def _sharp_face_densities(self) -> list:
+        if self._planes is None:
+            self._planes = np.zeros(self.fraction.shape + (4,))
+        cell_planes(self.fraction, self._planes)
         out = []
         for axis, shape in enumerate((self.u.shape, self.v.shape, self.w.shape)):
             density = np.ones(shape)
             if not (axis == 1 and self.grid.two_dimensional):
-                face_densities(self.fraction, axis, self.water.density, self.air.density, density)
+                face_densities(self.fraction, self._planes, axis, self.water.density,
+                               self.air.density, density)
             out.append(density)
         return out
 

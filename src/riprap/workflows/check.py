@@ -101,5 +101,10 @@ def _bodies_step(sim) -> str:
         text = f"time step {step:.3e} s"
     if sim.fluid is not None:
         # the fluid's own step follows its Courant number; the bodies' is a sub-step inside it
+        coupled = getattr(model, "solver", None)
+        if getattr(coupled, "adaptive_substep", False):
+            return (f"{text} to start the contact sub-steps of each fluid step (adaptive: they "
+                    f"follow the contacts' measured stability, up to {coupled.substep_ceiling:.3e} "
+                    f"s) for {what}")
         return f"{text} (a sub-step of each fluid step) for {what}"
     return f"{text} and the work of {sim.end_time / step:.3g} steps of {what}"
