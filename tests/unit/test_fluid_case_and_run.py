@@ -7,6 +7,7 @@ import pytest
 from riprap.case.build_fluid import build_fluid_run
 from riprap.case.load import parse_case
 from riprap.errors import CaseFileError, InstabilityError
+from riprap.fluid import pressure as pressure_module
 from riprap.io.vti import read_vti
 
 CASE = """
@@ -48,8 +49,10 @@ def test_restart_reproduces_the_unbroken_run(tmp_path):
     assert summary.water_volume_error < 1e-10
 
 
-def test_a_failing_step_leaves_the_last_good_state(tmp_path):
-    # A pressure tolerance no solver can reach: the first step fails.
+def test_a_failing_step_leaves_the_last_good_state(tmp_path, monkeypatch):
+    # A pressure tolerance no solver can reach, and no capped solve kept (a capped solve whose
+    # residual is below CAPPED_RESIDUAL_LIMIT is kept and reported instead): the first step fails.
+    monkeypatch.setattr(pressure_module, "CAPPED_RESIDUAL_LIMIT", 1e-30)
     with pytest.raises(InstabilityError, match="failure_checkpoint.npz"):
         _run(tmp_path, "fail", tolerance=1e-30)
     assert (tmp_path / "fail" / "failure_checkpoint.npz").is_file()
