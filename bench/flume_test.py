@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riprap.analysis.stability_report import _incident
+from riprap.analysis.stability_report import incident_at_toe
 from riprap.case.build_fluid import build_fluid_run
 from riprap.case.load import load_case
 
@@ -41,7 +41,7 @@ DISPLACEMENT_BAND_DN = 0.1
 
 
 def results_of(summary, report: dict, displacement, volume_errors) -> dict:
-    incident, _, waves, source = _incident(report)
+    incident, _, waves, source = incident_at_toe(report)
     reflection = [e["reflection_coefficient"] for e in report.get("reflection_three_gauge", [])]
     run_up = next(iter(report.get("run_up", {}).values()), {})
     overtopping = next(iter(report.get("overtopping", {}).values()), {})

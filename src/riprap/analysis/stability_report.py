@@ -18,7 +18,7 @@ import math
 from riprap.analysis.design_formulas import hudson_stability_number, van_der_meer_cubes_damage
 from riprap.geometry.unit_kinds import UNIT_RECORDS
 
-__all__ = ["flume_stability", "HUDSON_TRUNK_STABILITY"]
+__all__ = ["flume_stability", "incident_at_toe", "HUDSON_TRUNK_STABILITY"]
 
 #: K_D of a trunk under non-breaking waves per unit kind (armour_design.md §5.2, kept in each
 #: kind's record); None: no value retrieved for it (cubes: Van der Meer's formula instead).
@@ -31,7 +31,7 @@ def _finite(value) -> bool:
             and math.isfinite(value))
 
 
-def _incident(waves_report: dict):
+def incident_at_toe(waves_report: dict):
     """(incident Hm0, Tz, waves, where it was read) at the toe; values the waves report left
     null (not computed) are passed over."""
     gauges = waves_report.get("gauges", {})
@@ -58,7 +58,7 @@ def flume_stability(waves_report: dict, layer_summary: dict, *, unit_kind: str,
                     nominal_diameter: float, armour_density: float, water_density: float,
                     slope_cot: float) -> dict:
     """The stability part of the flume test's report (a dict for JSON)."""
-    height, period, waves, source = _incident(waves_report)
+    height, period, waves, source = incident_at_toe(waves_report)
     delta = armour_density / water_density - 1.0
     result = {"unit": unit_kind, "nominal_diameter_m": nominal_diameter, "relative_density": delta,
               "slope_cot": slope_cot, "wave_height_source": source,
