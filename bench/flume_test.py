@@ -84,6 +84,9 @@ def compare(new: dict, old: dict) -> bool:
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--end", type=float, default=60.0, help="simulated seconds (default 60)")
+    parser.add_argument("--case", default=str(CASE),
+                        help="another case file (e.g. examples/10 with a round-off change, to "
+                             "measure the run-to-run spread the bands stand for)")
     parser.add_argument("--out", default="/tmp/riprap_bench_flume_test")
     parser.add_argument("--save", help="write the results as JSON here")
     parser.add_argument("--compare", help="a JSON of --save to compare with")
@@ -92,7 +95,7 @@ def main():
                              "from the waves on the structure)")
     args = parser.parse_args()
     load_before = os.getloadavg()
-    case = load_case(CASE)
+    case = load_case(Path(args.case))
     simulation = build_fluid_run(case, output_directory=args.out, progress=False)
     simulation.end_time = args.end
     bodies = simulation.solver

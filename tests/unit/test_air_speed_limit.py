@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from riprap.fluid.grid import FluidGrid
-from riprap.fluid.kernels.face_speeds import (largest_pore_speed, limit_air_faces,
+from riprap.fluid.kernels.face_speeds import (WET_FRACTION, largest_pore_speed, limit_air_faces,
                                               limit_listed_faces, listed_pore_speed)
 from riprap.fluid.solver import FluidSolver
 
@@ -45,6 +45,23 @@ def test_kernels_see_only_the_faces_beside_water():
     assert listed_pore_speed(f, axes, index, values, open_part, False) == 6.0
     assert limit_listed_faces(f, axes, index, values, open_part, 2.0) == 1
     assert values.tolist() == [-2.0, 3.0, 0.25]
+
+
+def test_traces_of_water_count_as_air():
+    """A face beside cells with only a trace of water (the round-off the sweeps leave, a wisp of
+    spray) neither sets the step nor escapes the cap; one more trace above WET_FRACTION does."""
+    f = np.zeros((3, 1, 2))
+    f[:, :, 0] = 1.0
+    f[1, 0, 1] = 1e-30                  # a round-off trace in the upper row
+    open_part = np.ones_like(f)
+    w = np.zeros((3, 1, 3))
+    w[:, :, 1] = 0.5
+    w[1, 0, 2] = 9.0                    # the top face of the trace cell
+    assert largest_pore_speed(f, w, 2, open_part, True) == 0.5
+    assert limit_air_faces(f, w.copy(), 2, open_part, 1.0) == (1, 9.0)
+    f[1, 0, 1] = 2.0 * WET_FRACTION
+    assert largest_pore_speed(f, w, 2, open_part, True) == 9.0
+    assert limit_air_faces(f, w.copy(), 2, open_part, 1.0)[0] == 0
 
 
 def test_a_face_takes_the_porosity_of_its_own_cells():

@@ -34,7 +34,7 @@ from riprap.waves.theory import GRAVITY, wave_number
 
 __all__ = ["WaveStatistics", "wave_statistics", "ReflectionAnalysis", "separate_incident_reflected",
            "separate_regular_wave", "separate_three_gauges", "harmonic_amplitude",
-           "even_record", "zero_down_crossing_heights", "variance_density"]
+           "even_record", "zero_down_crossing_heights", "variance_density", "three_gauge_split"]
 
 # The band of the Goda-Suzuki split: where the gauge spacing is within this fraction of a wave length.
 _GODA_SUZUKI_BAND = (0.05, 0.45)
@@ -219,7 +219,7 @@ def separate_incident_reflected(times, eta_1, eta_2, spacing: float, depth: floa
 _THREE_GAUGE_CONDITION = (2.0 - 2.0 * math.cos(2.0 * math.pi * _GODA_SUZUKI_BAND[0])) / 2.0
 
 
-def _three_gauge_split(amplitudes, k, offsets):
+def three_gauge_split(amplitudes, k, offsets):
     """(a_I, a_R) by least squares from the complex amplitudes at the gauges, or None where the
     system is ill posed (all spacings near whole numbers of half wave lengths)."""
     phases = np.exp(1j * k * offsets)
@@ -254,7 +254,7 @@ def separate_three_gauges(times, records, positions, depth: float,
             raise CaseFileError("wave analysis: the three-gauge split of a regular wave needs its period")
         k = wave_number(peak_period, depth, gravity)
         amplitudes = np.array([harmonic_amplitude(times, r, peak_period) for r in records])
-        split = _three_gauge_split(amplitudes, k, offsets)
+        split = three_gauge_split(amplitudes, k, offsets)
         if split is None:
             raise CaseFileError(f"wave analysis: gauges at x = {positions.tolist()} m are all whole "
                                 f"numbers of half wave lengths apart (L = {2 * math.pi / k:.3g} m): "
@@ -278,7 +278,7 @@ def separate_three_gauges(times, records, positions, depth: float,
     for m, f in enumerate(frequencies):
         if m == 0 or not band[0] * fp <= f <= band[1] * fp:
             continue
-        split = _three_gauge_split(spectra[:, m], wave_number(1.0 / f, depth, gravity), offsets)
+        split = three_gauge_split(spectra[:, m], wave_number(1.0 / f, depth, gravity), offsets)
         if split is None:
             continue
         energy_incident += 0.5 * abs(split[0]) ** 2
