@@ -34,7 +34,8 @@ from riprap.waves.theory import GRAVITY, wave_number
 
 __all__ = ["WaveStatistics", "wave_statistics", "ReflectionAnalysis", "separate_incident_reflected",
            "separate_regular_wave", "separate_three_gauges", "harmonic_amplitude",
-           "even_record", "zero_down_crossing_heights", "variance_density", "three_gauge_split"]
+           "even_record", "zero_down_crossing_heights", "variance_density", "three_gauge_split",
+           "gauge_spectra"]
 
 # The band of the Goda-Suzuki split: where the gauge spacing is within this fraction of a wave length.
 _GODA_SUZUKI_BAND = (0.05, 0.45)
@@ -232,6 +233,22 @@ def three_gauge_split(amplitudes, k, offsets):
     return incident, reflected
 
 
+def gauge_spectra(times, records, peak_period: float | None = None):
+    """(t, frequencies, spectra, peak period) of gauge ``records`` on ``times``: the records put
+    on the first one's even grid, and per gauge the complex amplitudes of exp(-i omega t) at each
+    frequency (numpy's rfft is of exp(+i omega t)); the peak period is ``peak_period`` or, if
+    None, the spectral peak of the first gauge."""
+    t, first = even_record(times, records[0])
+    evens = [first] + [np.interp(t, np.asarray(times, dtype=float), np.asarray(r, dtype=float))
+                       for r in records[1:]]
+    n = first.size
+    frequencies = np.fft.rfftfreq(n, t[1] - t[0])
+    spectra = np.array([np.conj(np.fft.rfft(e - e.mean())) * 2.0 / n for e in evens])
+    if peak_period is None:
+        peak_period = 1.0 / frequencies[1 + int(np.argmax(np.abs(spectra[0, 1:])))]
+    return t, frequencies, spectra, peak_period
+
+
 def separate_three_gauges(times, records, positions, depth: float,
                           peak_period: float | None = None, gravity: float = GRAVITY,
                           band=(0.5, 2.0), regular: bool = False) -> ReflectionAnalysis:
@@ -263,15 +280,7 @@ def separate_three_gauges(times, records, positions, depth: float,
         return ReflectionAnalysis(incident_hm0=2.0 * abs(incident), reflected_hm0=2.0 * abs(reflected),
                                   reflection_coefficient=abs(reflected) / abs(incident),
                                   band=(1.0 / peak_period, 1.0 / peak_period))
-    t, first = even_record(times, records[0])
-    evens = [first] + [np.interp(t, np.asarray(times, dtype=float), np.asarray(r, dtype=float))
-                       for r in records[1:]]
-    n = first.size
-    frequencies = np.fft.rfftfreq(n, t[1] - t[0])
-    # complex amplitudes of exp(-i omega t) at each gauge (numpy's rfft is of exp(+i omega t))
-    spectra = np.array([np.conj(np.fft.rfft(e - e.mean())) * 2.0 / n for e in evens])
-    if peak_period is None:
-        peak_period = 1.0 / frequencies[1 + int(np.argmax(np.abs(spectra[0, 1:])))]
+    t, frequencies, spectra, peak_period = gauge_spectra(times, records, peak_period)
     fp = 1.0 / peak_period
     energy_incident = energy_reflected = 0.0
     used = []

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from riprap.errors import CaseFileError
-from riprap.waves.analysis import even_record, three_gauge_split
+from riprap.waves.analysis import gauge_spectra, three_gauge_split
 from riprap.waves.theory import GRAVITY, wave_number
 
 __all__ = ["Waves", "incident_elevation", "zero_down_crossing_waves", "OvertoppingEvents",
@@ -50,14 +50,8 @@ def incident_elevation(times, records, positions, depth: float, at: float,
     if positions.size != 3 or len(records) != 3:
         raise CaseFileError(f"incident elevation: needs three gauges, got {positions.size}")
     offsets = positions - positions[0]
-    t, first = even_record(times, records[0])
-    evens = [first] + [np.interp(t, np.asarray(times, dtype=float), np.asarray(r, dtype=float))
-                       for r in records[1:]]
+    t, frequencies, spectra, peak_period = gauge_spectra(times, records, peak_period)
     n = t.size
-    frequencies = np.fft.rfftfreq(n, t[1] - t[0])
-    spectra = np.array([np.conj(np.fft.rfft(e - e.mean())) * 2.0 / n for e in evens])
-    if peak_period is None:
-        peak_period = 1.0 / frequencies[1 + int(np.argmax(np.abs(spectra[0, 1:])))]
     fp = 1.0 / peak_period
     incident = np.zeros(frequencies.size, dtype=complex)
     kept = 0
