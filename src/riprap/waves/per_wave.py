@@ -33,7 +33,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 from riprap.waves.analysis import gauge_spectra, three_gauge_split
-from riprap.waves.theory import GRAVITY, wave_number
+from riprap.waves.theory import GRAVITY, wave_length, wave_number
 
 __all__ = ["Waves", "incident_elevation", "zero_down_crossing_waves", "OvertoppingEvents",
            "overtopping_events", "shifted_windows", "lag_to", "window_sums", "window_maxima"]
@@ -152,7 +152,7 @@ def shifted_windows(waves: Waves, lag: float) -> tuple[np.ndarray, np.ndarray]:
 def lag_to(distance: float, peak_period: float, depth: float, gravity: float = GRAVITY) -> float:
     """Travel time (s) of a wave crest over ``distance`` m at the linear celerity of
     ``peak_period`` in water ``depth`` m deep."""
-    return max(distance, 0.0) * wave_number(peak_period, depth, gravity) / (2.0 * math.pi / peak_period)
+    return max(distance, 0.0) * peak_period / wave_length(peak_period, depth, gravity)
 
 
 def window_sums(start, end, event_times, event_values) -> np.ndarray:
