@@ -307,6 +307,17 @@ TABLES: tuple[Table, ...] = (
           "contact. The other bodies stay rigid. Explicit finite-strain tetrahedra "
           "(docs/deformable.md); stresses in every frame and units.csv. With `[fluid]` the water "
           "loads their surfaces."),
+    Table("series", False, 0, None,
+          "A test series (`riprap run` or `riprap series`; docs/campaign.md): the same structure "
+          "attacked by the sea states of `[[series_steps]]` one after the other, each step "
+          "starting from the bodies' end state of the step before (at rest, contact history "
+          "kept) with the water still again, as in a laboratory flume; a survey after every "
+          "step and the damage curves at the end. Needs `[fluid]`, irregular `[waves]` and "
+          "bodies."),
+    Table("series_steps", True, 0, None,
+          "The sea states of a `[series]`, in the order they are run, each replacing the "
+          "`[waves]` table's significant_height, peak_period, peak_enhancement, seed and "
+          "duration; significant heights must rise from step to step."),
     Table("output", False, 1, None, "Where and what riprap writes."),
 )
 
@@ -663,6 +674,10 @@ KEYS: tuple[Key, ...] = (
     Key("waves", "ramp_periods", "number", "-",
         "Wave periods over which the generated wave grows from still water.", default=2.0,
         valid_range=_NON_NEGATIVE),
+    Key("waves", "stop_time", "number", "s",
+        "When the wave maker stops (s): the wave fades out over ramp_periods ending then, and the "
+        "flume calms (a step of a test series); 0: it makes waves to the end.", default=0.0,
+        valid_range=_NON_NEGATIVE),
     *(key
       for variant in _REGULAR_WAVES
       for key in (
@@ -783,6 +798,35 @@ KEYS: tuple[Key, ...] = (
     Key("deformable", "fracture_region_upper", "vector", "m",
         "Upper corner of that box.", default=(1.0e9, 1.0e9, 1.0e9),
         greater_than="fracture_region_lower"),
+    # [series]
+    Key("series", "displacement_threshold", "number", "-",
+        "A unit counts as displaced (N_od) once its centroid has moved more than this many "
+        "nominal diameters Dn from where the series started (Van der Meer 1988: units moved out "
+        "of the layer, about 1 Dn).", default=1.0, valid_range=Range(minimum=0.0, maximum=10.0,
+                                                                     minimum_inclusive=False)),
+    Key("series", "settle_time", "number", "s",
+        "How long each step runs on after its sea ends, for the last waves to reach the "
+        "structure and run down; 0: three peak periods plus the travel time from the wave maker "
+        "to the structure.", default=0.0, valid_range=_NON_NEGATIVE),
+    # [[series_steps]]
+    Key("series_steps", "significant_height", "number", "m",
+        "Spectral significant wave height Hm0 of the step's sea.", valid_range=_POSITIVE),
+    Key("series_steps", "peak_period", "number", "s",
+        "Peak period Tp; 0: from wave_steepness.", default=0.0, valid_range=_NON_NEGATIVE),
+    Key("series_steps", "wave_steepness", "number", "-",
+        "Deep-water wave steepness s_op = 2 pi Hm0 / (g Tp^2) that sets Tp (a series at constant "
+        "steepness); 0: peak_period is given.", default=0.0,
+        valid_range=Range(minimum=0.0, maximum=0.142)),
+    Key("series_steps", "peak_enhancement", "number", "-", "JONSWAP peak enhancement factor gamma.",
+        default=3.3, valid_range=Range(minimum=1.0)),
+    Key("series_steps", "waves", "integer", "-",
+        "Number of waves of the step: its sea lasts waves x Tm02 (the spectrum's mean "
+        "zero-crossing period); 0: duration is given.", default=0, valid_range=_NON_NEGATIVE),
+    Key("series_steps", "duration", "number", "s",
+        "Length of the step's sea (s); 0: from waves.", default=0.0, valid_range=_NON_NEGATIVE),
+    Key("series_steps", "seed", "integer", "-",
+        "Seed of the step's random phases; 0: the step's number (1, 2, ...).", default=0,
+        valid_range=_NON_NEGATIVE),
     Key("output", "directory", "string", "-",
         "Output folder, relative to the current directory unless the command line overrides it.",
         default="riprap-out"),
@@ -853,6 +897,15 @@ PLAUSIBLE: dict[tuple[str, str], Range] = {
     ("waves", "peak_period"): _between(0.1, 300.0),
     # JONSWAP peak enhancement: 1 (Pierson-Moskowitz) to about 7 for young swell-free seas
     ("waves", "peak_enhancement"): _between(1.0, 20.0),
+    ("series_steps", "significant_height"): _between(1.0e-3, 50.0),
+    ("series_steps", "peak_period"): _between(0.1, 300.0),
+    ("series_steps", "peak_enhancement"): _between(1.0, 20.0),
+    # a step of 10 000 waves is ten storm tests; 1e6 s is eleven days of sea
+    ("series_steps", "waves"): _between(1.0, 10000.0),
+    ("series_steps", "duration"): _between(1.0, 1.0e6),
+    ("series_steps", "wave_steepness"): _between(1.0e-3, 0.142),
+    ("series", "displacement_threshold"): _between(1.0e-3, 10.0),
+    ("series", "settle_time"): _between(0.0, 1.0e5),
     # elastic material: gels (1e3 Pa) to diamond (1.2e12); concrete about 3e10
     ("deformable", "young_modulus"): _between(1.0e3, 1.0e13),
     # viscous damping of the elements: riprap's examples use 2-300 Pa s; far beyond 1e9 the

@@ -67,7 +67,7 @@ def build_waves(case, solver) -> None:
         _check_water_level_at_the_zones(case, solver, level, spec.absorbing_end)
         ramp_time = spec.ramp_periods * wave.period
         if boundary:
-            maker = BoundaryWaveMaker(wave, level, ramp_time=ramp_time,
+            maker = BoundaryWaveMaker(wave, level, ramp_time=ramp_time, stop_time=spec.stop_time,
                                       active_absorption=spec.active_absorption, gravity=gravity)
             try:
                 maker.attach(solver)
@@ -76,7 +76,8 @@ def build_waves(case, solver) -> None:
             if zones:
                 solver.relaxation = WaveRelaxation(None, level, zones)
         else:
-            solver.relaxation = WaveRelaxation(wave, level, zones, ramp_time=ramp_time)
+            solver.relaxation = WaveRelaxation(wave, level, zones, ramp_time=ramp_time,
+                                               stop_time=spec.stop_time)
     if case.gauges:
         if level is None:
             levels = [r.parameters["level"] for r in case.water_regions if r.type == "level"]

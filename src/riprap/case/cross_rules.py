@@ -66,6 +66,8 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
             add((name,), f"{header} belongs to a flume: it needs a [fluid] table (the air and water "
                 "the waves run in)")
 
+    _check_series(tables, add, ok)
+
     given_placement = [name for name in PLACEMENT_TABLES if tables.get(name) is not None]
     has_bodies = bool(tables.get("bodies")) or bool(tables.get("body_grids"))
     if given_placement:
@@ -134,3 +136,47 @@ def _check_placement(tables: Tables, add: Callable, ok: Callable) -> None:
         elif low >= high:
             add(("underlayer", "from_s"), f"not below to_s = {high:g} m: the rock band would be "
                 "empty", low)
+
+
+def _check_series(tables: Tables, add: Callable, ok: Callable) -> None:
+    """A test series: a flume with irregular waves, steps that each give one period and one
+    length, and significant heights that rise from step to step."""
+    series, steps = tables.get("series"), tables.get("series_steps") or []
+    if series is None:
+        if steps:
+            add(("series_steps",), "[[series_steps]] are the sea states of a test series: add a "
+                "[series] table, or drop them and give the sea in [waves]")
+        return
+    if not steps:
+        add(("series",), "a test series needs its sea states: add [[series_steps]] entries "
+            "(significant_height, peak_period or wave_steepness, waves or duration)")
+    waves = tables.get("waves")
+    if tables.get("fluid") is None or waves is None:
+        add(("series",), "a test series attacks a structure with waves: it needs [fluid] and "
+            "[waves] (type = \"irregular\", whose sea the steps replace)")
+    elif ok(waves.get("type")) and waves.get("type") != "irregular":
+        add(("waves", "type"), "a test series replaces an irregular sea's significant_height and "
+            "peak_period step by step: [waves] type must be \"irregular\"", waves.get("type"))
+    previous = None
+    for number, step in enumerate(steps):
+        if step is None:
+            continue
+        period, steepness = step.get("peak_period"), step.get("wave_steepness")
+        if ok(period, steepness) and (period > 0) == (steepness > 0):
+            add(("series_steps", number, "peak_period"),
+                "give either peak_period or wave_steepness (the other 0)"
+                if period > 0 else "give peak_period or wave_steepness", period)
+        waves_run, duration = step.get("waves"), step.get("duration")
+        if ok(waves_run, duration) and (waves_run > 0) == (duration > 0):
+            add(("series_steps", number, "waves"),
+                "give either waves (a number of waves) or duration (s), the other 0"
+                if waves_run > 0 else "give waves (a number of waves) or duration (s)", waves_run)
+        height = step.get("significant_height")
+        if not ok(height):
+            continue
+        if previous is not None and not height > previous[1]:
+            add(("series_steps", number, "significant_height"),
+                f"does not rise above step {previous[0] + 1}'s {previous[1]:g} m: a test series "
+                "runs rising sea states on one structure (another sea on the same structure is "
+                "another member of a campaign: docs/campaign.md)", height)
+        previous = (number, height)

@@ -27,7 +27,8 @@ from riprap.case.cross_rules import check_cross_rules
 # case's parts have always been imported from.
 from riprap.case.specs import (ArmourSpec, BodyGridSpec, BodySpec, Case, DeformableSpec,
                                FluidSpec, GaugeSpec, MaterialSpec, OutputSettings, PlacementSpec,
-                               PorousZoneSpec, RegionSpec, ShapeSpec, SimulationSettings,
+                               PorousZoneSpec, RegionSpec, SeriesSpec, SeriesStepSpec,
+                               ShapeSpec, SimulationSettings,
                                SlopeSpec, UnderlayerSpec, WallSpec, WavesSpec)
 from riprap.errors import CaseFileError
 from riprap.io.case_text import PACK_HEADER, read_case_text
@@ -794,6 +795,8 @@ class _Validator:
             gauges=tuple(_with_parameters(GaugeSpec, "gauges", values) for values in tables["gauges"]),
             porous_zones=tuple(_with_parameters(PorousZoneSpec, "porous_zones", values)
                                for values in tables["porous_zones"]),
+            series=_optional(SeriesSpec, tables["series"]),
+            series_steps=tuple(SeriesStepSpec(**values) for values in tables["series_steps"]),
         )
         if top.get("pack"):
             case = _with_pack(case, top["pack"])

@@ -31,6 +31,8 @@ __all__ = [
     "WavesSpec",
     "GaugeSpec",
     "PorousZoneSpec",
+    "SeriesSpec",
+    "SeriesStepSpec",
     "OutputSettings",
     "spec_class",
     "keywords_for",
@@ -142,6 +144,8 @@ RegionSpec = spec_class("RegionSpec", "water_regions", doc=(
 WavesSpec = spec_class("WavesSpec", "waves")
 GaugeSpec = spec_class("GaugeSpec", "gauges")
 PorousZoneSpec = spec_class("PorousZoneSpec", "porous_zones")
+SeriesSpec = spec_class("SeriesSpec", "series")
+SeriesStepSpec = spec_class("SeriesStepSpec", "series_steps")
 OutputSettings = spec_class("OutputSettings", "output")
 
 
@@ -180,11 +184,18 @@ class Case:
     waves: WavesSpec | None = None
     gauges: tuple[GaugeSpec, ...] = ()
     porous_zones: tuple[PorousZoneSpec, ...] = ()
+    series: SeriesSpec | None = None
+    series_steps: tuple[SeriesStepSpec, ...] = ()
 
     @property
     def is_fluid(self) -> bool:
         """Whether the case has a ``[fluid]`` table (a two-phase flow run)."""
         return self.fluid is not None
+
+    @property
+    def is_series(self) -> bool:
+        """Whether the case is a test series (``[series]``: ``riprap series``)."""
+        return self.series is not None
 
     @property
     def is_placement(self) -> bool:

@@ -43,7 +43,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 from riprap.schema import default_of
-from riprap.waves.theory import ramp
+from riprap.waves.theory import envelope
 
 __all__ = ["BoundaryWaveMaker"]
 
@@ -71,6 +71,7 @@ class BoundaryWaveMaker:
     zones: tuple = ()
 
     def __init__(self, wave, still_water_level: float, *, ramp_time: float = 0.0,
+                 stop_time: float = 0.0,
                  active_absorption: bool = default_of("waves", "active_absorption"),
                  gravity: float = 9.81):
         if not math.isfinite(ramp_time) or ramp_time < 0:
@@ -78,6 +79,10 @@ class BoundaryWaveMaker:
         self.wave = wave
         self.still_water_level = float(still_water_level)
         self.ramp_time = float(ramp_time)
+        if not math.isfinite(stop_time) or stop_time < 0:
+            raise CaseFileError(f"waves: stop_time must be >= 0 s, got {stop_time!r}")
+        #: When the made wave has faded out (s; 0: never): a test step's sea ends.
+        self.stop_time = float(stop_time)
         self.active_absorption = bool(active_absorption)
         self.gravity = float(gravity)
         self.origin = None          # the boundary's x, set by ``attach``
@@ -134,7 +139,8 @@ class BoundaryWaveMaker:
 
     def target_elevation(self, x, t):
         """eta (m, above the still water level) of the generated wave at x, t."""
-        return ramp(t, self.ramp_time) * self.wave.elevation(np.asarray(x, dtype=float) - self.origin, t)
+        return (envelope(t, self.ramp_time, self.stop_time)
+                * self.wave.elevation(np.asarray(x, dtype=float) - self.origin, t))
 
     def measured_elevation(self, fluid) -> np.ndarray:
         """eta (m) in each column (j) of the first cells: their water over the depth."""
@@ -145,7 +151,7 @@ class BoundaryWaveMaker:
         fluid's present water fraction."""
         h = fluid.h
         level = self.still_water_level
-        factor = float(ramp(t, self.ramp_time))
+        factor = float(envelope(t, self.ramp_time, self.stop_time))
         eta_target = float(self.target_elevation(self.origin, t))
         profile = factor * self._theory_profile(t, h, eta_target)
         velocity = np.broadcast_to(profile, (fluid.fraction.shape[1], profile.size)).copy()

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from riprap.errors import CaseFileError
-from riprap.waves.theory import ramp
+from riprap.waves.theory import envelope
 
 __all__ = ["RelaxationZone", "WaveRelaxation", "relaxation_weight"]
 
@@ -90,6 +90,7 @@ class WaveRelaxation:
     """
 
     def __init__(self, wave, still_water_level: float, zones, *, ramp_time: float = 0.0,
+                 stop_time: float = 0.0,
                  origin: float | None = None):
         self.wave = wave
         self.still_water_level = float(still_water_level)
@@ -99,6 +100,10 @@ class WaveRelaxation:
         if not math.isfinite(ramp_time) or ramp_time < 0:
             raise CaseFileError(f"waves: ramp_time must be >= 0 s, got {ramp_time!r}")
         self.ramp_time = float(ramp_time)
+        if not math.isfinite(stop_time) or stop_time < 0:
+            raise CaseFileError(f"waves: stop_time must be >= 0 s, got {stop_time!r}")
+        #: When the made wave has faded out (s; 0: never): a test step's sea ends.
+        self.stop_time = float(stop_time)
         generation = [z for z in self.zones if z.kind == GENERATION]
         self.origin = float(origin if origin is not None else (generation[0].end if generation else 0.0))
         self._cache = None
@@ -128,7 +133,7 @@ class WaveRelaxation:
         """eta (m, above the still water level) the generation zone imposes at x, t."""
         if self.wave is None:
             return np.zeros_like(np.asarray(x, dtype=float))
-        return ramp(t, self.ramp_time) * self.wave.elevation(np.asarray(x) - self.origin, t)
+        return envelope(t, self.ramp_time, self.stop_time) * self.wave.elevation(np.asarray(x) - self.origin, t)
 
     def _targets(self, zone, x_cells, x_faces, z_cells, z_faces, h, t):
         """(cell fraction (nx_zone, nz), u (nx_faces, nz), w (nx_zone, nz + 1)) targets."""
@@ -144,7 +149,7 @@ class WaveRelaxation:
         face_fraction = np.clip((level + eta_faces[:, None] - bottoms[None, :]) / h, 0.0, 1.0)
         if zone.kind == ABSORPTION or self.wave is None:
             return fraction, np.zeros_like(face_fraction), np.zeros((x_cells.size, z_faces.size))
-        factor = ramp(t, self.ramp_time)
+        factor = envelope(t, self.ramp_time, self.stop_time)
         u, _ = self.wave.velocity_grid(x_faces - self.origin, z_cells - level, t)
         _, w = self.wave.velocity_grid(x_cells - self.origin, z_faces - level, t)
         # water fraction at the z faces: the mean of the cells above and below

@@ -21,7 +21,7 @@ from riprap.waves.analysis_window import few_waves_caution
 from riprap.waves.gauges import OVERTOPPING, RUN_UP, SURFACE
 from riprap.waves.theory import group_velocity
 
-__all__ = ["flume_report", "group_velocity", "arrival_time", "run_up_statistics",
+__all__ = ["flume_report", "group_velocity", "arrival_time", "closing_time", "run_up_statistics",
            "overtopping_statistics"]
 
 
@@ -31,6 +31,19 @@ def arrival_time(wave_source, x: float) -> float:
     wave = wave_source.wave
     speed = group_velocity(wave.period, wave.depth, wave.wave_length)
     return wave_source.ramp_time + max(x - wave_source.origin, 0.0) / speed + 2.0 * wave.period
+
+
+def closing_time(wave_source, x: float) -> float:
+    """When the last wave of a sea that stops (``stop_time`` > 0: a test step's) has passed ``x``
+    (s): the stop time plus the travel from the wave maker; infinite for a sea that runs to the
+    end. Each gauge's analysis window closes then, so that the calm water after the sea does not
+    count as a sea."""
+    stop = float(getattr(wave_source, "stop_time", 0.0) or 0.0)
+    if wave_source is None or wave_source.wave is None or stop <= 0:
+        return math.inf
+    wave = wave_source.wave
+    speed = group_velocity(wave.period, wave.depth, wave.wave_length)
+    return stop + max(x - wave_source.origin, 0.0) / speed
 
 
 def run_up_statistics(times, level) -> dict:
@@ -83,7 +96,7 @@ def flume_report(gauges, wave_source=None, water_density: float | None = None) -
     for gauge in surface:
         times, eta = gauges.series(gauge.columns[0])
         start = arrival_time(wave_source, gauge.position[0]) if wave is not None else times[0] if times.size else 0.0
-        chosen = times >= start
+        chosen = (times >= start) & (times <= closing_time(wave_source, gauge.position[0]))
         windows[gauge.name] = (times[chosen], eta[chosen])
         entry = {"x_m": gauge.position[0], "analysed_from_s": float(start),
                  "samples": int(chosen.sum())}
@@ -100,7 +113,9 @@ def flume_report(gauges, wave_source=None, water_density: float | None = None) -
             continue
         times, values = gauges.series(gauge.columns[-1])
         start = arrival_time(wave_source, gauge.position[0]) if wave is not None else (times[0] if times.size else 0.0)
-        chosen = times >= start
+        # the last waves' run-up and overtopping come a little after they pass the gauge's x
+        closes = closing_time(wave_source, gauge.position[0]) + (2.0 * wave.period if wave else 0.0)
+        chosen = (times >= start) & (times <= closes)
         entry = {"x_m": gauge.position[0], "analysed_from_s": float(start)}
         if gauge.kind == OVERTOPPING:
             entry.update(overtopping_statistics(times[chosen], values[chosen]))
@@ -127,7 +142,7 @@ def flume_report(gauges, wave_source=None, water_density: float | None = None) -
                 continue
             _, eta_1 = gauges.series(first.columns[0])
             times = gauges.times
-            chosen = times >= t1[0]
+            chosen = (times >= t1[0]) & (times <= t1[-1])
             spacing = second.position[0] - first.position[0]
             try:
                 if regular:     # at its own frequency: its bound harmonics are not free waves
@@ -178,7 +193,7 @@ def _three_gauge_entry(gauges, windows, triple, wave, regular):
     if t_last.size < 8 or t_last[-1] - t_last[0] < 4.0 * wave.period:
         return None
     times = gauges.times
-    chosen = times >= t_last[0]
+    chosen = (times >= t_last[0]) & (times <= t_last[-1])
     records = [gauges.series(g.columns[0])[1][chosen] for g in triple]
     positions = [g.position[0] for g in triple]
     try:

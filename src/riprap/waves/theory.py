@@ -23,7 +23,7 @@ from riprap.errors import CaseFileError
 from riprap.schema import default_of
 
 __all__ = ["wave_number", "wave_length", "group_velocity", "LinearWave", "StokesSecondOrderWave", "IrregularWave",
-           "jonswap_spectrum", "ramp"]
+           "jonswap_spectrum", "ramp", "envelope"]
 
 GRAVITY = 9.81
 
@@ -73,6 +73,18 @@ def ramp(time, ramp_time: float):
         return np.ones_like(np.asarray(time, dtype=float))
     s = np.clip(np.asarray(time, dtype=float) / ramp_time, 0.0, 1.0)
     return s - np.sin(2.0 * math.pi * s) / (2.0 * math.pi)
+
+
+def envelope(time, ramp_time: float, stop_time: float = 0.0):
+    """The wave maker's factor: ``ramp`` up from t = 0 and, with ``stop_time`` > 0, the same ramp
+    down to nothing at ``stop_time`` (a test step's sea ends; the flume calms); 0 after it."""
+    factor = ramp(time, ramp_time)
+    if stop_time > 0:
+        if ramp_time > 0:
+            factor = factor * ramp(stop_time - np.asarray(time, dtype=float), ramp_time)
+        else:
+            factor = factor * (np.asarray(time, dtype=float) < stop_time)
+    return factor
 
 
 @dataclass(frozen=True)
