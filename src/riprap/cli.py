@@ -3,8 +3,12 @@ contact, armour layers placed on a slope and analysed, air and water flow.
 
 Commands (each has --help):
   riprap demo                      rocks and tetrapods dropped into a box (a minute the first time)
+  riprap campaign CASE.toml... --seeds 0 1 2 --out DIR  members (series of other seeds or
+                                   designs) on Dask workers, their spread; resumes when run again
   riprap place CASE.toml --out DIR build an armour layer on a slope: pack, pictures, summary
   riprap run CASE.toml --out DIR   run a case: bodies, a placed pack (DIR/pack.toml) or a fluid case
+  riprap series CASE.toml --out DIR  a test series ([series]): rising sea states on one structure,
+                                   a survey after each, damage curves beside the formulas
   riprap analyse PACK_OR_RUN       contact forces, coordination numbers, stereonet, factors of
                                    safety, packing density and a report.html (also: analyze)
   riprap check CASE.toml           every check that run or place makes, without running
@@ -40,6 +44,12 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
     if case.is_placement:
         raise CaseFileError(f"{path} describes an armour placement: build the layer with "
                             f"'riprap place {path} --out DIR', then run DIR/pack.toml")
+    if case.is_series:
+        if restart is not None:
+            raise CaseFileError(f"{path} is a test series: it resumes by itself from its steps' "
+                                "checkpoints when run again into the same --out folder; drop "
+                                "--restart")
+        return _series_case(path, case, out, quiet)
     if case.is_fluid:
         sim = build_fluid_run(case, output_directory=out, progress=not quiet)
         grid = sim.fluid.grid
@@ -77,6 +87,36 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
         print(f"riprap: {key}: {value}")
     if "waves_report" in summary.outputs:
         _say_waves_report(Path(summary.outputs["waves_report"]))
+    return 0
+
+
+def _series_case(path: Path, case, out: str | None, quiet: bool) -> int:
+    from riprap.workflows.series import run_series  # lazy: only series cases need it
+
+    print(f"riprap: test series {path}: {len(case.series_steps)} steps, {case.body_count} bodies")
+    results = run_series(case, output_directory=out, progress=not quiet)
+    curve = results["curve"]
+    for k, step in enumerate(curve["step"]):
+        print(f"riprap: step {step}: Hm0 {curve['Hm0_m'][k]:.3g} m, N_s "
+              f"{curve['stability_number'][k]:.3g}, {curve['waves'][k]} waves, N_od "
+              f"{curve['N_od'][k]:.3g}, S {curve['S'][k]:.3g}, q {curve['q_m3_s_m'][k]:.3g} m3/s/m")
+    for key, value in results["outputs"].items():
+        print(f"riprap: {key}: {value}")
+    return 0
+
+
+def _campaign(args) -> int:
+    from riprap.workflows.campaign import members_of, run_campaign  # lazy: Dask is optional
+
+    members = members_of(args.cases, args.seeds)
+    result = run_campaign(members, args.out, workers=args.workers, threads=args.threads,
+                          scheduler=args.scheduler)
+    for case_name, columns in result["spread"].items():
+        for k, step in enumerate(columns["step"]):
+            print(f"riprap: {case_name} step {step}: N_od {columns['N_od_mean'][k]:.3g} "
+                  f"({columns['N_od_min'][k]:.3g}..{columns['N_od_max'][k]:.3g}) over "
+                  f"{columns['members'][k]} members, S {columns['S_mean'][k]:.3g}")
+    print(f"riprap: campaign results: {Path(args.out) / 'campaign_results.json'}")
     return 0
 
 
@@ -215,6 +255,25 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--restart", default=None,
                      help="continue from this checkpoint (.npz) with the case's settings")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
+    series = sub.add_parser("series", help="run a test series ([series]: rising sea states on one "
+                                           "structure, surveyed after each step)")
+    series.add_argument("case", type=Path, help="a case file with [series] and [[series_steps]]")
+    series.add_argument("--out", default=None, help="output folder (default: [output] directory)")
+    series.add_argument("--quiet", action="store_true", help="no progress bar")
+    campaign = sub.add_parser("campaign", help="test series of other seeds or designs as Dask "
+                                               "tasks (dask.distributed), with their spread")
+    campaign.add_argument("cases", type=Path, nargs="+", metavar="CASE",
+                          help="series case files (each with [series])")
+    campaign.add_argument("--seeds", type=int, nargs="+", default=[0],
+                          help="offsets added to every step's seed, one member each (default 0)")
+    campaign.add_argument("--out", required=True, help="the campaign's folder")
+    campaign.add_argument("--workers", type=int, default=2,
+                          help="worker processes of the local cluster (default 2)")
+    campaign.add_argument("--threads", type=int, default=1,
+                          help="numba threads of each member (default 1)")
+    campaign.add_argument("--scheduler", default=None,
+                          help="address of a running Dask scheduler (tcp://host:8786) instead of "
+                               "a local cluster")
     place = sub.add_parser("place", help="build an armour layer on a slope (POSITIT)")
     place.add_argument("case", type=Path, help="a placement case file (.toml)")
     place.add_argument("--out", default=None, help="output folder (default: [output] directory)")
@@ -248,6 +307,15 @@ def _dispatch(args) -> int:
             return _run_case(Path(path), args.out, None, args.quiet)
     if args.command == "run":
         return _run_case(args.case, args.out, args.restart, args.quiet)
+    if args.command == "series":
+        case = load_case(args.case)
+        if not case.is_series:
+            raise CaseFileError(f"{args.case} has no [series] table: add [series] and "
+                                "[[series_steps]], or run it with riprap run")
+        _say_if_smoke()
+        return _series_case(args.case, case, args.out, args.quiet)
+    if args.command == "campaign":
+        return _campaign(args)
     if args.command == "place":
         return _place_case(args.case, args.out, args.quiet)
     if args.command in ("analyse", "analyze"):

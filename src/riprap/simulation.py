@@ -229,6 +229,9 @@ class Simulation:
         self._scheduled_writers = []     # the run's writers with a schedule of their own
         self._checkpoints_written = 0    # periodic checkpoints (next at (count + 1) * interval)
         self._restarted = False
+        #: What the progress display calls the run (default the model's name): a test series
+        #: names its step there.
+        self.progress_label = None
         self._model = None
         if isinstance(scene, Model):
             self._model, scene = scene, None
@@ -299,6 +302,14 @@ class Simulation:
         (nothing overlaps; bodies inside the fluid box and wide enough for its cells)."""
         self.model.prepare(restarted=self._restarted)
 
+    def start_bodies_at_rest_from(self, checkpoint) -> None:
+        """Start this run's bodies where the run that wrote ``checkpoint`` (a ``.npz`` of the same
+        bodies) left them, at rest, with their contact history: the next step of a test series.
+        Its fluid starts as the case makes it (still water)."""
+        arrays, _ = load_checkpoint(checkpoint)
+        self.prepare()
+        self.model.start_bodies_at_rest_from(arrays)
+
     # ------------------------------------------------------------------ the rigid bodies now
     def build_without_checks(self) -> None:
         """Build the rigid bodies' arrays, choose the time step and evaluate the initial forces,
@@ -355,7 +366,8 @@ class Simulation:
         start_steps = model.step_count
         end_reason = "end_time"
         good = model.state_arrays()
-        with _Progress(self.progress, self.end_time, model.name) as progress:
+        with _Progress(self.progress, self.end_time,
+                       self.progress_label or model.name) as progress:
             stalled = 0
             while not model.reached(self.end_time):
                 until = min(time for time in self._scheduled_times(model, schedules)
@@ -681,6 +693,7 @@ class _Progress:
             from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
             self._progress = Progress(
+                TextColumn("{task.description}"),
                 TextColumn("[bold]t = {task.completed:.4f} / {task.total:.4f} s"), BarColumn(),
                 TextColumn("{task.fields[rate]} steps/s"), TextColumn("{task.fields[figures]}"),
                 TimeRemainingColumn(), transient=False)

@@ -21,6 +21,8 @@ random axes, S1 -> 1 when all axes are parallel).
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -113,8 +115,12 @@ def _fabric(axes) -> dict:
             "principal_trend_deg": float(trend[0]), "principal_plunge_deg": float(plunge[0])}
 
 
-def analyse_layer(state) -> LayerAnalysis:
-    """Analyse the armour units of ``state`` (a :class:`~riprap.analysis.layer_state.LayerState`)."""
+def analyse_layer(state, *, displaced_threshold_dn: float = None) -> LayerAnalysis:
+    """Analyse the armour units of ``state`` (a :class:`~riprap.analysis.layer_state.LayerState`);
+    a unit moved more than ``displaced_threshold_dn`` nominal diameters counts as displaced
+    (default ``DISPLACED_THRESHOLD_DN``)."""
+    if displaced_threshold_dn is None:
+        displaced_threshold_dn = DISPLACED_THRESHOLD_DN
     layer = state.layer
     slope = layer.slope
     bodies = np.asarray(layer.unit_bodies, dtype=np.int64)
@@ -224,7 +230,7 @@ def analyse_layer(state) -> LayerAnalysis:
         "units_below_factor_of_safety_1": [int(k) for k in np.flatnonzero(fos < 1.0)],
         "mean_distance_from_design_m": float(columns["distance_from_design_m"].mean()) if n_units else 0.0,
         "nose_axis_fabric": _fabric(nose_axes) if nose_axes is not None else {},
-        **_displacement_summary(state, columns),
+        **_displacement_summary(state, columns, displaced_threshold_dn),
     }
     if not state.contacts_recorded:
         columns.update({name: np.full(n_units, np.nan) for name in CONTACT_COLUMNS})
@@ -250,17 +256,21 @@ def _displacement_columns(state, bodies) -> dict:
                               slope=state.layer.slope)
 
 
-def _displacement_summary(state, columns) -> dict:
+def _displacement_summary(state, columns, threshold_dn: float) -> dict:
     """Layer figures of the displacements: the reference, largest and mean, units moved."""
     if state.reference_positions is None:
         return {"displacement_reference": state.reference_note or "none"}
     distance, over_dn = columns["displacement_m"], columns["displacement_over_dn"]
     turned = columns["rotation_deg"]
     moved = np.flatnonzero(over_dn > MOVED_THRESHOLD_DN)
-    displaced = displaced_units(over_dn, DISPLACED_THRESHOLD_DN)
+    displaced = displaced_units(over_dn, threshold_dn)
     layer = state.layer
+    edges = [0.0, MOVED_THRESHOLD_DN, 0.5, threshold_dn, math.inf]
+    classes = {f"{low:g}-{high:g} Dn": int(np.sum((over_dn >= low) & (over_dn < high)))
+               for low, high in zip(edges[:-1], edges[1:]) if high > low}
     return {"displacement_reference": state.reference_note,
-            "damage_threshold_over_dn": DISPLACED_THRESHOLD_DN,
+            "damage_threshold_over_dn": threshold_dn,
+            "displacement_classes": classes,
             "units_displaced": [int(k) for k in displaced],
             "damage_number_nod": damage_number_nod(len(displaced), layer.slope.width,
                                                    layer.nominal_diameter),

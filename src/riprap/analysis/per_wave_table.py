@@ -20,7 +20,7 @@ Columns (``PER_WAVE_COLUMNS``):
 - ``largest_fluid_force_N``, ``force_unit``: the largest fluid force on any unit in its window
   (the bodies' recorded peaks, ``body_forces.csv``) and which unit took it;
 - ``units_displaced``, ``N_od``: at the end of its window, the units whose centroid has moved
-  more than ``threshold_dn`` nominal diameters from the start, and N_od = that count per Dn of
+  more than ``threshold_dn`` nominal diameters from the start (of the run, or of the test series), and N_od = that count per Dn of
   section width (Van der Meer 1988) - the damage development N_od(N).
 """
 from __future__ import annotations
@@ -58,7 +58,9 @@ class FlumeLayout:
 @dataclass(frozen=True)
 class UnitTracks:
     """The units' recorded states (rows of ``body_forces.csv`` for the free units): per row the
-    unit, the time (s), the centroid (m, (n, 3)) and the peak fluid force since the last row (N)."""
+    unit, the time (s), the centroid (m, (n, 3)) and the peak fluid force since the last row (N).
+    ``reference``: where each unit started (m, indexed by unit: a test series' start), or None
+    for each unit's first row."""
 
     unit: np.ndarray
     time: np.ndarray
@@ -66,6 +68,7 @@ class UnitTracks:
     peak_force: np.ndarray
     nominal_diameter: float       # m
     section_width: float          # m, for N_od
+    reference: np.ndarray | None = None
 
 
 def _shifted(waves, layout, x):
@@ -131,7 +134,9 @@ def _unit_columns(table, waves, layout, tracks, threshold_dn):
     for unit in units:
         rows = np.flatnonzero(tracks.unit == unit)
         rows = rows[np.argsort(tracks.time[rows], kind="stable")]
-        moved = np.linalg.norm(tracks.position[rows] - tracks.position[rows[0]], axis=1)
+        start = (tracks.position[rows[0]] if tracks.reference is None
+                 else np.asarray(tracks.reference)[int(unit)])
+        moved = np.linalg.norm(tracks.position[rows] - start, axis=1)
         # the last record at or before each window's end (the last wave: the last record)
         last = np.searchsorted(tracks.time[rows], end, side="right") - 1
         known = last >= 0

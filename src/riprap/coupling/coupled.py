@@ -303,6 +303,13 @@ class CoupledSolver:
         if self.adaptive_substep and "coupling_substep" in arrays:
             self.solid_time_step = float(arrays["coupling_substep"][0])
 
+    def start_bodies_at_rest_from(self, arrays: dict) -> None:
+        """The bodies where another run's left them (``state_arrays`` of its solids), at rest, in
+        this run's fluid: their cells are clipped again at the first step."""
+        self.solids.start_at_rest_from(arrays)
+        self.fluid_loads[:] = 0.0
+        self._blocks = self._block_poses = self._faces = self._restart_block_poses = None
+
     def body_fraction(self) -> np.ndarray:
         """Solid fraction of every cell held by the bodies, at their present poses (nx, ny, nz)."""
         return self._solid_volumes().solid_fraction()

@@ -16,7 +16,7 @@ from riprap.errors import CaseFileError
 from riprap.io.case_text import read_text_file
 from riprap.io.appended_table import AppendedTable
 
-__all__ = ["BODY_FORCE_COLUMNS", "BodyForceTable", "read_peak_fluid_forces"]
+__all__ = ["BODY_FORCE_COLUMNS", "BodyForceTable", "read_peak_fluid_forces", "read_body_tracks"]
 
 BODY_FORCE_COLUMNS = ("body", "time_s", "x_m", "y_m", "z_m", "vx_m_per_s", "vy_m_per_s",
                       "vz_m_per_s", "pressure_force_x_N", "pressure_force_y_N",
@@ -84,3 +84,45 @@ def read_peak_fluid_forces(path, n_bodies: int, until: float = math.inf) -> dict
         if not force[body] >= peak:
             force[body], when[body] = peak, peak_time
     return {"force_N": force, "time_s": when}
+
+
+def read_body_tracks(path, bodies) -> dict | None:
+    """The rows of ``bodies`` (indices) in ``path`` (a ``body_forces.csv`` with the peak columns)
+    as arrays: ``body``, ``time_s``, ``position_m`` (n, 3), ``peak_fluid_force_N``; None when there
+    is no such file. Rows of other bodies are skipped; a row that cannot be read is a
+    CaseFileError naming the file and the line (a last row cut by a killed run is left out)."""
+    path = Path(path)
+    if not path.is_file():
+        return None
+    lines = read_text_file(path, what="body forces table", extension=".csv").splitlines()
+    header = tuple(lines[0].strip().split(",")) if lines else ()
+    if header != BODY_FORCE_COLUMNS:
+        raise CaseFileError(f"{path}: line 1 is not the header of a riprap body_forces.csv with "
+                            f"the peak fluid force (expected '{','.join(BODY_FORCE_COLUMNS[:3])}"
+                            f",...,{BODY_FORCE_COLUMNS[-1]}')")
+    wanted = {int(b) for b in bodies}
+    rows = []
+    for number, line in enumerate(lines[1:], start=2):
+        fields = line.split(",")
+        if not line.strip():
+            continue
+        if len(fields) != len(header):
+            if number == len(lines):
+                break
+            raise CaseFileError(f"{path}, line {number}: {len(fields)} values, the header has "
+                                f"{len(header)}; the file is corrupt")
+        try:
+            body = int(fields[0])
+            if body not in wanted:
+                continue
+            values = [float(fields[k]) for k in (1, 2, 3, 4, 17)]
+        except ValueError:
+            raise CaseFileError(f"{path}, line {number}: '{line[:60]}' is not a row of numbers; "
+                                "the file is corrupt") from None
+        if not all(math.isfinite(v) for v in values):
+            raise CaseFileError(f"{path}, line {number}: body {body} has a value that is not a "
+                                "finite number; the run blew up or the file is corrupt")
+        rows.append([body, *values])
+    table = np.array(rows, dtype=float).reshape(-1, 6)
+    return {"body": table[:, 0].astype(np.int64), "time_s": table[:, 1],
+            "position_m": table[:, 2:5], "peak_fluid_force_N": table[:, 5]}

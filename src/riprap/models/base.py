@@ -2,6 +2,8 @@
 bodies next)."""
 from __future__ import annotations
 
+from riprap.errors import RiprapError
+
 __all__ = ["Model"]
 
 
@@ -63,6 +65,11 @@ class Model:
 
     def load_state_arrays(self, arrays: dict) -> None:
         raise NotImplementedError
+
+    def start_bodies_at_rest_from(self, arrays: dict) -> None:
+        """Start from the bodies' end state of another run of the same bodies (``bodies_*``
+        arrays of its checkpoint), at rest: a step of a test series."""
+        raise RiprapError(f"a {self.name} run cannot start from another run's bodies")
 
     def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
         """(arrays, metadata) of a checkpoint of ``state``: the state and what a restart checks."""

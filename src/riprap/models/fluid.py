@@ -249,6 +249,13 @@ class CoupledModel(FluidModel):
     def _bodies(self) -> int:
         return self.solids.n_bodies
 
+    def start_bodies_at_rest_from(self, arrays: dict) -> None:
+        self.solver.start_bodies_at_rest_from(
+            {name[len("bodies_"):]: value for name, value in arrays.items()
+             if name.startswith("bodies_")})
+        self._peak_force[:] = 0.0
+        self._peak_time[:] = np.nan
+
     def advance(self, until: float) -> None:
         super().advance(until)
         self.substeps += self._report.solid_substeps

@@ -161,6 +161,27 @@ class SolidSolver:
         self._ready = True
         self.load_state_arrays(arrays)
 
+    def start_at_rest_from(self, arrays: dict) -> None:
+        """Take the poses and contact history of another run's end state (its
+        :meth:`state_arrays`) with every body at rest, and evaluate the forces there (at rest the
+        tangential springs do not grow: the history is kept as it was); this run's clock and time
+        step stay. A step of a test series starts so, where the step before ended, as a flume
+        test goes on once the water is still."""
+        self.finalize()
+        for name in ("positions", "quaternions"):
+            value = np.asarray(arrays[name], dtype=np.float64)
+            if value.shape != getattr(self, name).shape:
+                raise CaseFileError(f"the bodies' end state has '{name}' of shape {value.shape}, "
+                                    f"this run {getattr(self, name).shape}: not the same bodies")
+            setattr(self, name, np.ascontiguousarray(value.copy()))
+        self.history_keys = np.ascontiguousarray(np.asarray(arrays["history_keys"]).copy())
+        self.history_springs = np.ascontiguousarray(np.asarray(arrays["history_springs"]).copy())
+        self.velocities[:] = 0.0
+        self.angular_momenta[:] = 0.0
+        self.external_loads[:] = 0.0
+        self._piece_cache = interactions.empty_piece_cache()
+        self._compute_forces(self.time_step)
+
     def clear_contact_records(self) -> None:
         """Make the contact records again from the last force evaluation when next asked (after
         the state arrays were replaced)."""

@@ -27,15 +27,20 @@ from riprap.workflows.layer_input import load_layer_state, load_run_case
 __all__ = ["analyse", "compare_layers"]
 
 
-def analyse(path, *, out=None, frame: int = -1) -> LayerAnalysis:
+def analyse(path, *, out=None, frame: int = -1, reference_run=None,
+            displaced_threshold_dn: float | None = None) -> LayerAnalysis:
     """Analyse the pack folder (or ``pack.toml``) or run folder ``path``; with ``out``, write
     ``units.csv``, ``report.html``, ``stereonet.png`` and the rest there
-    (:mod:`riprap.io.analysis_report`). ``frame``: which frame of a run (-1 the last)."""
+    (:mod:`riprap.io.analysis_report`). ``frame``: which frame of a run (-1 the last);
+    ``reference_run``: the run folder whose frame 0 the displacements count from (a test series'
+    first step; default the run's own frame 0); ``displaced_threshold_dn``: a unit moved more than
+    this many Dn is displaced (default 1)."""
     # A broken waves report is refused before any work (and before the output folder is made).
     waves = load_waves_report(path)
     if out is not None:
         prepare_output_folder(out)
-    analysis = analyse_layer(load_layer_state(path, frame=frame))
+    analysis = analyse_layer(load_layer_state(path, frame=frame, reference_run=reference_run),
+                             displaced_threshold_dn=displaced_threshold_dn)
     analysis = _add_flume_test(path, waves, analysis)
     if out is not None:
         analysis.layer["outputs"] = write_analysis(out, analysis)

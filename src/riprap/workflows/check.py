@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 from riprap.case.build import build_simulation
 from riprap.case.build_fluid import build_fluid_run
+from riprap.workflows.series import check_series
 from riprap.case.load import Case
 from riprap.errors import CaseFileError
 from riprap.io.output_folder import check_output_folder
@@ -52,6 +53,15 @@ def check_case(case: Case, *, output_directory=None, restart=None) -> CheckRepor
         else:
             report.checked.append("design grid: units per row across the section, rows on the "
                                   "face, units inside the side walls")
+    elif case.is_series:
+        if restart is not None:
+            raise CaseFileError(f"{case.source}: a test series resumes from its steps' checkpoints "
+                                "when run again into the same folder; drop --restart")
+        report = CheckReport(f"a test series of {len(case.series_steps)} steps on "
+                             f"{case.body_count} bodies",
+                             checked=["tables and keys", *check_series(case, out)],
+                             not_checked=["whether the flow stays stable (the time step adapts "
+                                          "to it)"])
     elif case.is_fluid:
         run = sim = build_fluid_run(case, output_directory=out, progress=False)
         cells = "x".join(map(str, case.fluid.cells))

@@ -31,14 +31,16 @@ from riprap.io.layer_file import CONTACTS_FILE_NAME, read_contact_table, read_la
 __all__ = ["load_layer_state", "load_pack_state", "load_run_state", "load_run_case"]
 
 
-def load_layer_state(path, *, frame: int = -1):
+def load_layer_state(path, *, frame: int = -1, reference_run=None):
     """A :class:`~riprap.analysis.layer_state.LayerState` from a pack folder or file, or from
-    frame ``frame`` (index into the run's frames, -1 the last) of a run folder."""
+    frame ``frame`` (index into the run's frames, -1 the last) of a run folder; ``reference_run``
+    (a run folder of the same bodies, e.g. a test series' first step): the displacements and the
+    eroded area count from its frame 0 instead of the run's own."""
     path = Path(path)
     if not path.exists():
         raise CaseFileError(f"{path}: no such pack or run folder")
     if is_run_folder(path):
-        return load_run_state(path, frame=frame)
+        return load_run_state(path, frame=frame, reference_run=reference_run)
     return load_pack_state(path)
 
 
@@ -144,7 +146,7 @@ def _fit_pose(local, world, centroid):
     return rotation, world_mean - rotation @ (local_mean - centroid)
 
 
-def load_run_state(run_folder, *, frame: int = -1):
+def load_run_state(run_folder, *, frame: int = -1, reference_run=None):
     """The state at frame ``frame`` (index into ``bodies.pvd``'s list, -1 the last) of a run
     started from a pack (or from a case that includes one), with frame 0's poses as the reference
     of the displacements."""
@@ -168,12 +170,20 @@ def load_run_state(run_folder, *, frame: int = -1):
     positions, rotations = _frame_poses(run_folder, frames, frame, pack, pack_file)
     reference = _reference_poses(run_folder, frames, frame, pack, pack_file,
                                  now=(positions, rotations))
+    own_reference = reference
+    if reference_run is not None:
+        # the rocking events stay counted from the run's own frame 0 (a unit tilted for good in
+        # an earlier step does not rock in this one); the displacements count from the other's
+        reference_run = Path(reference_run)
+        reference = _reference_poses(reference_run, read_pvd_frames(reference_run / "bodies.pvd"),
+                                     -1, pack, pack_file, now=None)
     if coupled:
         contacts = no_contact_records()
     else:
         contacts = read_contacts_vtu(run_folder / contact_frames[time],
                                       f"the contacts frame at t = {time:g} s (contacts.pvd)")
-    history = _rotation_history(run_folder, frames, frame, pack, pack_file, reference, rotations)
+    history = _rotation_history(run_folder, frames, frame, pack, pack_file, own_reference,
+                                rotations)
     return _layer_state(pack, positions=positions, rotations=rotations, contacts=contacts,
                         time=time, source=f"{run_folder} frame {frame} (t = {time:g} s)",
                         contacts_recorded=not coupled, rotation_history=history, **reference)
@@ -206,7 +216,7 @@ def _reference_poses(run_folder: Path, frames, frame: int, pack: dict, pack_file
     when that is frame 0), or none, with the reason, when frame 0 cannot be read."""
     time = frames[0][0]
     note = f"frame 0 of {run_folder / 'bodies.pvd'} (t = {time:g} s)"
-    if frame % len(frames) == 0:
+    if now is not None and frame % len(frames) == 0:
         positions, rotations = now
     else:
         try:

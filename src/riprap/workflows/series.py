@@ -1,0 +1,326 @@
+"""``riprap series`` (and ``riprap run`` on a case with ``[series]``): a test series, the unit of
+work of a hydraulic stability study (``docs/campaign.md``).
+
+The steps run one after the other, each in its own folder (``step_01``, ``step_02``, ...), each an
+ordinary run folder with its own case file (``step.toml``, written by
+``riprap.case.series_steps``): step k starts from the bodies where step k-1 left them (at rest,
+contact history kept: ``Simulation.start_bodies_at_rest_from``) and from still water. After each
+step its *survey*: the layer analysis of its last frame with displacements and the eroded area
+counted from the series' start (``survey/``: units.csv, layer_summary.json, profiles and face
+pictures, report.html) and its *per-wave table* (``per_wave.csv``). At the end the damage curves
+(``damage_curve.csv``, ``damage_curve.png``, ``series_results.json``, ``report.html``) beside the
+design formulas.
+
+Resuming: the series folder records the riprap version and a fingerprint of the case
+(``series.json``); a folder of another version or case is refused before anything runs. A step
+with its ``summary.json`` is done and is not run again; a step with a checkpoint is continued
+from it; the others start from the step before. Every step is checked (the flume can carry its
+sea) before the first one runs.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time as wallclock
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import riprap
+from riprap.analysis.per_wave_table import FlumeLayout, UnitTracks, per_wave_table
+from riprap.analysis.series_damage import series_curve
+from riprap.case.build_fluid import build_fluid_run, build_fluid_solver
+from riprap.case.load import parse_case
+from riprap.case.series_steps import step_case_text, step_seas
+from riprap.errors import CaseFileError, RiprapError
+from riprap.io.body_forces import read_body_tracks
+from riprap.io.gauge_files import read_gauges_csv
+from riprap.io.json_files import read_json_object, write_json
+from riprap.io.output_folder import prepare_output_folder
+from riprap.io.series_report import read_columns_csv, write_columns_csv, write_series_report
+from riprap.workflows.analyse import analyse
+
+__all__ = ["run_series", "series_fingerprint", "SERIES_RECORD", "step_folder"]
+
+#: The series folder's record: riprap version, case fingerprint, steps.
+SERIES_RECORD = "series.json"
+#: Its format (a folder of another format is refused).
+SERIES_FORMAT = 1
+#: Overtopping events smaller than this (m^3 per m of crest) are not counted (traces of water
+#: that the VOF field carries over the crest; EurOtop counts waves that overtop, not spray).
+EVENT_THRESHOLD = 1.0e-6
+
+
+def step_folder(out: Path, number: int) -> Path:
+    """The folder of step ``number`` (from 1)."""
+    return Path(out) / f"step_{number:02d}"
+
+
+@dataclass(frozen=True)
+class _Step:
+    sea: object
+    text: str
+    case: object
+    folder: Path
+
+
+def series_fingerprint(case) -> str:
+    """A fingerprint of what defines the series: the case file's content (as TOML data, not its
+    comments or layout) and the pack it includes, so that a folder written for another case is
+    recognised."""
+    import tomllib
+
+    digest = hashlib.sha256()
+    data = tomllib.loads(Path(case.source).read_text(encoding="utf-8"))
+    data.get("output", {}).pop("directory", None)
+    digest.update(json.dumps(data, sort_keys=True, default=str).encode())
+    pack = data.get("pack")
+    if isinstance(pack, str):
+        pack_path = (Path(case.base_dir) / pack).resolve()
+        if pack_path.is_file():
+            digest.update(pack_path.read_bytes())
+    return digest.hexdigest()
+
+
+def _steps(case, out: Path, seed_offset: int = 0) -> list[_Step]:
+    """Every step's sea, case text and case, each checked as ``riprap run`` checks a flume (the
+    flume can carry the sea) before anything runs."""
+    steps = []
+    for sea in step_seas(case, seed_offset):
+        folder = step_folder(out, sea.number)
+        text = step_case_text(case, sea)
+        where = (f"{case.source} [[series_steps]] step {sea.number} (Hm0 = "
+                 f"{sea.significant_height:g} m, Tp = {sea.peak_period:.3g} s)")
+        try:
+            step_case = parse_case(text, source=str(folder / "step.toml"), base_dir=folder)
+            build_fluid_solver(step_case)
+        except CaseFileError as error:
+            message = str(error).replace(str(folder / "step.toml"), "its sea")
+            raise CaseFileError(f"{where}: {message}") from None
+        steps.append(_Step(sea, text, step_case, folder))
+    return steps
+
+
+def _claim_folder(out: Path, record: dict, *, write: bool = True) -> None:
+    """Refuse a folder written by another riprap version or for another case (nothing in it is
+    touched); otherwise record the series there (``write``)."""
+    path = out / SERIES_RECORD
+    if path.is_file():
+        old = read_json_object(path, "series record", "it was written by riprap series")
+        if old.get("format") != SERIES_FORMAT or old.get("riprap_version") != riprap.__version__:
+            raise RiprapError(
+                f"{path}: this folder holds a series written by riprap "
+                f"{old.get('riprap_version')!r} (format {old.get('format')!r}), this is "
+                f"{riprap.__version__} (format {SERIES_FORMAT}); its steps are not resumed or "
+                "overwritten: give another --out folder")
+        if (old.get("fingerprint"), old.get("seed_offset", 0)) != (record["fingerprint"],
+                                                                   record["seed_offset"]):
+            raise RiprapError(
+                f"{path}: this folder holds the series of another case ({old.get('case_file')}, "
+                "or the same file since changed, another pack or other seeds); its steps are not "
+                "resumed or "
+                "overwritten: give another --out folder, or restore that case")
+    elif out.is_dir() and any(step_folder(out, 1).parent.glob("step_*")):
+        raise RiprapError(f"{out}: holds step folders but no {SERIES_RECORD}: not a series riprap "
+                          "wrote; give another --out folder")
+    if write:
+        write_json(path, record)
+
+
+def _record(case, steps: list[_Step], seed_offset: int = 0) -> dict:
+    return {"format": SERIES_FORMAT, "riprap_version": riprap.__version__,
+            "case_file": str(Path(case.source).resolve()),
+            "fingerprint": series_fingerprint(case), "seed_offset": int(seed_offset),
+            "steps": [{"step": s.sea.number, "Hm0_m": s.sea.significant_height,
+                       "Tp_s": s.sea.peak_period, "peak_enhancement": s.sea.peak_enhancement,
+                       "seed": s.sea.seed, "waves": s.sea.waves, "sea_duration_s": s.sea.duration,
+                       "end_time_s": s.sea.end_time} for s in steps]}
+
+
+def check_series(case, output_directory=None, seed_offset: int = 0) -> list[str]:
+    """Every check ``run_series`` makes before it runs (each step's flume, the bodies of the
+    first step, the output folder's series record); returns what was checked, in words."""
+    out = Path(output_directory or case.output.directory)
+    steps = _steps(case, out, seed_offset)
+    build_fluid_run(steps[0].case, output_directory=steps[0].folder, progress=False)
+    if out.is_dir():
+        _claim_folder(out, _record(case, steps, seed_offset), write=False)
+    return [f"{len(steps)} steps: each step's sea in the flume (as [waves]), Hm0 "
+            + ", ".join(f"{s.sea.significant_height:g}" for s in steps) + " m",
+            f"bodies of the first step ({case.body_count})",
+            f"the series folder {out} (a series of this case and riprap version, or none)"]
+
+
+def run_series(case, *, output_directory=None, progress: bool = True, say=print,
+               seed_offset: int = 0) -> dict:
+    """Run the test series of ``case`` (a case with ``[series]``) into ``output_directory``
+    (default ``[output] directory``), every step's seed raised by ``seed_offset`` (a campaign's
+    member); returns the series results (``series_results.json``)."""
+    if not case.is_series:
+        raise CaseFileError(f"{case.source}: has no [series] table: run it with riprap run")
+    out = Path(output_directory or case.output.directory)
+    steps = _steps(case, out, seed_offset)
+    record = _record(case, steps, seed_offset)
+    prepare_output_folder(out)
+    _claim_folder(out, record)
+    total = sum(s.sea.end_time for s in steps)
+    simulated, wall = 0.0, 0.0
+    for index, step in enumerate(steps):
+        sea = step.sea
+        done = (step.folder / "summary.json").is_file()
+        if done:
+            say(f"riprap: series step {sea.number}/{len(steps)}: done before, not run again "
+                f"({step.folder})")
+        else:
+            to_go = ("" if simulated == 0 else
+                     f"; about {(total - simulated) * wall / simulated / 3600:.2g} h of the series "
+                     "to go at the pace so far")
+            say(f"riprap: series step {sea.number}/{len(steps)}: Hm0 = {sea.significant_height:g} "
+                f"m, Tp = {sea.peak_period:.3g} s, {sea.duration:.4g} s of sea"
+                + (f" (~{sea.waves} waves)" if sea.waves else "")
+                + f", {sea.end_time:.4g} s simulated{to_go}")
+            started = wallclock.perf_counter()
+            _run_step(step, steps[index - 1] if index else None, len(steps), progress)
+            wall += wallclock.perf_counter() - started
+        simulated += sea.end_time
+        _survey(step, steps[0].folder, case, say)
+    results = _series_results(out, steps, case)
+    write_json(out / "series_results.json", results)
+    write_columns_csv(out / "damage_curve.csv", results["curve"])
+    results["outputs"] = write_series_report(out, results)
+    write_json(out / "series_results.json", results)
+    return results
+
+
+def _run_step(step: _Step, before: _Step | None, count: int, progress: bool) -> None:
+    folder = step.folder
+    prepare_output_folder(folder)
+    (folder / "step.toml").write_text(step.text, encoding="utf-8")
+    sim = build_fluid_run(step.case, output_directory=folder, progress=progress)
+    sim.case_file = str((folder / "step.toml").resolve())
+    sim.progress_label = f"step {step.sea.number}/{count}"
+    checkpoint = folder / "checkpoint.npz"
+    if checkpoint.is_file():
+        sim.run(restart_from=checkpoint)
+        return
+    if before is not None:
+        sim.start_bodies_at_rest_from(before.folder / "checkpoint.npz")
+    sim.run()
+
+
+def _survey(step: _Step, first: Path, case, say) -> None:
+    """The survey after a step (``survey/``, from the series' start) and its per-wave table
+    (``per_wave.csv``), unless both were written before."""
+    folder = step.folder
+    survey = folder / "survey"
+    if (survey / "layer_summary.json").is_file() and (folder / "per_wave.csv").is_file():
+        return
+    threshold = case.series.displacement_threshold
+    analysis = analyse(folder, out=survey, reference_run=first, displaced_threshold_dn=threshold)
+    layer = analysis.layer
+    say(f"riprap: series step {step.sea.number} survey: {len(layer.get('units_displaced', []))} "
+        f"unit(s) displaced more than {threshold:g} Dn since the start, N_od = "
+        f"{layer.get('damage_number_nod', math.nan):.3g}, S = "
+        f"{layer.get('damage_level_s', math.nan):.3g}")
+    description = analysis.state.layer
+    table = step_per_wave_table(folder, step.case, first,
+                                units=np.asarray(description.unit_bodies, dtype=np.int64),
+                                nominal_diameter=float(description.nominal_diameter),
+                                section_width=float(description.slope.width),
+                                threshold_dn=threshold)
+    if table is not None:
+        write_columns_csv(folder / "per_wave.csv", table)
+
+
+def step_per_wave_table(folder: Path, step_case, first: Path, *, units, nominal_diameter: float,
+                        section_width: float, threshold_dn: float) -> dict | None:
+    """The per-wave table of one step's run folder (None where it has fewer than two surface
+    gauges): waves counted at the toe (the run-up gauge's start, else the last surface gauge),
+    the units' (body indices ``units``) displacements counted from the series' start (the first
+    rows of ``first``'s ``body_forces.csv``)."""
+    gauges = read_gauges_csv(folder / "gauges.csv")
+    if gauges is None:
+        return None
+    times, columns = gauges
+    surface = sorted((g for g in step_case.gauges if g.type == "surface"),
+                     key=lambda g: g.parameters["position"][0])
+    if len(surface) < 2:
+        return None
+    run_up = next((g for g in step_case.gauges if g.type == "run_up"), None)
+    over = next((g for g in step_case.gauges if g.type == "overtopping"), None)
+    waves = step_case.waves
+    depth = waves.still_water_level - step_case.fluid.lower[2]
+    toe = run_up.parameters["position"][0] if run_up else surface[-1].parameters["position"][0]
+    tracks = None
+    rows = read_body_tracks(folder / "body_forces.csv", units) if len(units) else None
+    start = read_body_tracks(first / "body_forces.csv", units) if len(units) else None
+    if rows is not None and start is not None and len(rows["body"]) and len(start["body"]):
+        reference = np.full((int(np.max(units)) + 1, 3), np.nan)
+        first_rows = start["time_s"] == start["time_s"].min()
+        reference[start["body"][first_rows]] = start["position_m"][first_rows]
+        tracks = UnitTracks(unit=rows["body"], time=rows["time_s"], position=rows["position_m"],
+                            peak_force=rows["peak_fluid_force_N"],
+                            nominal_diameter=nominal_diameter, section_width=section_width,
+                            reference=reference)
+    armour_x = float(np.mean(tracks.position[:, 0])) if tracks is not None else None
+    layout = FlumeLayout(
+        gauge_positions=tuple(g.parameters["position"][0] for g in surface), toe_x=toe,
+        depth=depth, peak_period=waves.parameters["peak_period"],
+        run_up_x=toe if run_up else None,
+        overtopping_x=over.parameters["position"][0] if over else None, armour_x=armour_x)
+    return per_wave_table(
+        times, [columns[f"{g.name}_eta_m"] for g in surface], layout,
+        run_up=columns.get(f"{run_up.name}_level_m") if run_up else None,
+        overtopping_volume=columns.get(f"{over.name}_volume_m3_m") if over else None,
+        tracks=tracks, threshold_dn=threshold_dn, event_threshold=EVENT_THRESHOLD)
+
+
+def _series_results(out: Path, steps: list[_Step], case) -> dict:
+    """The damage curve from every step's survey and per-wave table, beside the formulas."""
+    rows, flume, per_wave, counted_so_far = [], {}, {}, 0
+    for step in steps:
+        folder = step.folder
+        layer = read_json_object(folder / "survey" / "layer_summary.json", "layer summary",
+                                 "riprap series wrote it after the step")
+        flume = layer.get("flume_test") or {}
+        waves = {"overtopping_m3_per_m": [], "wave": []}
+        if (folder / "per_wave.csv").is_file():
+            waves = read_columns_csv(folder / "per_wave.csv")
+        counted = len(waves["wave"])
+        if counted:
+            per_wave[step.sea.number] = {
+                "cumulative_wave": [counted_so_far + int(w) for w in waves["wave"]],
+                "N_od": [float(v) for v in waves["N_od"]]}
+        counted_so_far += counted
+        volume = float(np.nansum(waves["overtopping_m3_per_m"])) if counted else math.nan
+        rows.append({"step": step.sea.number,
+                     "Hm0_m": _number(flume.get("Hm0_m")),
+                     "Tm_s": _number(flume.get("Tz_s")),
+                     "waves": counted,
+                     "units_displaced": len(layer.get("units_displaced", [])),
+                     "N_od": _number(layer.get("damage_number_nod")),
+                     "S": _number(layer.get("damage_level_s")),
+                     "rocking_events": _number(layer.get("rocking_events")),
+                     "q_m3_s_m": volume / step.sea.duration})
+    over = next((g for g in case.gauges if g.type == "overtopping"), None)
+    freeboard = (over.parameters["position"][2] - case.waves.still_water_level
+                 if over is not None else None)
+    results = series_curve(rows, unit_kind=str(flume.get("unit", "")),
+                           nominal_diameter=float(flume.get("nominal_diameter_m", math.nan)),
+                           delta=float(flume.get("relative_density", math.nan)),
+                           slope_cot=float(flume.get("slope_cot", math.nan)), freeboard=freeboard)
+    results["per_wave"] = per_wave
+    results["case_file"] = str(Path(case.source).resolve())
+    results["displacement_threshold_over_dn"] = case.series.displacement_threshold
+    results["steps"] = [{"step": s.sea.number, "folder": str(s.folder),
+                         "target_Hm0_m": s.sea.significant_height, "Tp_s": s.sea.peak_period,
+                         "target_waves": s.sea.waves, "sea_duration_s": s.sea.duration}
+                        for s in steps]
+    return results
+
+
+def _number(value) -> float:
+    return (float(value) if isinstance(value, (int, float)) and not isinstance(value, bool)
+            else math.nan)
