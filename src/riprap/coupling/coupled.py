@@ -204,6 +204,8 @@ class CoupledSolver:
                                 if self.adaptive_substep else math.inf)
         #: The contacts' measured stability ratio at the last step's sub-step (0: no contact).
         self.last_stability_ratio = 0.0
+        # the contacts' stability rate a restart takes from its checkpoint (used once)
+        self._restored_contact_rate = None
         n = solids.n_bodies
         #: Force (3) and torque (3) of the fluid on every body over the last step (N, N m).
         self.fluid_loads = np.zeros((n, 6))
@@ -286,6 +288,10 @@ class CoupledSolver:
         if self._block_poses is not None:
             arrays["coupling_block_poses"] = self._block_poses.copy()
         arrays["coupling_substep"] = np.array([self.solid_time_step])
+        if self.adaptive_substep:
+            # the next sub-step follows the contacts of the last force evaluation, which a
+            # checkpoint does not hold (the solids make them again only at their next step)
+            arrays["coupling_contact_rate"] = np.array([contact_stability_rate(self.solids)])
         return arrays
 
     def load_state_arrays(self, arrays: dict) -> None:
@@ -302,6 +308,8 @@ class CoupledSolver:
                          if "coupling_carried_axis" in arrays else None)
         if self.adaptive_substep and "coupling_substep" in arrays:
             self.solid_time_step = float(arrays["coupling_substep"][0])
+        self._restored_contact_rate = (float(arrays["coupling_contact_rate"][0])
+                                       if "coupling_contact_rate" in arrays else None)
 
     def start_bodies_at_rest_from(self, arrays: dict) -> None:
         """The bodies where another run's left them (``state_arrays`` of its solids), at rest, in
@@ -309,6 +317,7 @@ class CoupledSolver:
         self.solids.start_at_rest_from(arrays)
         self.fluid_loads[:] = 0.0
         self._blocks = self._block_poses = self._faces = self._restart_block_poses = None
+        self._restored_contact_rate = None
 
     def body_fraction(self) -> np.ndarray:
         """Solid fraction of every cell held by the bodies, at their present poses (nx, ny, nz)."""
@@ -828,7 +837,10 @@ class CoupledSolver:
         """The next sub-step of an adaptive run (``SUBSTEP_TARGET_RATIO``), from the contacts and
         speeds the last sub-step left."""
         solids = self.solids
-        rate = contact_stability_rate(solids)
+        rate = self._restored_contact_rate
+        if rate is None:
+            rate = contact_stability_rate(solids)
+        self._restored_contact_rate = None
         target = SUBSTEP_TARGET_RATIO / rate if rate > 0.0 else math.inf
         self.solid_time_step = min(self.solid_time_step * SUBSTEP_GROWTH, target,
                                    motion_limited_step(solids), self.substep_ceiling)
