@@ -274,7 +274,7 @@ def _step_error(tmp_path, steps, series="settle_time = 1.0"):
      r"series_steps\[0\]\.waves = 5: give either waves"),
     (STEPS.replace("peak_period = 1.2\n", "peak_period = 1.2\nwave_steepness = 0.03\n", 1),
      r"series_steps\[0\]\.peak_period = 1.2: give either peak_period or wave_steepness"),
-    ("", r"\[series\]: a test series needs its sea states"),
+    ("", r"series: a test series needs its sea states"),
 ])
 def test_bad_steps_are_refused_at_their_key(tmp_path, steps, message):
     with pytest.raises(CaseFileError, match=message):
@@ -321,3 +321,24 @@ def test_an_unanswering_scheduler_is_refused_within_seconds(unbroken):
         run_campaign(members_of([case], [0]), root / "nowhere", scheduler="tcp://127.0.0.1:9")
     assert time.monotonic() - started < 30
     assert not (root / "nowhere").exists()
+
+
+def test_a_campaign_folder_of_other_members_or_version_is_refused_before_any_worker(unbroken):
+    from riprap.workflows.campaign import CAMPAIGN_RECORD, members_of, run_campaign
+
+    root, case, _, _ = unbroken
+    folder = root / "other_campaign"
+    folder.mkdir()
+    record = {"format": 1, "riprap_version": "0.0.1", "members": []}
+    (folder / CAMPAIGN_RECORD).write_text(json.dumps(record))
+    with pytest.raises(RiprapError, match="written by riprap '0.0.1'"):
+        run_campaign(members_of([case], [0]), folder, client=object())
+    import riprap
+
+    record["riprap_version"] = riprap.__version__
+    (folder / CAMPAIGN_RECORD).write_text(json.dumps(record))
+    with pytest.raises(RiprapError, match="a campaign of other members"):
+        run_campaign(members_of([case], [0]), folder, client=object())
+    assert json.loads((folder / CAMPAIGN_RECORD).read_text()) == record
+    with pytest.raises(CaseFileError, match="given more than once"):
+        members_of([case, case], [0])

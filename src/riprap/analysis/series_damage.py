@@ -56,7 +56,7 @@ def cumulative_damage(formula, sea_states) -> list[float]:
             if formula(hs, tm, 1e9) <= damage:
                 out.append(damage)           # this sea cannot add to what was done
                 continue
-            equivalent = brentq(lambda n: formula(hs, tm, n) - damage, 0.0, 1e9, xtol=1e-9,
+            equivalent = brentq(lambda n: formula(hs, tm, n) - damage, 1e-9, 1e9, xtol=1e-9,
                                 rtol=1e-12)
         damage = max(damage, formula(hs, tm, equivalent + waves))
         out.append(damage)

@@ -102,7 +102,10 @@ def _client(scheduler: str | None, workers: int, threads: int):
     return Client(cluster), cluster
 
 
-def _claim(out: Path, members: list[Member], fingerprints: list[str]) -> None:
+def _claim(out: Path, members: list[Member], fingerprints: list[str], *,
+           write: bool = True) -> None:
+    """Refuse a campaign folder of another riprap version or other members (nothing in it is
+    touched); otherwise record the campaign there (``write``)."""
     record = {"format": CAMPAIGN_FORMAT, "riprap_version": riprap.__version__,
               "members": [{"name": m.name, "case_file": str(m.case_file),
                            "seed_offset": m.seed_offset, "fingerprint": f}
@@ -119,7 +122,8 @@ def _claim(out: Path, members: list[Member], fingerprints: list[str]) -> None:
             raise RiprapError(f"{path}: a campaign of other members or cases ({before}); "
                               "nothing in it is resumed or overwritten: give another --out "
                               "folder, or the same cases and seeds as before")
-    write_json(path, record)
+    if write:
+        write_json(path, record)
 
 
 def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int = 1,
@@ -138,6 +142,7 @@ def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int =
                                 "case needs [series] and [[series_steps]]")
         check_series(case, out / member.name, member.seed_offset)
     fingerprints = [series_fingerprint(cases[m.case_file]) for m in members]
+    _claim(out, members, fingerprints, write=False)      # before any worker starts
     own_cluster = None
     if client is None:
         client, own_cluster = _client(scheduler, workers, threads)

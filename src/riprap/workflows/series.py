@@ -200,7 +200,9 @@ def _run_step(step: _Step, before: _Step | None, count: int, progress: bool) -> 
     (folder / "step.toml").write_text(step.text, encoding="utf-8")
     sim = build_fluid_run(step.case, output_directory=folder, progress=progress)
     sim.case_file = str((folder / "step.toml").resolve())
-    sim.progress_label = f"step {step.sea.number}/{count}"
+    sea = step.sea
+    sim.progress_label = (f"step {sea.number}/{count}, Hm0 {sea.significant_height:g} m"
+                          + (f", {sea.waves} waves" if sea.waves else ""))
     checkpoint = folder / "checkpoint.npz"
     if checkpoint.is_file():
         sim.run(restart_from=checkpoint)

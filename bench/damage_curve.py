@@ -1,0 +1,222 @@
+"""Issue 38's damage curve: a test series on a narrow section of a single layer of concrete cubes
+on a porous core at laboratory scale, untuned, from below the start of damage to beyond it.
+
+The section (Froude-scaled laboratory flume, fresh water): cubes of Dn = 4.5 cm (2300 kg/m^3,
+Delta = 1.3) placed by ``riprap place`` on a 1:1.5 slope (Van der Meer's 1988 cube tests' slope)
+over one layer of fixed underlayer rocks (Dn50 = Dn / 2.3, the filter rule), a porous core
+(porosity 0.4, core stone 1 cm), water depth 0.5 m, crest freeboard 0.12 m, section 0.15 m wide
+(3.3 Dn: two units a row). The flume: boundary wave maker with active absorption 3.2 m seaward of
+the toe, three gauges for the incident waves, a run-up gauge on the face and an overtopping
+gauge at the crest's landward edge; cells of 1.5 cm (3 across a cube, 7 across the smallest Hm0).
+
+The ladder: N_s = Hm0 / (Delta Dn) = 1.8, 2.4, 3.0, 3.6 at a constant wave steepness s_op = 0.035
+(Tp 1.39-1.97 s), ``--waves`` waves each (default 50, the issue's least). Van Gent's (2002)
+single-layer cubes start to be damaged at N_s = 2.9-3.0 and fail at 3.5-3.75; Van der Meer's
+(1988) double-layer cubes formula is drawn for the waves run. Nothing is fitted: the materials
+are those of riprap's examples (friction 0.6), the core that of examples/10.
+
+The campaign runs in parts: started again with the same ``--out`` it resumes where it stopped
+(the placed pack, the finished steps, a cut step from its last checkpoint). Prints each step's
+row of the damage curve beside the formulas, where the first displacement happened in N_s, and
+last ``METRIC damage_curve_wall_s <seconds> s`` (the wall time of this call; the steps already
+done before it are not counted again).
+
+    python bench/damage_curve.py [--out DIR] [--waves N] [--steps 1.8,2.4,3.0,3.6]
+"""
+import argparse
+import math
+import time
+from pathlib import Path
+
+from riprap.case.load import load_case
+from riprap.workflows.place import run_placement
+from riprap.workflows.series import run_series
+
+DN = 0.045                 # m, the cubes' nominal diameter
+DELTA = 2300.0 / 1000.0 - 1.0
+DEPTH = 0.5                # m
+FREEBOARD = 0.12           # m
+COT = 1.5
+WIDTH = 0.15               # m
+STEEPNESS = 0.035
+CELL = 0.015               # m
+
+PLACEMENT = f"""format_version = 1
+
+[simulation]
+end_time = 1.0
+time_step_safety = 0.3
+output_interval = 0.1
+
+[[materials]]
+name = "concrete"
+density = 2300.0
+friction_coefficient = 0.6
+restitution = 0.3
+contact_penalty = 1.0e8
+
+[[materials]]
+name = "rock"
+density = 2650.0
+friction_coefficient = 0.6
+restitution = 0.3
+contact_penalty = 1.0e8
+
+[[materials]]
+name = "core"
+density = 2650.0
+friction_coefficient = 0.9
+restitution = 0.3
+contact_penalty = 1.0e8
+
+[[materials]]
+name = "glass"
+density = 2500.0
+friction_coefficient = 0.2
+restitution = 0.3
+contact_penalty = 1.0e8
+
+[slope]
+cotangent = {COT}
+width = {WIDTH}
+length = {(DEPTH + FREEBOARD) * math.hypot(1.0, COT):.4f}
+toe_stop_distance = 0.03
+face_material = "core"
+side_wall_material = "glass"
+
+[underlayer]
+material = "rock"
+dn50 = {DN / 2.3:.5f}
+dn85_over_dn15 = 1.3
+rock_shapes = 4
+size_classes = 2
+layers = 1
+settle_time = 1.0
+
+[armour]
+unit = "cube"
+material = "concrete"
+nominal_diameter = {DN}
+
+[placement]
+rows = 22
+units_per_row = 2
+release = "on_contact"
+orientation = "random"
+settle_time = 2.0
+rest_speed = 0.01
+
+[output]
+directory = "pack"
+"""
+
+
+def series_case(steps: list[float], waves: int) -> str:
+    crest = DEPTH + FREEBOARD
+    top_x = crest * COT
+    ladder = "".join(f"""
+[[series_steps]]
+significant_height = {ns * DELTA * DN:.4f}
+wave_steepness = {STEEPNESS}
+waves = {waves}
+""" for ns in steps)
+    length = 4.7
+    # three gauges for the incident waves, 0.3 and 0.6 m apart (0.07-0.33 of the wave lengths)
+    gauges = "\n".join(f'[[gauges]]\ntype = "surface"\nname = "g{k + 1}"\n'
+                       f"position = [{x}, {WIDTH / 2}, 0.0]\n"
+                       for k, x in enumerate((-2.4, -2.1, -1.5)))
+    return f"""format_version = 1
+pack = "pack/pack.toml"
+
+[simulation]
+end_time = 60.0
+adaptive_time_step = true
+output_interval = 5.0
+checkpoint_interval = 20.0
+
+[fluid]
+lower = [-3.2, 0.0, 0.0]
+upper = [1.5, {WIDTH}, 0.855]
+cells = [{round(length / CELL)}, {round(WIDTH / CELL)}, {round(0.855 / CELL)}]
+surface_tension = 0.0
+limit_air_speed = true
+pressure_volume_tolerance = 1e-3
+
+[[water_regions]]
+type = "level"
+level = {DEPTH}
+
+[[porous_zones]]
+type = "polygon"
+porosity = 0.4
+stone_diameter = 0.01
+points = [[0.03, 0.0], [{top_x - 0.03:.4f}, {crest - 0.02:.4f}], [1.2, {crest - 0.02:.4f}], [1.2, 0.0]]
+
+[waves]
+type = "irregular"
+still_water_level = {DEPTH}
+significant_height = 0.1
+peak_period = 1.4
+duration = 100.0
+generation = "boundary"
+absorbing_end = false
+
+{gauges}
+[[gauges]]
+type = "run_up"
+name = "face"
+position = [-0.03, {WIDTH / 2}, 0.0]
+to_x = 1.2
+
+[[gauges]]
+type = "overtopping"
+name = "crest"
+position = [1.2, {WIDTH / 2}, {crest:.4f}]
+
+[series]
+displacement_threshold = 1.0
+{ladder}
+[output]
+directory = "series"
+body_forces_interval = 0.25
+"""
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", default="bench_out/damage_curve")
+    parser.add_argument("--waves", type=int, default=50)
+    parser.add_argument("--steps", default="1.8,2.4,3.0,3.6",
+                        help="stability numbers Hm0 / (Delta Dn) of the steps")
+    args = parser.parse_args()
+    out = Path(args.out).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    started = time.perf_counter()
+    if not (out / "pack" / "pack.toml").is_file():
+        (out / "placement.toml").write_text(PLACEMENT)
+        summary = run_placement(load_case(out / "placement.toml"), output_directory=out / "pack",
+                                progress=False)
+        print(f"placed {summary['units_placed']} cubes on {summary['underlayer_rocks']} rocks, "
+              f"packing density {summary.get('packing_density_coefficient', float('nan')):.3f}, "
+              f"{time.perf_counter() - started:.0f} s")
+    steps = [float(v) for v in args.steps.split(",")]
+    (out / "series.toml").write_text(series_case(steps, args.waves))
+    results = run_series(load_case(out / "series.toml"), output_directory=out / "series",
+                         progress=False)
+    curve = results["curve"]
+    print("step  Hm0_m  N_s    waves  displaced  N_od    S      VdM_cubes_N_od  q_m3/s/m  EurOtop_q")
+    for k in range(len(curve["step"])):
+        print(f"{curve['step'][k]:4d}  {curve['Hm0_m'][k]:.3f}  {curve['stability_number'][k]:.2f}  "
+              f"{curve['waves'][k]:5d}  {curve['units_displaced'][k]:9d}  {curve['N_od'][k]:.3f}  "
+              f"{curve['S'][k]:.3f}  {curve['van_der_meer_cubes_N_od'][k]:.3f}           "
+              f"{curve['q_m3_s_m'][k]:.2e}  {curve['eurotop_q_m3_s_m'][k]:.2e}")
+    first = results["first_displacement"]
+    print("first displacement: " + (f"step {first['step']}, N_s = {first['stability_number']:.2f}"
+                                     if first else "none")
+          + "; Van Gent (2002) single-layer cubes: start N_s = 2.9-3.0, failure 3.5-3.75")
+    print(f"report: {results['outputs']['report']}")
+    print(f"METRIC damage_curve_wall_s {time.perf_counter() - started:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
