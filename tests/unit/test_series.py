@@ -333,9 +333,9 @@ def test_a_campaign_folder_of_other_members_or_version_is_refused_before_any_wor
     (folder / CAMPAIGN_RECORD).write_text(json.dumps(record))
     with pytest.raises(RiprapError, match="written by riprap '0.0.1'"):
         run_campaign(members_of([case], [0]), folder, client=object())
-    import riprap
+    from riprap.io.pack import riprap_version
 
-    record["riprap_version"] = riprap.__version__
+    record["riprap_version"] = riprap_version()
     (folder / CAMPAIGN_RECORD).write_text(json.dumps(record))
     with pytest.raises(RiprapError, match="a campaign of other members"):
         run_campaign(members_of([case], [0]), folder, client=object())

@@ -44,7 +44,7 @@ from riprap.io.case_text import PACK_HEADER
 from riprap.io.contact_history import CONTACT_HISTORY_FILE_NAME, write_contact_history
 from riprap.io.mesh_files import write_volume_mesh
 
-__all__ = ["PackBody", "write_pack", "PACK_FILE_NAME", "PACK_HEADER", "SHAPES_FOLDER",
+__all__ = ["PackBody", "write_pack", "riprap_version", "PACK_FILE_NAME", "PACK_HEADER", "SHAPES_FOLDER",
            "DEFAULT_PACK_SIMULATION", "DEFAULT_PACK_OUTPUT"]
 
 #: Name of the case file inside a pack folder.
@@ -227,7 +227,7 @@ def _check_references(shapes: Mapping, materials: Sequence, bodies: Sequence,
         raise error
 
 
-def _riprap_version() -> str:
+def riprap_version() -> str:
     """The installed riprap's version (from its package metadata: io stands below the package's
     ``__init__`` and does not import it)."""
     try:
@@ -240,7 +240,7 @@ def _header(comment: str, n_bodies: int, n_shapes: int) -> list[str]:
     now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0).isoformat()
     lines = [
         f"{PACK_HEADER} {n_bodies} bodies, {n_shapes} shapes; written by riprap "
-        f"{_riprap_version()} (riprap.io.pack.write_pack) on {now}",
+        f"{riprap_version()} (riprap.io.pack.write_pack) on {now}",
         "# Start a run from it with: riprap run pack.toml",
         "# Each shape's mesh (shapes/*.vtu) is in the body's own frame; a body's orientation",
         "# rotates that mesh into the world and its position is the mesh centroid's place (m).",

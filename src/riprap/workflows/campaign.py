@@ -25,11 +25,11 @@ from pathlib import Path
 
 import numpy as np
 
-import riprap
 from riprap.case.load import load_case
 from riprap.errors import CaseFileError, RiprapError
 from riprap.io.json_files import read_json_object, write_json
 from riprap.io.output_folder import prepare_output_folder
+from riprap.io.pack import riprap_version
 from riprap.io.series_report import write_columns_csv
 from riprap.workflows.series import check_series, run_series, series_fingerprint
 
@@ -106,16 +106,16 @@ def _claim(out: Path, members: list[Member], fingerprints: list[str], *,
            write: bool = True) -> None:
     """Refuse a campaign folder of another riprap version or other members (nothing in it is
     touched); otherwise record the campaign there (``write``)."""
-    record = {"format": CAMPAIGN_FORMAT, "riprap_version": riprap.__version__,
+    record = {"format": CAMPAIGN_FORMAT, "riprap_version": riprap_version(),
               "members": [{"name": m.name, "case_file": str(m.case_file),
                            "seed_offset": m.seed_offset, "fingerprint": f}
                           for m, f in zip(members, fingerprints)]}
     path = out / CAMPAIGN_RECORD
     if path.is_file():
         old = read_json_object(path, "campaign record", "riprap campaign wrote it")
-        if old.get("format") != CAMPAIGN_FORMAT or old.get("riprap_version") != riprap.__version__:
+        if old.get("format") != CAMPAIGN_FORMAT or old.get("riprap_version") != riprap_version():
             raise RiprapError(f"{path}: a campaign written by riprap {old.get('riprap_version')!r}, "
-                              f"this is {riprap.__version__}; nothing in it is resumed or "
+                              f"this is {riprap_version()}; nothing in it is resumed or "
                               "overwritten: give another --out folder")
         if old.get("members") != record["members"]:
             before = ", ".join(m.get("name", "?") for m in old.get("members", []))

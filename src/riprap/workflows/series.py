@@ -28,7 +28,6 @@ from pathlib import Path
 
 import numpy as np
 
-import riprap
 from riprap.analysis.per_wave_table import FlumeLayout, UnitTracks, per_wave_table
 from riprap.analysis.series_damage import series_curve
 from riprap.case.build_fluid import build_fluid_run, build_fluid_solver
@@ -39,6 +38,7 @@ from riprap.io.body_forces import read_body_tracks
 from riprap.io.gauge_files import read_gauges_csv
 from riprap.io.json_files import read_json_object, write_json
 from riprap.io.output_folder import prepare_output_folder
+from riprap.io.pack import riprap_version
 from riprap.io.series_report import read_columns_csv, write_columns_csv, write_series_report
 from riprap.workflows.analyse import analyse
 
@@ -109,11 +109,11 @@ def _claim_folder(out: Path, record: dict, *, write: bool = True) -> None:
     path = out / SERIES_RECORD
     if path.is_file():
         old = read_json_object(path, "series record", "it was written by riprap series")
-        if old.get("format") != SERIES_FORMAT or old.get("riprap_version") != riprap.__version__:
+        if old.get("format") != SERIES_FORMAT or old.get("riprap_version") != riprap_version():
             raise RiprapError(
                 f"{path}: this folder holds a series written by riprap "
                 f"{old.get('riprap_version')!r} (format {old.get('format')!r}), this is "
-                f"{riprap.__version__} (format {SERIES_FORMAT}); its steps are not resumed or "
+                f"{riprap_version()} (format {SERIES_FORMAT}); its steps are not resumed or "
                 "overwritten: give another --out folder")
         if (old.get("fingerprint"), old.get("seed_offset", 0)) != (record["fingerprint"],
                                                                    record["seed_offset"]):
@@ -130,7 +130,7 @@ def _claim_folder(out: Path, record: dict, *, write: bool = True) -> None:
 
 
 def _record(case, steps: list[_Step], seed_offset: int = 0) -> dict:
-    return {"format": SERIES_FORMAT, "riprap_version": riprap.__version__,
+    return {"format": SERIES_FORMAT, "riprap_version": riprap_version(),
             "case_file": str(Path(case.source).resolve()),
             "fingerprint": series_fingerprint(case), "seed_offset": int(seed_offset),
             "steps": [{"step": s.sea.number, "Hm0_m": s.sea.significant_height,
