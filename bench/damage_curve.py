@@ -4,8 +4,8 @@ on a porous core at laboratory scale, untuned, from below the start of damage to
 The section (Froude-scaled laboratory flume, fresh water): cubes of Dn = 4.5 cm (2300 kg/m^3,
 Delta = 1.3) placed by ``riprap place`` on a 1:1.5 slope (Van der Meer's 1988 cube tests' slope)
 over one layer of fixed underlayer rocks (Dn50 = Dn / 2.3, the filter rule), a porous core
-(porosity 0.4, core stone 1 cm), water depth 0.5 m, crest freeboard 0.12 m, section 0.15 m wide
-(3.3 Dn: two units a row). The flume: boundary wave maker with active absorption 3.2 m seaward of
+(porosity 0.4, core stone 1 cm), water depth 0.5 m, crest freeboard 0.12 m, section 0.105 m wide
+(2.3 Dn: two units a row). The flume: boundary wave maker with active absorption 2.6 m seaward of
 the toe, three gauges for the incident waves, a run-up gauge on the face and an overtopping
 gauge at the crest's landward edge; cells of 1.5 cm (3 across a cube, 7 across the smallest Hm0).
 
@@ -37,7 +37,7 @@ DELTA = 2300.0 / 1000.0 - 1.0
 DEPTH = 0.5                # m
 FREEBOARD = 0.12           # m
 COT = 1.5
-WIDTH = 0.15               # m
+WIDTH = 0.105              # m: 7 cells, two cubes a row
 STEEPNESS = 0.035
 CELL = 0.015               # m
 
@@ -120,11 +120,12 @@ significant_height = {ns * DELTA * DN:.4f}
 wave_steepness = {STEEPNESS}
 waves = {waves}
 """ for ns in steps)
-    length = 4.7
+    length = 4.1
+    height = 0.75
     # three gauges for the incident waves, 0.3 and 0.6 m apart (0.07-0.33 of the wave lengths)
     gauges = "\n".join(f'[[gauges]]\ntype = "surface"\nname = "g{k + 1}"\n'
                        f"position = [{x}, {WIDTH / 2}, 0.0]\n"
-                       for k, x in enumerate((-2.4, -2.1, -1.5)))
+                       for k, x in enumerate((-2.0, -1.7, -1.1)))
     return f"""format_version = 1
 pack = "pack/pack.toml"
 
@@ -135,9 +136,9 @@ output_interval = 5.0
 checkpoint_interval = 20.0
 
 [fluid]
-lower = [-3.2, 0.0, 0.0]
-upper = [1.5, {WIDTH}, 0.855]
-cells = [{round(length / CELL)}, {round(WIDTH / CELL)}, {round(0.855 / CELL)}]
+lower = [-2.6, 0.0, 0.0]
+upper = [1.5, {WIDTH}, {height}]
+cells = [{round(length / CELL)}, {round(WIDTH / CELL)}, {round(height / CELL)}]
 surface_tension = 0.0
 limit_air_speed = true
 pressure_volume_tolerance = 1e-3

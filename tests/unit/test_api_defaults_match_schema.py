@@ -31,7 +31,8 @@ from riprap.solid.materials import Material
 from riprap.solid.solver import SolidSolver
 from riprap.waves.boundary_generation import BoundaryWaveMaker
 from riprap.waves.stream_function import StreamFunctionWave
-from riprap.waves.theory import IrregularWave, LinearWave, StokesSecondOrderWave, jonswap_spectrum
+from riprap.waves.theory import (IrregularWave, LinearWave, StokesSecondOrderWave, envelope,
+                                 jonswap_spectrum)
 
 # (callable, schema tables, {parameter name: key name, or None for a parameter that only shares
 # the name}); other parameters are compared with the key of the same name in the first table that
@@ -69,6 +70,7 @@ API_TABLES = [
     (IrregularWave, ("waves",), {}),
     (jonswap_spectrum, ("waves",), {}),
     (BoundaryWaveMaker, ("waves",), {}),
+    (envelope, ("waves",), {}),
     # A deformable body's own gravity is off: the run gives it the [simulation] gravity.
     (DeformableBody, ("deformable",), {}),
     (FracturingBody, ("deformable",), {}),

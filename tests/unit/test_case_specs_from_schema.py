@@ -15,6 +15,7 @@ SPECS = {"simulation": specs.SimulationSettings, "materials": specs.MaterialSpec
          "water_regions": specs.RegionSpec, "obstacles": specs.RegionSpec,
          "waves": specs.WavesSpec, "gauges": specs.GaugeSpec,
          "porous_zones": specs.PorousZoneSpec, "deformable": specs.DeformableSpec,
+         "series": specs.SeriesSpec, "series_steps": specs.SeriesStepSpec,
          "output": specs.OutputSettings}
 
 
