@@ -200,7 +200,7 @@ def test_the_per_wave_table_adds_up_to_the_steps_totals(unbroken):
     total_overtopping = 0.0
     for number in (1, 2):
         folder = root / "unbroken" / f"step_{number:02d}"
-        table = read_columns_csv(folder / "per_wave.csv")
+        table = read_columns_csv(folder / "survey" / "per_wave.csv")
         gauges = np.genfromtxt(folder / "gauges.csv", delimiter=",", names=True)
         volume = gauges["crest_volume_m3_m"]
         assert np.nansum(table["overtopping_m3_per_m"]) == pytest.approx(

@@ -152,16 +152,21 @@ def write_series_report(out, results: dict) -> dict:
              + ", ".join(f"{html.escape(k)} = {v:g}" for k, v in start.items() if v) + ".</p>",
              "<img src='damage_curve.png'><img src='overtopping.png'>",
              f"<p>Sources: {html.escape(results['formulas']['sources'])}.</p>",
-             "<h2>Steps</h2>"]
+             "<h2>Before the series</h2><p><a href='start/report.html'>the layer as built</a> "
+             "(frame 0 of step 1)</p>"]
+    for picture in sorted((out / "start").glob("slope_*.png"))[:2]:
+        parts.append(f"<img src='start/{picture.name}' style='max-width:49%'>")
+    parts.append("<h2>Steps</h2>")
     for step in results["steps"]:
         folder = Path(step["folder"])
         relative = folder.name
         parts.append(f"<h3>Step {step['step']}: target Hm0 {step['target_Hm0_m']:g} m, Tp "
                      f"{step['Tp_s']:.3g} s</h3><p><a href='{relative}/survey/report.html'>survey "
-                     f"report</a> · <a href='{relative}/per_wave.csv'>per-wave table</a> · "
+                     f"report</a> · <a href='{relative}/survey/per_wave.csv'>per-wave table</a> · "
                      f"<a href='{relative}/survey/units.csv'>units</a></p>")
         for picture in sorted((folder / "survey").glob("*.png")):
-            if picture.name.startswith(("stability_profiles", "stability_units", "face")):
+            if picture.name.startswith(("stability_profiles", "stability_units",
+                                        "slope_displacement_over_dn")):
                 parts.append(f"<img src='{relative}/survey/{picture.name}' style='max-width:49%'>")
     parts.append("<p>Data: <a href='damage_curve.csv'>damage_curve.csv</a>, "
                  "<a href='series_results.json'>series_results.json</a>.</p>")

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from riprap.analysis.flume_test import FlumeRecords, fluid_force_columns, with_derived
-from riprap.analysis.layer_analysis import LayerAnalysis, analyse_layer
+from riprap.analysis.layer_analysis import DISPLACED_THRESHOLD_DN, LayerAnalysis, analyse_layer
 from riprap.analysis.stability_report import flume_stability
 from riprap.errors import CaseFileError
 from riprap.io.analysis_input import is_run_folder, load_waves_report
@@ -22,7 +22,9 @@ from riprap.io.body_forces import read_peak_fluid_forces
 from riprap.io.frame_contacts import read_unit_contacts_per_frame
 from riprap.io.gauge_files import read_gauges_csv
 from riprap.io.output_folder import prepare_output_folder
+from riprap.io.series_report import write_columns_csv
 from riprap.workflows.layer_input import load_layer_state, load_run_case
+from riprap.workflows.per_wave_records import run_per_wave_table
 
 __all__ = ["analyse", "compare_layers"]
 
@@ -44,7 +46,31 @@ def analyse(path, *, out=None, frame: int = -1, reference_run=None,
     analysis = _add_flume_test(path, waves, analysis)
     if out is not None:
         analysis.layer["outputs"] = write_analysis(out, analysis)
+        # the whole run's waves: with its last frame only
+        table = (_per_wave(path, analysis, reference_run, displaced_threshold_dn)
+                 if frame == -1 else None)
+        if table is not None:
+            analysis.layer["outputs"]["per_wave"] = str(
+                write_columns_csv(Path(out) / "per_wave.csv", table))
     return analysis
+
+
+def _per_wave(path, analysis, reference_run, threshold_dn) -> dict | None:
+    """A flume run's per-wave table (``riprap.workflows.per_wave_records``), or None."""
+    if not is_run_folder(path):
+        return None
+    case = load_run_case(path)
+    layer = analysis.state.layer
+    try:
+        return run_per_wave_table(
+            Path(path), case, units=np.asarray(layer.unit_bodies, dtype=np.int64),
+            nominal_diameter=float(layer.nominal_diameter), section_width=float(layer.slope.width),
+            threshold_dn=threshold_dn or DISPLACED_THRESHOLD_DN, reference_run=reference_run)
+    except CaseFileError as error:
+        # the gauges cannot give waves at the toe (too short a record, gauges too close for the
+        # split): the analysis stands without the table, and says why
+        analysis.layer["per_wave_not_computed"] = str(error)
+        return None
 
 
 def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:

@@ -153,14 +153,25 @@ def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int =
             f"{getattr(client.scheduler, 'address', '')}: " + ", ".join(m.name for m in members))
         futures = [client.submit(_run_member, str(m.case_file), str(out / m.name), m.seed_offset,
                                  threads, key=f"riprap-{m.name}", pure=False) for m in members]
-        results = {}
+        results, failed = {}, {}
         for member, future in zip(members, futures):
-            results[member.name] = future.result()
-            say(f"riprap: campaign member {member.name} done")
+            try:
+                results[member.name] = future.result()
+                say(f"riprap: campaign member {member.name} done")
+            except Exception as error:  # noqa: BLE001 - one member's failure ends only it
+                failed[member.name] = f"{type(error).__name__}: {error}"
+                say(f"riprap: campaign member {member.name} failed: {failed[member.name]}")
     finally:
         if own_cluster is not None:
             client.close()
             own_cluster.close()
+    if failed:
+        write_json(out / "campaign_results.json", {"members": results, "failed": failed})
+        raise RiprapError(
+            f"{len(failed)} of {len(members)} campaign members failed ("
+            + "; ".join(f"{name}: {why}" for name, why in failed.items())
+            + f"); the others are done. Their folders under {out} keep what was done: mend the "
+            "cause and start the same command again to resume them")
     summary = _spread(members, results)
     write_json(out / "campaign_results.json", {"members": results, "spread": summary})
     for case_name, columns in summary.items():

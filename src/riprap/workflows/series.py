@@ -7,7 +7,7 @@ ordinary run folder with its own case file (``step.toml``, written by
 contact history kept: ``Simulation.start_bodies_at_rest_from``) and from still water. After each
 step its *survey*: the layer analysis of its last frame with displacements and the eroded area
 counted from the series' start (``survey/``: units.csv, layer_summary.json, profiles and face
-pictures, report.html) and its *per-wave table* (``per_wave.csv``). At the end the damage curves
+pictures, report.html) with its *per-wave table* (``survey/per_wave.csv``). At the end the damage curves
 (``damage_curve.csv``, ``damage_curve.png``, ``series_results.json``, ``report.html``) beside the
 design formulas.
 
@@ -28,14 +28,11 @@ from pathlib import Path
 
 import numpy as np
 
-from riprap.analysis.per_wave_table import FlumeLayout, UnitTracks, per_wave_table
 from riprap.analysis.series_damage import series_curve
 from riprap.case.build_fluid import build_fluid_run, build_fluid_solver
 from riprap.case.load import parse_case
 from riprap.case.series_steps import step_case_text, step_seas
 from riprap.errors import CaseFileError, RiprapError
-from riprap.io.body_forces import read_body_tracks
-from riprap.io.gauge_files import read_gauges_csv
 from riprap.io.json_files import read_json_object, write_json
 from riprap.io.output_folder import prepare_output_folder
 from riprap.io.pack import riprap_version
@@ -48,9 +45,6 @@ __all__ = ["run_series", "series_fingerprint", "SERIES_RECORD", "step_folder"]
 SERIES_RECORD = "series.json"
 #: Its format (a folder of another format is refused).
 SERIES_FORMAT = 1
-#: Overtopping events smaller than this (m^3 per m of crest) are not counted (traces of water
-#: that the VOF field carries over the crest; EurOtop counts waves that overtop, not spray).
-EVENT_THRESHOLD = 1.0e-6
 
 
 def step_folder(out: Path, number: int) -> Path:
@@ -185,6 +179,9 @@ def run_series(case, *, output_directory=None, progress: bool = True, say=print,
             _run_step(step, steps[index - 1] if index else None, len(steps), progress)
             wall += wallclock.perf_counter() - started
         simulated += sea.end_time
+        if index == 0 and not (out / "start" / "layer_summary.json").is_file():
+            # the layer as built, before the first wave: the "before" of every survey's pictures
+            analyse(step.folder, out=out / "start", frame=0)
         _survey(step, steps[0].folder, case, say)
     results = _series_results(out, steps, case)
     write_json(out / "series_results.json", results)
@@ -213,70 +210,19 @@ def _run_step(step: _Step, before: _Step | None, count: int, progress: bool) -> 
 
 
 def _survey(step: _Step, first: Path, case, say) -> None:
-    """The survey after a step (``survey/``, from the series' start) and its per-wave table
-    (``per_wave.csv``), unless both were written before."""
-    folder = step.folder
-    survey = folder / "survey"
-    if (survey / "layer_summary.json").is_file() and (folder / "per_wave.csv").is_file():
+    """The survey after a step (``survey/``: the layer analysis from the series' start, with its
+    ``per_wave.csv``), unless written before."""
+    survey = step.folder / "survey"
+    if (survey / "layer_summary.json").is_file():
         return
     threshold = case.series.displacement_threshold
-    analysis = analyse(folder, out=survey, reference_run=first, displaced_threshold_dn=threshold)
+    analysis = analyse(step.folder, out=survey, reference_run=first,
+                       displaced_threshold_dn=threshold)
     layer = analysis.layer
     say(f"riprap: series step {step.sea.number} survey: {len(layer.get('units_displaced', []))} "
         f"unit(s) displaced more than {threshold:g} Dn since the start, N_od = "
         f"{layer.get('damage_number_nod', math.nan):.3g}, S = "
         f"{layer.get('damage_level_s', math.nan):.3g}")
-    description = analysis.state.layer
-    table = step_per_wave_table(folder, step.case, first,
-                                units=np.asarray(description.unit_bodies, dtype=np.int64),
-                                nominal_diameter=float(description.nominal_diameter),
-                                section_width=float(description.slope.width),
-                                threshold_dn=threshold)
-    if table is not None:
-        write_columns_csv(folder / "per_wave.csv", table)
-
-
-def step_per_wave_table(folder: Path, step_case, first: Path, *, units, nominal_diameter: float,
-                        section_width: float, threshold_dn: float) -> dict | None:
-    """The per-wave table of one step's run folder (None where it has fewer than two surface
-    gauges): waves counted at the toe (the run-up gauge's start, else the last surface gauge),
-    the units' (body indices ``units``) displacements counted from the series' start (the first
-    rows of ``first``'s ``body_forces.csv``)."""
-    gauges = read_gauges_csv(folder / "gauges.csv")
-    if gauges is None:
-        return None
-    times, columns = gauges
-    surface = sorted((g for g in step_case.gauges if g.type == "surface"),
-                     key=lambda g: g.parameters["position"][0])
-    if len(surface) < 2:
-        return None
-    run_up = next((g for g in step_case.gauges if g.type == "run_up"), None)
-    over = next((g for g in step_case.gauges if g.type == "overtopping"), None)
-    waves = step_case.waves
-    depth = waves.still_water_level - step_case.fluid.lower[2]
-    toe = run_up.parameters["position"][0] if run_up else surface[-1].parameters["position"][0]
-    tracks = None
-    rows = read_body_tracks(folder / "body_forces.csv", units) if len(units) else None
-    start = read_body_tracks(first / "body_forces.csv", units) if len(units) else None
-    if rows is not None and start is not None and len(rows["body"]) and len(start["body"]):
-        reference = np.full((int(np.max(units)) + 1, 3), np.nan)
-        first_rows = start["time_s"] == start["time_s"].min()
-        reference[start["body"][first_rows]] = start["position_m"][first_rows]
-        tracks = UnitTracks(unit=rows["body"], time=rows["time_s"], position=rows["position_m"],
-                            peak_force=rows["peak_fluid_force_N"],
-                            nominal_diameter=nominal_diameter, section_width=section_width,
-                            reference=reference)
-    armour_x = float(np.mean(tracks.position[:, 0])) if tracks is not None else None
-    layout = FlumeLayout(
-        gauge_positions=tuple(g.parameters["position"][0] for g in surface), toe_x=toe,
-        depth=depth, peak_period=waves.parameters["peak_period"],
-        run_up_x=toe if run_up else None,
-        overtopping_x=over.parameters["position"][0] if over else None, armour_x=armour_x)
-    return per_wave_table(
-        times, [columns[f"{g.name}_eta_m"] for g in surface], layout,
-        run_up=columns.get(f"{run_up.name}_level_m") if run_up else None,
-        overtopping_volume=columns.get(f"{over.name}_volume_m3_m") if over else None,
-        tracks=tracks, threshold_dn=threshold_dn, event_threshold=EVENT_THRESHOLD)
 
 
 def _series_results(out: Path, steps: list[_Step], case) -> dict:
@@ -288,8 +234,8 @@ def _series_results(out: Path, steps: list[_Step], case) -> dict:
                                  "riprap series wrote it after the step")
         flume = layer.get("flume_test") or {}
         waves = {"overtopping_m3_per_m": [], "wave": []}
-        if (folder / "per_wave.csv").is_file():
-            waves = read_columns_csv(folder / "per_wave.csv")
+        if (folder / "survey" / "per_wave.csv").is_file():
+            waves = read_columns_csv(folder / "survey" / "per_wave.csv")
         counted = len(waves["wave"])
         if counted:
             per_wave[step.sea.number] = {
