@@ -5,7 +5,8 @@ The section (Froude-scaled laboratory flume, fresh water): cubes of Dn = 4.5 cm 
 Delta = 1.3) placed by ``riprap place`` on a 1:1.5 slope (Van der Meer's 1988 cube tests' slope)
 over one layer of fixed underlayer rocks (Dn50 = Dn / 2.3, the filter rule), a porous core
 (porosity 0.4, core stone 1 cm), water depth 0.5 m, crest freeboard 0.12 m, section 0.105 m wide
-(2.3 Dn: two units a row). The flume: boundary wave maker with active absorption 2.6 m seaward of
+(2.3 Dn: two units a row, 16 rows, placed lying on the face within 15 degrees at a packing
+density of 0.7; the flume's water reaches half a cell beyond each side wall, as in examples/10). The flume: boundary wave maker with active absorption 2.6 m seaward of
 the toe, three gauges for the incident waves, a run-up gauge on the face and an overtopping
 gauge at the crest's landward edge; cells of 1.5 cm (3 across a cube, 7 across the smallest Hm0).
 
@@ -13,7 +14,9 @@ The ladder: N_s = Hm0 / (Delta Dn) = 1.8, 2.4, 3.0, 3.6 at a constant wave steep
 (Tp 1.39-1.97 s), ``--waves`` waves each (default 50, the issue's least). Van Gent's (2002)
 single-layer cubes start to be damaged at N_s = 2.9-3.0 and fail at 3.5-3.75; Van der Meer's
 (1988) double-layer cubes formula is drawn for the waves run. Nothing is fitted: the materials
-are those of riprap's examples (friction 0.6), the core that of examples/10.
+are those of riprap's examples (friction 0.6) with the contact penalty scaled from theirs as a
+Froude model scales stresses (2.8e8 Pa at Dn = 0.56 m -> 2e7 Pa at 4.5 cm), the core that of
+examples/10.
 
 The campaign runs in parts: started again with the same ``--out`` it resumes where it stopped
 (the placed pack, the finished steps, a cut step from its last checkpoint). Prints each step's
@@ -53,28 +56,28 @@ name = "concrete"
 density = 2300.0
 friction_coefficient = 0.6
 restitution = 0.3
-contact_penalty = 1.0e8
+contact_penalty = 2.0e7
 
 [[materials]]
 name = "rock"
 density = 2650.0
 friction_coefficient = 0.6
 restitution = 0.3
-contact_penalty = 1.0e8
+contact_penalty = 2.0e7
 
 [[materials]]
 name = "core"
 density = 2650.0
 friction_coefficient = 0.9
 restitution = 0.3
-contact_penalty = 1.0e8
+contact_penalty = 2.0e7
 
 [[materials]]
 name = "glass"
 density = 2500.0
 friction_coefficient = 0.2
 restitution = 0.3
-contact_penalty = 1.0e8
+contact_penalty = 2.0e7
 
 [slope]
 cotangent = {COT}
@@ -99,10 +102,12 @@ material = "concrete"
 nominal_diameter = {DN}
 
 [placement]
-rows = 22
+rows = 16
 units_per_row = 2
+packing_density_coefficient = 0.7
 release = "on_contact"
-orientation = "random"
+orientation = "random_within"
+max_tilt_deg = 15.0
 settle_time = 2.0
 rest_speed = 0.01
 
@@ -136,9 +141,9 @@ output_interval = 5.0
 checkpoint_interval = 20.0
 
 [fluid]
-lower = [-2.6, 0.0, 0.0]
-upper = [1.5, {WIDTH}, {height}]
-cells = [{round(length / CELL)}, {round(WIDTH / CELL)}, {round(height / CELL)}]
+lower = [{1.5 - round(length / CELL) * CELL:.4f}, {-CELL / 2}, 0.0]
+upper = [1.5, {WIDTH + CELL / 2:.4f}, {round(height / CELL) * CELL:.4f}]
+cells = [{round(length / CELL)}, {round(WIDTH / CELL) + 1}, {round(height / CELL)}]
 surface_tension = 0.0
 limit_air_speed = true
 pressure_volume_tolerance = 1e-3

@@ -91,7 +91,7 @@ def _steps(case, out: Path, seed_offset: int = 0) -> list[_Step]:
             step_case = parse_case(text, source=str(folder / "step.toml"), base_dir=folder)
             build_fluid_solver(step_case)
         except CaseFileError as error:
-            message = str(error).replace(str(folder / "step.toml"), "its sea")
+            message = str(error).replace(str(folder / "step.toml"), "step.toml")
             raise CaseFileError(f"{where}: {message}") from None
         steps.append(_Step(sea, text, step_case, folder))
     return steps
