@@ -32,7 +32,7 @@ from riprap.geometry.armour_units import armour_unit
 from riprap.io.checkpoint import load_checkpoint
 from riprap.io.layer_file import write_contact_table, write_layer_file
 from riprap.io.pack import PackBody, write_pack
-from riprap.io.series_report import read_columns_csv
+from riprap.io.csv_tables import read_columns_csv
 from riprap.placement.slope import Slope
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape

@@ -31,6 +31,7 @@ from riprap.io import analysis_figures as figures
 from riprap.io.analysis_figures import (FACTOR_OF_SAFETY_DISPLAY_CAP, PER_UNIT_FIELDS,
                                         drawn_fields)
 from riprap.io.flume_report import stability_section, waves_section, write_flume_figures
+from riprap.io.csv_tables import write_columns_csv
 from riprap.io.layer_file import write_contact_table
 from riprap.io.summary import write_json
 from riprap.io.vtk import write_vtu
@@ -150,24 +151,9 @@ def _verdict_table(layer: dict) -> str:
     return f"<table class='verdict'><tr>{head}</tr>{''.join(rows)}</table>"
 
 
-def _csv_number(value) -> str:
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    number = float(value)
-    if math.isinf(number):
-        return "inf" if number > 0 else "-inf"
-    return repr(number)
-
-
 def write_units_csv(path, units: dict) -> Path:
     """One row per unit, the columns of ``units`` in order."""
-    path = Path(path)
-    names = list(units)
-    lines = [",".join(names)]
-    for k in range(len(units[names[0]]) if names else 0):
-        lines.append(",".join(_csv_number(units[name][k]) for name in names))
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
+    return write_columns_csv(path, units)
 
 
 def _write_paraview(out: Path, analysis) -> dict:

@@ -1,5 +1,5 @@
-"""The files of a test series (``riprap.workflows.series``): column tables as CSV, the damage
-curve pictures and the series' ``report.html`` (every step's survey pictures and tables, the
+"""The files of a test series (``riprap.workflows.series``): the damage curve pictures and the
+series' ``report.html`` (every step's survey pictures and tables, the
 damage curves beside the formulas, the data files linked)."""
 from __future__ import annotations
 
@@ -9,40 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_columns_csv", "write_series_report", "read_columns_csv"]
-
-
-def _csv_number(value) -> str:
-    if isinstance(value, (bool, np.bool_)):
-        return str(int(value))
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    number = float(value)
-    if math.isnan(number):
-        return "nan"
-    if math.isinf(number):
-        return "inf" if number > 0 else "-inf"
-    return repr(number)
-
-
-def write_columns_csv(path, columns: dict) -> Path:
-    """One row per entry of the equally long ``columns`` (name -> values), in their order."""
-    path = Path(path)
-    names = list(columns)
-    lines = [",".join(names)]
-    for k in range(len(columns[names[0]]) if names else 0):
-        lines.append(",".join(_csv_number(columns[name][k]) for name in names))
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
-
-
-def read_columns_csv(path) -> dict:
-    """The columns of a table :func:`write_columns_csv` wrote (numbers; ``nan`` kept)."""
-    lines = [line for line in Path(path).read_text(encoding="utf-8").splitlines() if line.strip()]
-    names = lines[0].split(",")
-    rows = np.array([[float(v) for v in line.split(",")] for line in lines[1:]],
-                    dtype=float).reshape(-1, len(names))
-    return {name: rows[:, k] for k, name in enumerate(names)}
+__all__ = ["write_series_report"]
 
 
 def _pyplot():

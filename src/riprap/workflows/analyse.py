@@ -22,7 +22,7 @@ from riprap.io.body_forces import read_peak_fluid_forces
 from riprap.io.frame_contacts import read_unit_contacts_per_frame
 from riprap.io.gauge_files import read_gauges_csv
 from riprap.io.output_folder import prepare_output_folder
-from riprap.io.series_report import write_columns_csv
+from riprap.io.csv_tables import write_columns_csv
 from riprap.workflows.layer_input import load_layer_state, load_run_case
 from riprap.workflows.per_wave_records import run_per_wave_table
 

@@ -30,7 +30,7 @@ from riprap.errors import CaseFileError, RiprapError
 from riprap.io.json_files import read_json_object, write_json
 from riprap.io.output_folder import prepare_output_folder
 from riprap.io.pack import riprap_version
-from riprap.io.series_report import write_columns_csv
+from riprap.io.csv_tables import write_columns_csv
 from riprap.workflows.series import check_series, run_series, series_fingerprint
 
 __all__ = ["Member", "members_of", "run_campaign", "CAMPAIGN_RECORD", "SCHEDULER_TIMEOUT_S"]

@@ -36,7 +36,8 @@ from riprap.errors import CaseFileError, RiprapError
 from riprap.io.json_files import read_json_object, write_json
 from riprap.io.output_folder import prepare_output_folder
 from riprap.io.pack import riprap_version
-from riprap.io.series_report import read_columns_csv, write_columns_csv, write_series_report
+from riprap.io.csv_tables import read_columns_csv, write_columns_csv
+from riprap.io.series_report import write_series_report
 from riprap.workflows.analyse import analyse
 
 __all__ = ["run_series", "series_fingerprint", "SERIES_RECORD", "step_folder"]
