@@ -161,7 +161,7 @@ def test_v_cycle_is_a_symmetric_positive_definite_preconditioner(listed):
 
     def precondition(vector):
         residual[...] = vector
-        multigrid.apply_v_cycle(hierarchy, pressure_module.SMOOTHING_SWEEPS, listed_cells, 3)
+        multigrid.apply_v_cycle(hierarchy, pressure_module.SMOOTHING_SWEEPS, listed_cells, 3, 0)
         return correction.copy()
 
     block = np.zeros(shape, dtype=bool)

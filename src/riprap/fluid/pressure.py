@@ -45,7 +45,8 @@ import numpy as np
 from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.kernels import multigrid
 
-__all__ = ["PressureSolver", "PressureSolveReport", "apply_operator"]
+__all__ = ["PressureSolver", "PressureSolveReport", "apply_operator", "build_hierarchy",
+           "level_shapes", "build_levels", "outcome_report", "face_view", "cell_view"]
 
 # Coarsening stops once a level has at most this many cells; the coarsest level is then factored
 # directly (banded Cholesky, cost cells x (ny nz)^2: about a million operations for 8 x 8 x 8).
@@ -93,9 +94,10 @@ def _check_shapes(shape, beta_x, beta_y, beta_z, arrays):
                                 f"{wanted} for a grid of {nx} x {ny} x {nz} cells")
 
 
-def _listed_cells(cells, shape):
+def _listed_cells(cells, shape, parity: int = 0):
     """The flat cell indices of ``solve(listed_cells=...)``, checked, without repeats, red
-    ((i + j + k) even) first, as int64; and how many are red."""
+    ((i + j + k) even) first, as int64; and how many are red. ``parity``: the global x index of
+    plane 0 mod 2 (a slab of a split grid)."""
     n_cells = math.prod(shape)
     if cells is None:
         return np.zeros(0, dtype=np.int64), 0
@@ -104,7 +106,7 @@ def _listed_cells(cells, shape):
         raise CaseFileError(f"pressure solve: listed_cells must be flat cell indices in [0, "
                             f"{n_cells}), got [{listed[0]}, {listed[-1]}]")
     i, j, k = np.unravel_index(listed, shape)
-    black = (i + j + k) % 2 == 1
+    black = (i + parity + j + k) % 2 == 1
     return np.concatenate([listed[~black], listed[black]]), int(np.count_nonzero(~black))
 
 
@@ -132,6 +134,105 @@ def apply_operator(beta_x, beta_y, beta_z, p, cell_size) -> np.ndarray:
                                       p, result)
     np.negative(result, out=result)
     return result
+
+
+def outcome_report(iterations, relative_residual, largest, outcome, dt2, tolerance,
+                   shape) -> PressureSolveReport:
+    """The report of a solve that ended with ``outcome`` (``multigrid`` codes); raises
+    InstabilityError for one that failed and is not a usable capped solve."""
+    volume_change = float(dt2 * largest) if dt2 > 0.0 else None
+    capped = (outcome == multigrid.NOT_CONVERGED and relative_residual <= CAPPED_RESIDUAL_LIMIT)
+    if outcome != multigrid.CONVERGED and not capped:
+        reason = {
+            multigrid.NOT_CONVERGED: "did not converge",
+            multigrid.NON_FINITE: "met a non-finite value (check rhs and the coefficients)",
+            multigrid.BREAKDOWN: ("broke down: the operator is not positive definite on the "
+                                  "search direction (a region cut off by zero faces without a "
+                                  "Dirichlet face?)"),
+        }[outcome]
+        raise InstabilityError(f"pressure solve {reason}: relative residual "
+                               f"{relative_residual:.3e} after {iterations} iteration(s), "
+                               f"tolerance {tolerance:.1e}, grid {tuple(shape)}")
+    return PressureSolveReport(int(iterations), float(relative_residual), volume_change,
+                               bool(capped))
+
+
+def level_shapes(shape) -> tuple[list, list]:
+    """The cells per axis of every multigrid level of a grid of ``shape``, and the children per
+    coarse cell from each level to the next ((1, 1, 1) after the last): each level halves every
+    axis with more than one cell, until a level has at most ``COARSEST_MAXIMUM_CELLS``."""
+    shapes = [tuple(int(n) for n in shape)]
+    factors = []
+    while math.prod(shapes[-1]) > COARSEST_MAXIMUM_CELLS and max(shapes[-1]) > 1:
+        factor = tuple(2 if n > 1 else 1 for n in shapes[-1])
+        factors.append(factor)
+        shapes.append(tuple(-(-n // f) for n, f in zip(shapes[-1], factor)))
+    factors.append((1, 1, 1))
+    return shapes, factors
+
+
+def build_hierarchy(shape, spacing) -> multigrid.Hierarchy:
+    """The multigrid levels (``level_shapes``) of a grid of ``shape`` cells of ``spacing`` (3,) m
+    per axis, empty (``build_levels`` fills them)."""
+    shapes, factors = level_shapes(shape)
+    spacing = np.asarray(spacing, dtype=np.float64).reshape(3)
+    spacings = [spacing.copy()]
+    for factor in factors[:-1]:
+        spacing = spacing * np.array(factor)
+        spacings.append(spacing.copy())
+    shapes_array = np.array(shapes, dtype=np.int64)
+    cell_counts = shapes_array.prod(axis=1)
+    face_counts = np.empty((len(shapes), 3), dtype=np.int64)
+    for axis in range(3):
+        face_shapes = shapes_array.copy()
+        face_shapes[:, axis] += 1
+        face_counts[:, axis] = face_shapes.prod(axis=1)
+    cell_offsets = np.concatenate([[0], np.cumsum(cell_counts)]).astype(np.int64)
+    face_offsets = np.vstack([np.zeros((1, 3), dtype=np.int64),
+                              np.cumsum(face_counts, axis=0)]).astype(np.int64)
+    coarsest = shapes[-1]
+    return multigrid.Hierarchy(
+        shapes=shapes_array,
+        cell_offsets=cell_offsets,
+        face_offsets=face_offsets,
+        inverse_spacing_squared=1.0 / np.array(spacings) ** 2,
+        factors=np.array(factors, dtype=np.int64),
+        beta_x=np.zeros(face_offsets[-1, 0]),
+        beta_y=np.zeros(face_offsets[-1, 1]),
+        beta_z=np.zeros(face_offsets[-1, 2]),
+        corrections=np.zeros(cell_offsets[-1]),
+        residuals=np.zeros(cell_offsets[-1]),
+        coarsest_factor=np.zeros((math.prod(coarsest), coarsest[1] * coarsest[2] + 1)))
+
+
+def face_view(hierarchy: multigrid.Hierarchy, level: int, axis: int) -> np.ndarray:
+    """The face coefficients of ``axis`` on ``level`` as an array (a view of the flat storage)."""
+    shape = list(hierarchy.shapes[level])
+    shape[axis] += 1
+    flat = (hierarchy.beta_x, hierarchy.beta_y, hierarchy.beta_z)[axis]
+    return flat[hierarchy.face_offsets[level, axis]:hierarchy.face_offsets[level + 1, axis]] \
+        .reshape(shape)
+
+
+def cell_view(flat: np.ndarray, hierarchy: multigrid.Hierarchy, level: int) -> np.ndarray:
+    """``level``'s cells in a flat cell array (``residuals`` or ``corrections``) as an array."""
+    shape = tuple(int(n) for n in hierarchy.shapes[level])
+    return flat[hierarchy.cell_offsets[level]:hierarchy.cell_offsets[level + 1]].reshape(shape)
+
+
+def build_levels(hierarchy: multigrid.Hierarchy) -> None:
+    """Coarse coefficients from level 0's, and the coarsest factor: O(cells) work."""
+    levels = hierarchy.shapes.shape[0]
+    for level in range(levels - 1):
+        fine = [face_view(hierarchy, level, axis) for axis in range(3)]
+        coarse = [face_view(hierarchy, level + 1, axis) for axis in range(3)]
+        multigrid.coarsen_coefficients(*fine, *coarse, *(int(f) for f in hierarchy.factors[level]),
+                                       0, int(hierarchy.shapes[level, 0]), 0,
+                                       int(hierarchy.shapes[level + 1, 0]))
+    last = levels - 1
+    coarsest = [face_view(hierarchy, last, axis) for axis in range(3)]
+    multigrid.factor_coarsest(*coarsest, *hierarchy.inverse_spacing_squared[last],
+                              hierarchy.coarsest_factor)
 
 
 class PressureSolver:
@@ -177,43 +278,8 @@ class PressureSolver:
         self.max_iterations = int(max_iterations)
         self.volume_tolerance = float(volume_tolerance)
 
-        shapes = [shape]
-        factors = []
-        while math.prod(shapes[-1]) > COARSEST_MAXIMUM_CELLS and max(shapes[-1]) > 1:
-            factor = tuple(2 if n > 1 else 1 for n in shapes[-1])
-            factors.append(factor)
-            shapes.append(tuple(-(-n // f) for n, f in zip(shapes[-1], factor)))
-        factors.append((1, 1, 1))
-        spacing = np.full(3, self.cell_size)
-        spacings = [spacing.copy()]
-        for factor in factors[:-1]:
-            spacing = spacing * np.array(factor)
-            spacings.append(spacing.copy())
-
-        shapes_array = np.array(shapes, dtype=np.int64)
-        cell_counts = shapes_array.prod(axis=1)
-        face_counts = np.empty((len(shapes), 3), dtype=np.int64)
-        for axis in range(3):
-            face_shapes = shapes_array.copy()
-            face_shapes[:, axis] += 1
-            face_counts[:, axis] = face_shapes.prod(axis=1)
-        cell_offsets = np.concatenate([[0], np.cumsum(cell_counts)]).astype(np.int64)
-        face_offsets = np.vstack([np.zeros((1, 3), dtype=np.int64),
-                                  np.cumsum(face_counts, axis=0)]).astype(np.int64)
-        coarsest = shapes[-1]
-        self.levels = shapes
-        self._hierarchy = multigrid.Hierarchy(
-            shapes=shapes_array,
-            cell_offsets=cell_offsets,
-            face_offsets=face_offsets,
-            inverse_spacing_squared=1.0 / np.array(spacings) ** 2,
-            factors=np.array(factors, dtype=np.int64),
-            beta_x=np.zeros(face_offsets[-1, 0]),
-            beta_y=np.zeros(face_offsets[-1, 1]),
-            beta_z=np.zeros(face_offsets[-1, 2]),
-            corrections=np.zeros(cell_offsets[-1]),
-            residuals=np.zeros(cell_offsets[-1]),
-            coarsest_factor=np.zeros((math.prod(coarsest), coarsest[1] * coarsest[2] + 1)))
+        self._hierarchy = build_hierarchy(shape, np.full(3, self.cell_size))
+        self.levels = [tuple(int(n) for n in row) for row in self._hierarchy.shapes]
         self._system_rhs = np.zeros(shape)
         self._direction = np.zeros(shape)
         self._product = np.zeros(shape)
@@ -221,24 +287,10 @@ class PressureSolver:
         self._row_counts = np.zeros((shape[0] + 1, 2), dtype=np.int64)
 
     def _face_view(self, level, axis):
-        hierarchy = self._hierarchy
-        shape = list(hierarchy.shapes[level])
-        shape[axis] += 1
-        flat = (hierarchy.beta_x, hierarchy.beta_y, hierarchy.beta_z)[axis]
-        return flat[hierarchy.face_offsets[level, axis]:hierarchy.face_offsets[level + 1, axis]] \
-            .reshape(shape)
+        return face_view(self._hierarchy, level, axis)
 
     def _build_levels(self):
-        """Coarse coefficients from level 0's, and the coarsest factor: O(cells) work."""
-        hierarchy = self._hierarchy
-        for level in range(len(self.levels) - 1):
-            fine = [self._face_view(level, axis) for axis in range(3)]
-            coarse = [self._face_view(level + 1, axis) for axis in range(3)]
-            multigrid.coarsen_coefficients(*fine, *coarse, *(int(f) for f in hierarchy.factors[level]))
-        last = len(self.levels) - 1
-        coarsest = [self._face_view(last, axis) for axis in range(3)]
-        multigrid.factor_coarsest(*coarsest, *hierarchy.inverse_spacing_squared[last],
-                                  hierarchy.coarsest_factor)
+        build_levels(self._hierarchy)
 
     def _listed_stencils(self, cells, red):
         """The ``multigrid.ListedCells`` of ``cells`` with level 0's present coefficients."""
@@ -303,19 +355,5 @@ class PressureSolver:
             self._hierarchy, self._system_rhs, pressure, self._direction, self._product,
             self._row_sums, self.tolerance, self.max_iterations, SMOOTHING_SWEEPS, singular,
             active_cells, listed, LISTED_SWEEPS, largest_residual)
-        volume_change = float(dt2 * largest) if dt2 > 0.0 else None
-        capped = (outcome == multigrid.NOT_CONVERGED
-                  and relative_residual <= CAPPED_RESIDUAL_LIMIT)
-        if outcome != multigrid.CONVERGED and not capped:
-            reason = {
-                multigrid.NOT_CONVERGED: "did not converge",
-                multigrid.NON_FINITE: "met a non-finite value (check rhs and the coefficients)",
-                multigrid.BREAKDOWN: ("broke down: the operator is not positive definite on the "
-                                      "search direction (a region cut off by zero faces without a "
-                                      "Dirichlet face?)"),
-            }[outcome]
-            raise InstabilityError(f"pressure solve {reason}: relative residual "
-                                   f"{relative_residual:.3e} after {iterations} iteration(s), "
-                                   f"tolerance {self.tolerance:.1e}, grid {self.shape}")
-        return pressure, PressureSolveReport(int(iterations), float(relative_residual),
-                                             volume_change, bool(capped))
+        return pressure, outcome_report(iterations, relative_residual, largest, outcome, dt2,
+                                        self.tolerance, self.shape)

@@ -487,26 +487,31 @@ def copy_into(source, target):
 
 @parallel_kernel
 def coarsen_coefficients(fine_beta_x, fine_beta_y, fine_beta_z, coarse_beta_x, coarse_beta_y,
-                         coarse_beta_z, factor_x, factor_y, factor_z):
+                         coarse_beta_z, factor_x, factor_y, factor_z, fine_first, fine_stop,
+                         coarse_first, coarse_stop):
     """Coarse face coefficients: the mean over the fine face slots each coarse face covers.
 
     Slots outside the fine grid (odd sizes) count as zero faces; the last coarse face along an axis
     takes the fine boundary face, wherever it lies (module docstring). The coarse spacing
     (factor x fine spacing) is applied by the caller through the inverse spacings.
+
+    Along x only the coarse cells coarse_first..coarse_stop-1 (and their faces, both ends
+    included) are made, from the fine cells fine_first..fine_stop-1: the whole grid is (0, nx,
+    0, cx); a slab of a grid split over processes (``riprap/fluid/slab_pressure.py``) is its own
+    cells, between ghost planes.
     """
-    nx = fine_beta_y.shape[0]
     ny = fine_beta_x.shape[1]
     nz = fine_beta_x.shape[2]
-    cx = coarse_beta_y.shape[0]
     cy = coarse_beta_x.shape[1]
     cz = coarse_beta_x.shape[2]
     weight_x = 1.0 / (factor_y * factor_z)
     weight_y = 1.0 / (factor_x * factor_z)
     weight_z = 1.0 / (factor_x * factor_y)
-    for ci in prange(cx + 1):
-        i_first = ci * factor_x
-        i_stop = min(i_first + factor_x, nx)
-        fine_face_x = i_first if ci < cx else nx
+    cx = coarse_stop
+    for ci in prange(coarse_first, coarse_stop + 1):
+        i_first = fine_first + (ci - coarse_first) * factor_x
+        i_stop = min(i_first + factor_x, fine_stop)
+        fine_face_x = i_first if ci < cx else fine_stop
         for cj in range(cy + 1):
             j_first = cj * factor_y
             j_stop = min(j_first + factor_y, ny)
@@ -563,67 +568,77 @@ def _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, 
 
 
 @parallel_kernel
-def smooth_first_red(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x):
-    """The first red sweep from x = 0: red cells rhs / d, black cells 0 (saves zeroing x)."""
+def smooth_first_red(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, first,
+                     stop, parity):
+    """The first red sweep from x = 0: red cells rhs / d, black cells 0 (saves zeroing x), on the
+    x-slabs first..stop-1; ``parity`` is the global x index of slab 0 mod 2 (0 for a whole grid)."""
     nx, ny, nz = x.shape
-    for i in prange(nx):
+    for i in prange(first, stop):
         for j in range(ny):
             for k in range(nz):
-                if (i + j + k) % 2 == 1:
+                if (i + parity + j + k) % 2 == 1:
                     x[i, j, k] = 0.0
-    for i in prange(nx):
-        _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, 0, i,
-                     True)
+    for i in prange(first, stop):
+        _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, parity,
+                     i, True)
 
 
 @parallel_kernel
-def smooth_colour(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour):
-    """One Gauss-Seidel sweep over the cells with (i + j + k) mod 2 == colour (0 red, 1 black)."""
-    for i in prange(x.shape[0]):
+def smooth_colour(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour,
+                  first, stop):
+    """One Gauss-Seidel sweep over the cells of x-slabs first..stop-1 with (i + j + k) mod 2 ==
+    colour (0 red, 1 black; a slab of a split grid passes its colour shifted by its parity)."""
+    for i in prange(first, stop):
         _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour,
                      i, False)
 
 
 @kernel
 def smooth_colour_serial(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x,
-                         colour):
+                         colour, first, stop):
     """``smooth_colour`` on one thread: on the small coarse levels a parallel launch costs more
     than the sweep (the same result: cells of one colour do not read each other)."""
-    for i in range(x.shape[0]):
+    for i in range(first, stop):
         _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour,
                      i, False)
 
 
 @kernel
-def smooth(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour):
-    """One colour's sweep, in parallel on levels of at least ``PARALLEL_SWEEP_CELLS`` cells."""
+def smooth(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour, first,
+           stop):
+    """One colour's sweep over x-slabs first..stop-1, in parallel on levels of at least
+    ``PARALLEL_SWEEP_CELLS`` cells."""
     if x.size >= PARALLEL_SWEEP_CELLS:
-        smooth_colour(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour)
+        smooth_colour(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour,
+                      first, stop)
     else:
         smooth_colour_serial(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x,
-                             colour)
+                             colour, first, stop)
 
 
 @parallel_kernel
 def restrict_red_residual(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x,
-                          coarse_rhs, factor_x, factor_y, factor_z):
+                          coarse_rhs, factor_x, factor_y, factor_z, fine_first, fine_stop,
+                          coarse_first, coarse_stop, parity):
     """coarse_rhs = c P^T (rhs - L x), c = 1 / (factor_x factor_y factor_z), after a black sweep.
 
     The last smoothing sweep solved every black cell's equation, so the black residuals are zero
     (to round-off) and only the red ones are evaluated and summed: the same linear map as summing
     all children, at half the cost. Each thread owns whole coarse x-slabs, so the sums are formed
-    in a fixed order.
+    in a fixed order. Ranges and ``parity`` as in ``coarsen_coefficients`` and
+    ``smooth_first_red``.
     """
     nx, ny, nz = x.shape
     two_dimensional = ny == 1
     scale = 1.0 / (factor_x * factor_y * factor_z)
-    for ci in prange(coarse_rhs.shape[0]):
+    for ci in prange(coarse_first, coarse_stop):
         coarse_rhs[ci, :, :] = 0.0
-        for i in range(ci * factor_x, min(ci * factor_x + factor_x, nx)):
+        i_first = fine_first + (ci - coarse_first) * factor_x
+        for i in range(i_first, min(i_first + factor_x, fine_stop)):
             for j in range(ny):
                 row_is_interior = interior_row(i, j, x.shape)
                 cj = j // factor_y
-                for k in range((i + j) % 2, nz, 2):
+                for k in range((i + parity + j) % 2, nz, 2):
                     if row_is_interior and 0 < k < nz - 1:
                         diagonal, neighbours = interior_diagonal_and_neighbour_sum(
                             beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x, i, j, k,
@@ -637,11 +652,13 @@ def restrict_red_residual(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inve
 
 
 @parallel_kernel
-def prolong_correction(coarse_x, x, factor_x, factor_y, factor_z):
-    """x += P coarse_x: every fine cell gets its coarse cell's correction (piecewise constant)."""
+def prolong_correction(coarse_x, x, factor_x, factor_y, factor_z, fine_first, fine_stop,
+                       coarse_first):
+    """x += P coarse_x: every fine cell gets its coarse cell's correction (piecewise constant), on
+    the fine x-slabs fine_first..fine_stop-1 (coarse slab coarse_first holds the first's)."""
     nx, ny, nz = x.shape
-    for i in prange(nx):
-        ci = i // factor_x
+    for i in prange(fine_first, fine_stop):
+        ci = coarse_first + (i - fine_first) // factor_x
         for j in range(ny):
             cj = j // factor_y
             for k in range(nz):
@@ -795,12 +812,14 @@ def level_sweeps(sweeps, level):
 
 
 @kernel
-def apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps):
+def apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps, first_level):
     """corrections[level 0] = B residuals[level 0], B one symmetric V-cycle (module docstring).
 
     The cells of ``listed`` (``ListedCells``) get ``listed_sweeps`` extra Gauss-Seidel sweeps (red,
     black) before the level's own pre-smoothing and the same in reverse order (black, red) after its
     post-smoothing, which keeps B symmetric (module docstring, "Local smoothing").
+    ``first_level``: the level of the whole grid that this hierarchy's level 0 is (0 but for the
+    coarse levels a split grid gathers: ``riprap/fluid/slab_pressure.py``), for the sweeps.
     """
     n_levels = hierarchy.shapes.shape[0]
     spacing = hierarchy.inverse_spacing_squared
@@ -820,16 +839,17 @@ def apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps):
                 smooth_listed_cells(listed, rhs, x, 0, red)
                 smooth_listed_cells(listed, rhs, x, red, stop)
             first_from_zero = False
-        for sweep in range(level_sweeps(sweeps, level)):
+        nx = x.shape[0]
+        for sweep in range(level_sweeps(sweeps, level + first_level)):
             if sweep == 0 and first_from_zero:
-                smooth_first_red(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x)
+                smooth_first_red(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0, nx, 0)
             else:
-                smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0)
-            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 1)
+                smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0, 0, nx)
+            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 1, 0, nx)
         factors = hierarchy.factors[level]
-        restrict_red_residual(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x,
-                              cell_array(hierarchy.residuals, hierarchy, level + 1),
-                              factors[0], factors[1], factors[2])
+        coarse_rhs = cell_array(hierarchy.residuals, hierarchy, level + 1)
+        restrict_red_residual(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, coarse_rhs,
+                              factors[0], factors[1], factors[2], 0, nx, 0, coarse_rhs.shape[0], 0)
     last = n_levels - 1
     solve_coarsest(hierarchy.coarsest_factor, cell_array(hierarchy.residuals, hierarchy, last),
                    cell_array(hierarchy.corrections, hierarchy, last))
@@ -841,11 +861,12 @@ def apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps):
         x = cell_array(hierarchy.corrections, hierarchy, level)
         hx2, hy2, hz2 = spacing[level, 0], spacing[level, 1], spacing[level, 2]
         factors = hierarchy.factors[level]
+        nx = x.shape[0]
         prolong_correction(cell_array(hierarchy.corrections, hierarchy, level + 1), x,
-                           factors[0], factors[1], factors[2])
-        for sweep in range(level_sweeps(sweeps, level)):
-            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 1)
-            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0)
+                           factors[0], factors[1], factors[2], 0, nx, 0)
+        for sweep in range(level_sweeps(sweeps, level + first_level)):
+            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 1, 0, nx)
+            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0, 0, nx)
         if level == 0 and local:
             for _ in range(listed_sweeps):
                 smooth_listed_cells(listed, rhs, x, red, stop)
@@ -855,7 +876,7 @@ def apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps):
 @kernel
 def _precondition(hierarchy, sweeps, singular, active_cells, row_sums, listed, listed_sweeps):
     """z = B r in corrections[0] (r in residuals[0]); closed tank: z's active mean removed."""
-    apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps)
+    apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps, 0)
     z = cell_array(hierarchy.corrections, hierarchy, 0)
     if singular:
         beta_x = face_array(hierarchy.beta_x, hierarchy, 0, 0)

@@ -1,0 +1,189 @@
+"""The processes of one run and what they say to each other.
+
+Why a class of our own over mpi4py: every solver asks for the same few things (a largest value, a
+sum in the one order a single process would add it, the planes next to its slab from its
+neighbours, a whole coarse grid gathered), and a run on one process must not need MPI at all. So
+``SingleProcess`` answers them for one process without importing mpi4py, and ``MpiProcesses``
+answers them over MPI. ``world()`` picks one: MPI only when a launcher (``mpiexec``, ``srun``)
+started more than one process.
+
+Sums in order: the fluid's reductions are formed per x-plane and the planes added in x order
+(``riprap/fluid/kernels/multigrid.py``). Every slab is a run of whole x-planes, so gathering the
+planes' partial sums in rank order and adding them one by one gives the single process's sum bit
+for bit (``ordered_sum``).
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from riprap.errors import RiprapError
+from riprap.parallel.kernels.ordered import ordered_largest, ordered_total
+
+__all__ = ["SingleProcess", "MpiProcesses", "world", "launched_processes", "ParallelError"]
+
+# The variables a launcher sets to the number of processes it started: MPICH and Intel MPI
+# (PMI_SIZE), Open MPI (OMPI_COMM_WORLD_SIZE), PMIx launchers (PMIX_SIZE is not standard; Open
+# MPI 5 sets OMPI_COMM_WORLD_SIZE too), Slurm's srun with --mpi (PMI_SIZE).
+_LAUNCHER_SIZE_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS")
+
+
+class ParallelError(RiprapError):
+    """A run over several processes cannot start or went wrong on one of them."""
+
+
+def launched_processes() -> int:
+    """How many processes the launcher started (1 when no launcher did)."""
+    for name in _LAUNCHER_SIZE_VARIABLES:
+        value = os.environ.get(name)
+        if value and value.isdigit():
+            return max(1, int(value))
+    return 1
+
+
+class SingleProcess:
+    """One process: every reduction is the value itself."""
+
+    rank = 0
+    size = 1
+    name = "one process"
+
+    def max(self, value: float) -> float:
+        return float(value)
+
+    def sum_int(self, value: int) -> int:
+        return int(value)
+
+    def any(self, flag: bool) -> bool:
+        return bool(flag)
+
+    def ordered_rows(self, rows: np.ndarray, counts) -> np.ndarray:
+        return np.ascontiguousarray(rows)
+
+    def ordered_sum(self, rows: np.ndarray, counts) -> float:
+        return float(ordered_total(np.ascontiguousarray(rows, dtype=np.float64)))
+
+    def gather_planes(self, local: np.ndarray, counts) -> np.ndarray:
+        return local
+
+    def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:
+        return None
+
+    def broadcast(self, value):
+        return value
+
+    def all_values(self, value) -> list:
+        return [value]
+
+    def barrier(self) -> None:
+        return None
+
+    def abort(self, code: int = 1) -> None:
+        raise SystemExit(code)
+
+
+class MpiProcesses:
+    """Processes of an MPI communicator (``mpi4py``); the slabs are ordered by rank."""
+
+    def __init__(self, comm):
+        from mpi4py import MPI  # lazy: only runs over several processes import MPI
+        self._mpi = MPI
+        self.comm = comm
+        self.rank = comm.Get_rank()
+        self.size = comm.Get_size()
+        self.name = f"process {self.rank} of {self.size}"
+        self._low = self.rank - 1 if self.rank > 0 else MPI.PROC_NULL
+        self._high = self.rank + 1 if self.rank < self.size - 1 else MPI.PROC_NULL
+
+    def max(self, value: float) -> float:
+        return float(self.comm.allreduce(float(value), op=self._mpi.MAX))
+
+    def sum_int(self, value: int) -> int:
+        return int(self.comm.allreduce(int(value), op=self._mpi.SUM))
+
+    def any(self, flag: bool) -> bool:
+        return bool(self.comm.allreduce(bool(flag), op=self._mpi.LOR))
+
+    def ordered_rows(self, rows: np.ndarray, counts) -> np.ndarray:
+        """Every process's ``rows`` (its planes' values, (n, ...) with n = counts[rank]) joined
+        in rank order, on every process."""
+        rows = np.ascontiguousarray(rows, dtype=np.float64)
+        per_row = int(np.prod(rows.shape[1:], dtype=np.int64))
+        counts = np.asarray(counts, dtype=np.int64) * per_row
+        out = np.empty((int(counts.sum() // max(per_row, 1)),) + rows.shape[1:])
+        displacements = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        self.comm.Allgatherv(rows, [out, counts, displacements, self._mpi.DOUBLE])
+        return out
+
+    def ordered_sum(self, rows: np.ndarray, counts) -> float:
+        """The sum of every process's per-plane partial sums, added in plane order from 0.0: what
+        one process adding all planes gets, bit for bit."""
+        return float(ordered_total(self.ordered_rows(rows, counts)))
+
+    def gather_planes(self, local: np.ndarray, counts) -> np.ndarray:
+        """The whole array from every process's planes (axis 0), on every process."""
+        return self.ordered_rows(local, counts)
+
+    def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:
+        """Planes of ``array`` along axis 0 to and from the neighbouring slabs: ``send_high``
+        (a slice) goes to the next process's ``receive_low``, ``send_low`` to the previous
+        one's ``receive_high``. Slices of a C-ordered array along axis 0 are contiguous, so no
+        copy is made."""
+        mpi = self._mpi
+        receive = np.empty_like(array[receive_low]) if self._low != mpi.PROC_NULL else None
+        self.comm.Sendrecv(np.ascontiguousarray(array[send_high]), dest=self._high, sendtag=1,
+                           recvbuf=receive if receive is not None else np.empty(0),
+                           source=self._low, recvtag=1)
+        if receive is not None:
+            array[receive_low] = receive
+        receive = np.empty_like(array[receive_high]) if self._high != mpi.PROC_NULL else None
+        self.comm.Sendrecv(np.ascontiguousarray(array[send_low]), dest=self._low, sendtag=2,
+                           recvbuf=receive if receive is not None else np.empty(0),
+                           source=self._high, recvtag=2)
+        if receive is not None:
+            array[receive_high] = receive
+
+    def broadcast(self, value):
+        return self.comm.bcast(value, root=0)
+
+    def all_values(self, value) -> list:
+        return self.comm.allgather(value)
+
+    def barrier(self) -> None:
+        self.comm.Barrier()
+
+    def abort(self, code: int = 1) -> None:
+        self.comm.Abort(code)
+
+
+def largest_of(values: np.ndarray) -> float:
+    return float(ordered_largest(np.ascontiguousarray(values, dtype=np.float64)))
+
+
+_WORLD = None
+
+
+def world():
+    """The processes of this run: ``MpiProcesses`` when a launcher started more than one (mpi4py
+    needed), else ``SingleProcess``. The same object on every call."""
+    global _WORLD
+    if _WORLD is not None:
+        return _WORLD
+    launched = launched_processes()
+    if launched <= 1:
+        _WORLD = SingleProcess()
+        return _WORLD
+    try:
+        from mpi4py import MPI  # lazy: a run on one process never initialises MPI
+    except ImportError as error:
+        raise ParallelError(
+            f"riprap was started as {launched} processes, but mpi4py is not installed, so they "
+            "cannot work as one run: install it with `python3 -m pip install 'riprap[mpi]'` "
+            "(mpi4py and the MPICH wheel), or run one process without mpiexec") from error
+    comm = MPI.COMM_WORLD
+    if comm.Get_size() == 1:
+        _WORLD = SingleProcess()
+    else:
+        _WORLD = MpiProcesses(comm)
+    return _WORLD
