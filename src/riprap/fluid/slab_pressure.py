@@ -200,7 +200,8 @@ class SlabPressureSolver:
     def _v_cycle(self, sweeps, listed, listed_sweeps) -> None:
         """levels[0].x = B levels[0].rhs on this slab (``multigrid.apply_v_cycle``'s cycle)."""
         red, stop = listed.red, listed.cells.shape[0]
-        local = listed_sweeps > 0 and stop > 0
+        # every process sweeps (and exchanges) when any one lists cells
+        local = listed_sweeps > 0 and self._any_listed
         for number, level in enumerate(self.levels):
             first_from_zero = True
             if number == 0 and local:
@@ -291,6 +292,7 @@ class SlabPressureSolver:
         pressure_sum = float(_ordered_total(rows[:, 2]))
         self._build_levels()
         listed = self._listed_stencils(listed_flat, red)
+        self._any_listed = self.comm.any(len(listed_flat) > 0)
         singular = not self.comm.any(_has_dirichlet_face(fine, self.comm))
         if singular:
             multigrid.subtract_on_active(*fine.beta, self._system_rhs, rhs_sum / active_cells)

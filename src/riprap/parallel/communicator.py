@@ -186,4 +186,23 @@ def world():
         _WORLD = SingleProcess()
     else:
         _WORLD = MpiProcesses(comm)
+        _end_all_on_uncaught_error(_WORLD)
     return _WORLD
+
+
+def _end_all_on_uncaught_error(processes: MpiProcesses) -> None:
+    """An error that escapes on one process ends every process of the run at once, with one
+    message naming the process: the others would otherwise wait for it in their next exchange
+    for ever. (Errors the run loop handles, such as an instability, are met by every process
+    together and end the run in order, with a checkpoint.)"""
+    import sys
+    import traceback
+
+    def end_all(kind, error, trace):
+        text = "".join(traceback.format_exception(kind, error, trace))
+        sys.stderr.write(f"riprap: {processes.name} failed; ending every process of the run.\n"
+                         f"{text}")
+        sys.stderr.flush()
+        processes.abort(1)
+
+    sys.excepthook = end_all
