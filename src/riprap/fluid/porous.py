@@ -165,9 +165,6 @@ class PorousMedium:
                 porous_face[tuple(boundary)] = False
             self.faces.append(np.flatnonzero(porous_face))
 
-    def water_volume(self, fraction, cell_volume: float) -> float:
-        return float(np.sum(self.porosity * fraction)) * cell_volume
-
 
 def _first_crossing(points: np.ndarray):
     """The first pair (i, j) of sides of the closed polygon ``points`` (n, 2) that meet, side i

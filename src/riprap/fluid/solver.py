@@ -39,12 +39,14 @@ from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.kernels import momentum, plic
 from riprap.fluid.kernels.face_speeds import largest_pore_speed, limit_air_faces
+from riprap.fluid.kernels.plane_sums import plane_sums, weighted_plane_sums
 from riprap.fluid.kernels.porous_faces import face_speeds_and_viscosities
 from riprap.fluid.kernels.sharp_density import cell_planes, face_densities
 from riprap.fluid.kernels.surface_tension import face_forces
 from riprap.fluid.phases import AIR_20C, WATER_20C, Phase
 from riprap.fluid.porous import PorousMedium
 from riprap.fluid.pressure import PressureSolver
+from riprap.parallel.kernels.ordered import ordered_total
 from riprap.schema import default_of, key
 from riprap.work_estimate import check_fluid_grid
 
@@ -68,13 +70,22 @@ class StepReport:
     pressure_capped: bool = False                  # the solve stopped at its iteration cap
 
 
+def boundary_inflow_planes(fluxes) -> tuple[np.ndarray, np.ndarray]:
+    """Water that came in through the box's sides in one advection (m^3), as (the x-low minus
+    x-high faces' total, (nx,) the y and z sides' per x-plane): the fluxes (positive along +axis)
+    on the lower faces minus those on the upper faces; walls carry none. Per plane, so that a
+    grid split into slabs adds the same numbers in the same order (``kernels/plane_sums.py``)."""
+    flux_x, flux_y, flux_z = fluxes[:3]
+    ends = float(plane_sums(flux_x[:1])[0]) - float(plane_sums(flux_x[-1:])[0])
+    sides = (plane_sums(flux_y[:, :1]) - plane_sums(flux_y[:, -1:])
+             + plane_sums(flux_z[:, :, :1]) - plane_sums(flux_z[:, :, -1:]))
+    return ends, sides
+
+
 def _boundary_inflow(fluxes) -> float:
-    """Water that came in through the box's sides in one advection (m^3): the fluxes (positive
-    along +axis) on the lower faces minus those on the upper faces; walls carry none."""
-    total = 0.0
-    for axis, flux in enumerate(fluxes[:3]):
-        total += float(np.take(flux, 0, axis=axis).sum()) - float(np.take(flux, -1, axis=axis).sum())
-    return total
+    """``boundary_inflow_planes`` added up (m^3)."""
+    ends, sides = boundary_inflow_planes(fluxes)
+    return ends + float(ordered_total(sides))
 
 
 def _box_overlap_fractions(grid: FluidGrid, lower, upper) -> np.ndarray:
@@ -177,8 +188,8 @@ class FluidSolver:
         self.water_added = 0.0
         self.boundary_code = np.array([_BOUNDARY_CODE[grid.boundaries[side]] for side in SIDES],
                                       dtype=np.int64)
-        self.pressure_solver = PressureSolver((nx, ny, nz), self.h, tolerance=pressure_tolerance,
-                                              volume_tolerance=pressure_volume_tolerance)
+        self.pressure_solver = self._new_pressure_solver((nx, ny, nz), self.h, pressure_tolerance,
+                                                         pressure_volume_tolerance)
         self.last_report = None
         self.last_pressure_seconds = 0.0
         #: Wave-making and absorbing zones (``riprap.waves.relaxation.WaveRelaxation``) blended in
@@ -195,6 +206,11 @@ class FluidSolver:
         self._porous_factors = None
         self.last_water_fluxes = None
         self._planes = None          # the mixed cells' PLIC planes (kernels.sharp_density), per step
+
+    def _new_pressure_solver(self, shape, cell_size, tolerance, volume_tolerance):
+        """The pressure solve of this grid (a split grid's blocks take their slab's instead)."""
+        return PressureSolver(shape, cell_size, tolerance=tolerance,
+                              volume_tolerance=volume_tolerance)
 
     # ------------------------------------------------------------------ set-up
     def add_water_box(self, lower, upper) -> None:
@@ -274,9 +290,13 @@ class FluidSolver:
 
     def water_volume(self) -> float:
         """Water in the box (m^3): in porous zones only their pores hold it."""
+        return float(ordered_total(self.water_volume_planes())) * self.h ** 3
+
+    def water_volume_planes(self) -> np.ndarray:
+        """(nx,) the water in each x-plane in cell volumes, added in a fixed order."""
         if self.porous is not None:
-            return self.porous.water_volume(self.fraction, self.h ** 3)
-        return float(self.fraction.sum()) * self.h ** 3
+            return weighted_plane_sums(self.fraction, self.porous.porosity)
+        return plane_sums(self.fraction)
 
     def _pore_speed(self) -> float:
         """Largest speed the water moves at: on each face |u| / n of the cells beside it (the
@@ -344,6 +364,10 @@ class FluidSolver:
         return step
 
     # ------------------------------------------------------------------ stepping
+    def _boundary_inflow(self, fluxes) -> float:
+        """Water that came in through the box's sides in one advection (m^3)."""
+        return _boundary_inflow(fluxes)
+
     def _advect_water(self, dt: float, velocities=None):
         u, v, w = velocities or (self.u, self.v, self.w)
         return plic.advect(self.fraction, u, v, w, dt, self.h, self.step_count,
@@ -415,7 +439,7 @@ class FluidSolver:
         water_fluxes = self._advect_water(dt, carriers)
         #: The water volumes (m^3) that crossed every face in the last step (overtopping gauges).
         self.last_water_fluxes = water_fluxes
-        self.water_added += _boundary_inflow(water_fluxes)
+        self.water_added += self._boundary_inflow(water_fluxes)
         area = h * h
         masses = [momentum.mass_fluxes(water_fluxes[a], velocity, dt, area, self.water.density,
                                        self.air.density)

@@ -1,0 +1,45 @@
+"""Run under ``mpiexec -n N``: a fluid case's steps on N processes against one process's; exits 1
+if any array of the whole grid differs in any bit. Usage: slab_fluid_check.py CASE STEPS [HALO]"""
+import sys
+
+import numpy as np
+
+from riprap.case.build_fluid import build_fluid_solver
+from riprap.case.load import load_case
+from riprap.fluid.slab_solver import HALO_PLANES, split_fluid
+from riprap.parallel.communicator import world
+
+
+def main():
+    case_path, steps = sys.argv[1], int(sys.argv[2])
+    halo = int(sys.argv[3]) if len(sys.argv) > 3 else HALO_PLANES
+    comm = world()
+    case = load_case(case_path)
+    serial = build_fluid_solver(case)
+    split = split_fluid(build_fluid_solver(case), comm, halo=halo)
+    worst = 0
+    for step in range(steps):
+        serial.step()
+        split.step()
+        whole = split.gather_whole(split.state_arrays())
+        expected = serial.state_arrays()
+        differing = [name for name in ("fraction", "u", "v", "w", "pressure")
+                     if not np.array_equal(whole[name], expected[name])]
+        clock_same = np.array_equal(whole["clock"], expected["clock"])
+        if differing or not clock_same:
+            if comm.rank == 0:
+                planes = {name: np.unique(np.nonzero(whole[name] != expected[name])[0]).tolist()[:10]
+                          for name in differing}
+                print(f"step {step + 1}: differ in {differing} at x-planes {planes}; clock "
+                      f"{'same' if clock_same else 'different'}: {whole['clock']} vs "
+                      f"{expected['clock']}", flush=True)
+            worst = 1
+            break
+    if comm.rank == 0 and not worst:
+        print(f"{steps} steps on {comm.size} processes (halo {halo}, slabs {split.cut.starts}): "
+              "bit for bit", flush=True)
+    sys.exit(worst)
+
+
+if __name__ == "__main__":
+    main()
