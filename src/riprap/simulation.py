@@ -23,6 +23,7 @@ import numpy as np
 from riprap.errors import CaseFileError, InstabilityError, RiprapError
 from riprap.io.checkpoint import load_checkpoint, save_checkpoint
 from riprap.io.output_folder import prepare_output_folder
+from riprap.parallel.communicator import world
 from riprap.io.summary import write_json
 from riprap.models import rigid
 from riprap.models.base import Model
@@ -94,6 +95,8 @@ class RunSummary:
     broken_area: float | None = None      # m^2, one side of the cracks
     pieces: int | None = None             # deformable bodies and fragments, each counted once
     fracture_energy: float | None = None  # J taken by the joints (stored and dissipated)
+    # a run over several processes: their count, the slabs' first x-planes, the halo depth
+    processes: dict | None = None
 
     def as_dict(self) -> dict:
         return {key: value for key, value in self.__dict__.items() if value is not None}
@@ -351,12 +354,17 @@ class Simulation:
         """
 
         out = self.output_directory
-        prepare_output_folder(out)
+        if world().rank == 0:
+            prepare_output_folder(out)
         if restart_from is not None:
             self.restart(restart_from)
         self.prepare()
         model = self.model
         writers = self.writers(model)
+        if not model.writes_files:
+            # the other processes of a split run keep the schedules (the steps land on them)
+            # and join the gathers, but write nothing
+            writers = [_Silent(writer) for writer in writers]
         schedules = self._open_writers(model, writers, out)
         last_written = {id(schedule): model.time for schedule, _ in schedules}
         if not self._restarted:
@@ -366,7 +374,7 @@ class Simulation:
         start_steps = model.step_count
         end_reason = "end_time"
         good = model.state_arrays()
-        with _Progress(self.progress, self.end_time,
+        with _Progress(self.progress and model.writes_files, self.end_time,
                        self.progress_label or model.name) as progress:
             stalled = 0
             while not model.reached(self.end_time):
@@ -413,6 +421,7 @@ class Simulation:
                 model.after_good_chunk()
         wall = wallclock.perf_counter() - start_wall
         frames = self._frame_index
+        model.prepare_outputs()
         for schedule, due in schedules:
             if model.time - last_written[id(schedule)] > 0.5 * model.last_time_step():
                 # The run ended between entries (at rest, or an end time off the schedule): its
@@ -430,7 +439,8 @@ class Simulation:
                              case_file=self.case_file,
                              smoke=os.environ.get("RIPRAP_SMOKE", "") == "1",
                              **model.summary_fields(wall, steps))
-        write_json(out / "summary.json", summary.as_dict())
+        if model.writes_files:
+            write_json(out / "summary.json", summary.as_dict())
         return summary
 
     def _open_writers(self, model, writers, directory) -> list:
@@ -460,6 +470,7 @@ class Simulation:
         return times
 
     def _write_entry(self, model, schedule, writers) -> None:
+        model.prepare_outputs()
         for writer in writers:
             writer.write(model, schedule.index)
         if model.reached(self.end_time):
@@ -587,7 +598,10 @@ class Simulation:
             metadata["schedules"] = own
         if self.run_definition is not None:
             metadata["case_record"] = self.run_definition.values
-        return save_checkpoint(self.output_directory / name, arrays=arrays, metadata=metadata)
+        path = self.output_directory / name
+        if not model.writes_files:
+            return path
+        return save_checkpoint(path, arrays=arrays, metadata=metadata)
 
     def check_restart(self, path) -> tuple[dict, dict]:
         """Every check of a restart from ``path`` (``riprap check --restart`` makes them too): a
@@ -739,6 +753,24 @@ class _Progress:
 
 #: The summary of a fluid run is the summary of any run (the name fluid runs had before).
 FluidRunSummary = RunSummary
+
+
+class _Silent:
+    """A writer of process 0 as the other processes of a split run hold it: the same name and
+    schedule, writing nothing."""
+
+    def __init__(self, writer):
+        self.name = writer.name
+        self.schedule = writer.schedule
+
+    def open(self, model, directory, *, append) -> None:
+        return None
+
+    def write(self, model, entry) -> None:
+        return None
+
+    def close(self, model) -> dict:
+        return {}
 
 
 class FluidRun(Simulation):

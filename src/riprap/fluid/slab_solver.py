@@ -216,7 +216,7 @@ def split_fluid(whole: FluidSolver, comm, *, halo: int = HALO_PLANES,
         max_time_step=whole.max_time_step, surface_tension=whole.surface_tension,
         limit_air_speed=whole.limit_air_speed)
     block.h = h                      # the whole grid's, bit for bit (the block's own may round)
-    block.comm, block.cut = comm, cut
+    block.comm, block.cut, block.halo = comm, cut, halo
     block.whole_cells = (nx, ny, nz)
     block.first, block.stop, block.low, block.high = first, stop, low, high
     block.owned = stop - first

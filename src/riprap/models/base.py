@@ -78,6 +78,16 @@ class Model:
     def check_checkpoint(self, path, arrays: dict, metadata: dict) -> None:
         """Refuse a checkpoint written for another case (raise RiprapError naming ``path``)."""
 
+    @property
+    def writes_files(self) -> bool:
+        """Whether this process writes the run's files (of a run over several processes, only
+        process 0 does)."""
+        return True
+
+    def prepare_outputs(self) -> None:
+        """Make the data the writers ask for current (a run over several processes gathers its
+        slabs here; every process calls it when outputs are due)."""
+
     def restore(self, arrays: dict) -> None:
         """Take the state of a checkpoint being restarted from."""
         self.load_state_arrays(arrays)

@@ -13,12 +13,15 @@ from riprap.coupling.coupled import CoupledSolver, _same_plane, fluid_box_walls
 from riprap.coupling.deformable_coupled import DeformableBodies, DeformableCoupledSolver
 from riprap.coupling.obstacles import add_obstacle_bodies, name_obstacles_in_overlap
 from riprap.errors import CaseFileError, OverlapError, RiprapError
+from riprap.fluid.slab_solver import split_fluid
 from riprap.models.base import Model
 from riprap.models.deformable import DeformableModel
 from riprap.models.deformable_coupled import DeformableCoupledModel
 from riprap.models.fluid import CoupledModel, FluidModel
 from riprap.models.rigid import RigidModel, build_bodies, prepare_bodies
 from riprap.models.settings import ModelSettings
+from riprap.models.slab_fluid import SlabFluidModel
+from riprap.parallel.communicator import world
 from riprap.scene.scene import Scene
 from riprap.work_estimate import check_deformable_run
 
@@ -153,6 +156,19 @@ def _deformable_coupled_model(scene: Scene, settings: ModelSettings,
     return DeformableCoupledModel(coupled, stresses)
 
 
+def _slab_fluid_model(scene: Scene, settings: ModelSettings, restarted: bool) -> SlabFluidModel:
+    """The fluid alone over the processes of the run: each steps a slab of x-planes."""
+    processes = world()
+    return SlabFluidModel(split_fluid(scene.fluid, processes), scene.fluid)
+
+
+def _not_yet_over_processes(scene: Scene, settings: ModelSettings, restarted: bool) -> Model:
+    held = sorted(scene.holds() - {"several processes"})
+    raise CaseFileError(
+        f"this run holds {', '.join(held) or 'nothing'}: over several processes riprap runs so "
+        "far the fluid alone (no bodies); run this case on one process (without mpiexec)")
+
+
 #: Every model riprap has, with the scenes it serves (what ``Scene.holds()``: "rigid bodies",
 #: "deformable bodies", "fluid", "coupled solver").
 MODEL_BUILDERS: list[ModelBuilder] = [
@@ -170,4 +186,15 @@ MODEL_BUILDERS: list[ModelBuilder] = [
                         ("deformable bodies", "coupled solver"),
                         ("deformable bodies", "coupled solver", "rigid bodies")),
                  _deformable_coupled_model),
+    ModelBuilder("slab_fluid", scenes(("fluid", "several processes")), _slab_fluid_model),
+    ModelBuilder("not_yet_over_processes",
+                 scenes(("several processes",), ("rigid bodies", "several processes"),
+                        ("fluid", "rigid bodies", "several processes"),
+                        ("coupled solver", "several processes"),
+                        ("coupled solver", "rigid bodies", "several processes"),
+                        ("deformable bodies", "several processes"),
+                        ("deformable bodies", "rigid bodies", "several processes"),
+                        ("deformable bodies", "fluid", "several processes"),
+                        ("deformable bodies", "fluid", "rigid bodies", "several processes")),
+                 _not_yet_over_processes),
 ]

@@ -23,6 +23,7 @@ from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
 from riprap.solid.solver import SolidSolver
 from riprap.solid.walls import Wall
+from riprap.parallel.communicator import world
 
 __all__ = ["Scene", "DEFAULT_GRAVITY"]
 
@@ -66,7 +67,8 @@ class Scene:
     def holds(self) -> frozenset[str]:
         """What the scene holds, the key by which a model is chosen: any of "rigid bodies",
         "deformable bodies", "fluid" (a FluidSolver) and "coupled solver" (a CoupledSolver built
-        by the caller, which brings its own bodies)."""
+        by the caller, which brings its own bodies); and "several processes" when the run was
+        started over several (``mpiexec -n N``)."""
         held = set()
         if self.solver.n_bodies > 0:
             held.add("rigid bodies")
@@ -74,6 +76,8 @@ class Scene:
             held.add("deformable bodies")
         if self.fluid is not None:
             held.add("coupled solver" if isinstance(self.fluid, CoupledSolver) else "fluid")
+        if world().size > 1:
+            held.add("several processes")
         return frozenset(held)
 
     @property

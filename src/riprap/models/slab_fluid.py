@@ -1,0 +1,60 @@
+"""Air and water over several processes (``riprap/fluid/slab_solver.py``), as a model of the run
+loop: every process steps its block; the frames, the tables and the summary are those of one
+process's run, written by process 0 from the whole grid gathered there when they are due.
+
+Why gather for the outputs: a run's files are then the same whichever number of processes made
+them (the tests compare them bit for bit), and every reader of riprap's outputs (``riprap
+analyse``, the series, the reports) reads them unchanged. The gather costs one message of the
+slab's planes per frame, not per step.
+"""
+from __future__ import annotations
+
+from riprap.models.fluid import FluidModel
+
+__all__ = ["SlabFluidModel"]
+
+
+class SlabFluidModel(FluidModel):
+    """``FluidModel`` of a block (``SlabFluidSolver``); ``whole`` the whole grid's FluidSolver
+    that the writers read (refreshed by ``prepare_outputs``)."""
+
+    kind = "riprap fluid run"          # its checkpoints are one process's: any number restarts
+    name = "fluid"
+
+    def __init__(self, block, whole):
+        super().__init__(block)
+        self.whole = whole
+        self.processes = block.comm
+
+    @property
+    def fluid(self):
+        # the writers' and the reports' fluid: the whole grid (its clock is the block's)
+        return self.whole
+
+    @property
+    def writes_files(self) -> bool:
+        return self.processes.rank == 0
+
+    def _after_step(self, dt: float, report) -> None:
+        self.whole.last_report = self.solver.last_report
+        self.whole.last_air_limit = self.solver.last_air_limit
+        super()._after_step(dt, report)
+
+    def prepare_outputs(self) -> None:
+        """The whole grid's state from every process's slab (every process calls it)."""
+        block = self.solver
+        whole_state = block.gather_whole(block.state_arrays())
+        self.whole.load_state_arrays(whole_state)
+
+    def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
+        """One process's checkpoint of the whole grid (every process calls it): it restarts on
+        any number of processes."""
+        whole_state = self.solver.gather_whole(state)
+        return super().checkpoint_content(whole_state)
+
+    def summary_fields(self, wall_time: float, steps: int) -> dict:
+        fields = super().summary_fields(wall_time, steps)
+        block = self.solver
+        fields["processes"] = {"count": block.comm.size, "slabs": list(block.cut.starts),
+                               "halo_planes": block.halo}
+        return fields
