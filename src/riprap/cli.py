@@ -31,6 +31,7 @@ from riprap.case.load import load_case
 from riprap.errors import CaseFileError, RiprapError, plain_numbers
 from riprap.io.json_files import read_json_object
 from riprap.io.output_folder import describe_os_error
+from riprap.parallel.communicator import launched_processes, world
 from riprap.solid.kernels.pair_rule import PAIR_RULE_TEXT
 from riprap.work_estimate import RiprapWarning
 from riprap.workflows.analyse import analyse, compare_layers
@@ -340,10 +341,14 @@ def main(argv: list[str] | None = None) -> int:
     import warnings
 
     args = _parser().parse_args(argv)
+    several = launched_processes() > 1
+    if several and world().rank != 0:
+        # the other processes of a run over several say nothing but their errors
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - held for the process's life
     if os.environ.get("RIPRAP_TRACEBACK", "") == "1":
         return _dispatch(args)
     previous = warnings.showwarning
-    warnings.showwarning = _show_warning
+    warnings.showwarning = _show_warning if not (several and world().rank != 0) else _silent
     try:
         return _dispatch(args)
     except RiprapError as error:
@@ -368,4 +373,14 @@ def main(argv: list[str] | None = None) -> int:
               "please report it)", file=sys.stderr)
     finally:
         warnings.showwarning = previous
+    if several:
+        # The other processes may be waiting for this one: end them all now, not at a timeout.
+        processes = world()
+        print(f"riprap: {processes.name} stopped the run (the error above); ending every "
+              "process", file=sys.stderr, flush=True)
+        processes.abort(2)
     return 2
+
+
+def _silent(*args, **kwargs) -> None:
+    """Warnings of the other processes of a split run: process 0 shows them once."""
