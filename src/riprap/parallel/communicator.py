@@ -15,6 +15,7 @@ for bit (``ordered_sum``).
 from __future__ import annotations
 
 import os
+import time
 
 import numpy as np
 
@@ -95,25 +96,47 @@ class MpiProcesses:
         self.name = f"process {self.rank} of {self.size}"
         self._low = self.rank - 1 if self.rank > 0 else MPI.PROC_NULL
         self._high = self.rank + 1 if self.rank < self.size - 1 else MPI.PROC_NULL
+        #: What this process sent and how long it waited, per kind (``traffic``): halo and ghost
+        #: exchanges with the neighbours, reductions and gathers over all processes.
+        self.traffic = {kind: {"messages": 0, "bytes": 0, "seconds": 0.0}
+                        for kind in ("exchange", "reduction", "gather")}
+
+    def _count(self, kind: str, started: float, sent_bytes: int, messages: int = 1) -> None:
+        entry = self.traffic[kind]
+        entry["messages"] += messages
+        entry["bytes"] += int(sent_bytes)
+        entry["seconds"] += time.perf_counter() - started
 
     def max(self, value: float) -> float:
-        return float(self.comm.allreduce(float(value), op=self._mpi.MAX))
+        started = time.perf_counter()
+        result = float(self.comm.allreduce(float(value), op=self._mpi.MAX))
+        self._count("reduction", started, 8)
+        return result
 
     def sum_int(self, value: int) -> int:
-        return int(self.comm.allreduce(int(value), op=self._mpi.SUM))
+        started = time.perf_counter()
+        result = int(self.comm.allreduce(int(value), op=self._mpi.SUM))
+        self._count("reduction", started, 8)
+        return result
 
     def any(self, flag: bool) -> bool:
-        return bool(self.comm.allreduce(bool(flag), op=self._mpi.LOR))
+        started = time.perf_counter()
+        result = bool(self.comm.allreduce(bool(flag), op=self._mpi.LOR))
+        self._count("reduction", started, 1)
+        return result
 
     def ordered_rows(self, rows: np.ndarray, counts) -> np.ndarray:
         """Every process's ``rows`` (its planes' values, (n, ...) with n = counts[rank]) joined
         in rank order, on every process."""
+        started = time.perf_counter()
         rows = np.ascontiguousarray(rows, dtype=np.float64)
         per_row = int(np.prod(rows.shape[1:], dtype=np.int64))
         counts = np.asarray(counts, dtype=np.int64) * per_row
         out = np.empty((int(counts.sum() // max(per_row, 1)),) + rows.shape[1:])
         displacements = np.concatenate([[0], np.cumsum(counts)[:-1]])
         self.comm.Allgatherv(rows, [out, counts, displacements, self._mpi.DOUBLE])
+        # a few numbers per plane are a reduction; whole planes of a grid are a gather
+        self._count("reduction" if per_row <= 3 else "gather", started, rows.nbytes)
         return out
 
     def ordered_sum(self, rows: np.ndarray, counts) -> float:
@@ -131,6 +154,7 @@ class MpiProcesses:
         one's ``receive_high``. Slices of a C-ordered array along axis 0 are contiguous, so no
         copy is made."""
         mpi = self._mpi
+        started = time.perf_counter()
         receive = np.empty_like(array[receive_low]) if self._low != mpi.PROC_NULL else None
         self.comm.Sendrecv(np.ascontiguousarray(array[send_high]), dest=self._high, sendtag=1,
                            recvbuf=receive if receive is not None else np.empty(0),
@@ -143,12 +167,19 @@ class MpiProcesses:
                            source=self._high, recvtag=2)
         if receive is not None:
             array[receive_high] = receive
+        sent = array[send_high].nbytes * (self._high != mpi.PROC_NULL) \
+            + array[send_low].nbytes * (self._low != mpi.PROC_NULL)
+        self._count("exchange", started, sent,
+                    int(self._high != mpi.PROC_NULL) + int(self._low != mpi.PROC_NULL))
 
     def broadcast(self, value):
         return self.comm.bcast(value, root=0)
 
     def all_values(self, value) -> list:
-        return self.comm.allgather(value)
+        started = time.perf_counter()
+        result = self.comm.allgather(value)
+        self._count("reduction", started, 64)
+        return result
 
     def barrier(self) -> None:
         self.comm.Barrier()
