@@ -139,7 +139,7 @@ pack = "pack/pack.toml"
 end_time = 60.0
 adaptive_time_step = true
 output_interval = 5.0
-checkpoint_interval = 20.0
+checkpoint_interval = 5.0
 
 [fluid]
 lower = [{1.5 - round(length / CELL) * CELL:.4f}, {-CELL / 2}, 0.0]
