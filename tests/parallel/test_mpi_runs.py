@@ -78,6 +78,16 @@ def test_dam_break_over_two_processes_and_restarts(tmp_path):
         assert same_state(one / "checkpoint.npz", folder / "checkpoint.npz"), folder.name
 
 
+def test_wave_flume_over_two_processes():
+    """examples/09's regular waves (wave-making and absorbing zones, eight surface gauges), 600
+    steps of 0.01 s (the waves cross the cut at x = 6.32 m from t of about 5 s): the whole
+    grid and every gauge's record bit for bit those of one process, compared every 100 steps."""
+    case = ROOT / "examples" / "09_regular_waves" / "case.toml"
+    result = launch(2, sys.executable, str(HERE / "slab_fluid_check.py"), str(case), "600", "8",
+                    "100", timeout=1200)
+    assert "bit for bit" in result.stdout, result.stdout
+
+
 def test_a_killed_process_ends_the_run(tmp_path):
     """One process of two killed mid-run: the launcher ends the other, within 30 s."""
     longer = tmp_path / "long.toml"

@@ -178,15 +178,17 @@ class SlabFluidSolver(FluidSolver):
         super().load_state_arrays(arrays)
 
 
-def split_fluid(whole: FluidSolver, comm, *, halo: int = HALO_PLANES,
-                plane_costs=None) -> SlabFluidSolver:
+def split_fluid(whole: FluidSolver, comm, *, halo: int = HALO_PLANES, plane_costs=None,
+                add_parts=None) -> SlabFluidSolver:
     """This process's block of ``whole`` (built the same on every process), cut into slabs of
     x-planes balancing ``plane_costs``. The block's arrays are copies of ``whole``'s; its ends
-    inside the grid are walls that only the halo sees."""
+    inside the grid are walls that only the halo sees. ``add_parts(block, whole)`` gives the
+    block whole's porous zones, waves and gauges (``riprap/models/slab_features.py``); without
+    it a fluid that has any is refused."""
     unsupported = [name for name, present in (
         ("porous zones", whole.porous is not None), ("waves", whole.wave_source is not None),
         ("gauges", whole.gauges is not None)) if present]
-    if unsupported:
+    if unsupported and add_parts is None:
         raise CaseFileError(f"a fluid with {', '.join(unsupported)} cannot yet run over several "
                             "processes; run it on one (without mpiexec)")
     nx, ny, nz = whole.grid.cells
@@ -226,6 +228,8 @@ def split_fluid(whole: FluidSolver, comm, *, halo: int = HALO_PLANES,
                               volume_tolerance=whole.pressure_solver.volume_tolerance)
     block.pressure_solver = _BlockPressure(slab, low, stop - first, high)
     block.obstacle_boxes = list(whole.obstacle_boxes)
+    if add_parts is not None:
+        add_parts(block, whole)
     state = whole.state_arrays()
     block.load_state_arrays(block.block_of(state))
     block.water_added = whole.water_added

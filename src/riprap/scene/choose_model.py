@@ -20,6 +20,7 @@ from riprap.models.deformable_coupled import DeformableCoupledModel
 from riprap.models.fluid import CoupledModel, FluidModel
 from riprap.models.rigid import RigidModel, build_bodies, prepare_bodies
 from riprap.models.settings import ModelSettings
+from riprap.models.slab_features import add_parts_to_block
 from riprap.models.slab_fluid import SlabFluidModel
 from riprap.parallel.communicator import world
 from riprap.scene.scene import Scene
@@ -159,14 +160,16 @@ def _deformable_coupled_model(scene: Scene, settings: ModelSettings,
 def _slab_fluid_model(scene: Scene, settings: ModelSettings, restarted: bool) -> SlabFluidModel:
     """The fluid alone over the processes of the run: each steps a slab of x-planes."""
     processes = world()
-    return SlabFluidModel(split_fluid(scene.fluid, processes), scene.fluid)
+    return SlabFluidModel(split_fluid(scene.fluid, processes, add_parts=add_parts_to_block),
+                          scene.fluid)
 
 
 def _not_yet_over_processes(scene: Scene, settings: ModelSettings, restarted: bool) -> Model:
     held = sorted(scene.holds() - {"several processes"})
     raise CaseFileError(
         f"this run holds {', '.join(held) or 'nothing'}: over several processes riprap runs so "
-        "far the fluid alone (no bodies); run this case on one process (without mpiexec)")
+        "far the fluid alone (no bodies; porous zones, waves and gauges included); run this "
+        "case on one process (without mpiexec)")
 
 
 #: Every model riprap has, with the scenes it serves (what ``Scene.holds()``: "rigid bodies",
