@@ -50,6 +50,10 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
             raise CaseFileError(f"{path} is a test series: it resumes by itself from its steps' "
                                 "checkpoints when run again into the same --out folder; drop "
                                 "--restart")
+        if launched_processes() > 1:
+            raise CaseFileError(f"{path} is a test series: its steps run on one process each; "
+                                "start it without mpiexec (riprap campaign spreads series over "
+                                "machines)")
         return _series_case(path, case, out, quiet)
     if case.is_fluid:
         sim = build_fluid_run(case, output_directory=out, progress=not quiet)
@@ -300,7 +304,16 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+# The commands a run over several processes (mpiexec -n N) carries out together; the others would
+# each do the whole job on every process, writing the same files at once.
+_SPLIT_COMMANDS = ("run", "demo")
+
+
 def _dispatch(args) -> int:
+    if launched_processes() > 1 and args.command not in _SPLIT_COMMANDS:
+        raise CaseFileError(f"riprap {args.command} runs on one process: start it without mpiexec "
+                            f"(only {' and '.join(_SPLIT_COMMANDS)} spread one run over several "
+                            "processes)")
     if args.command == "demo":
         from importlib.resources import as_file, files
 

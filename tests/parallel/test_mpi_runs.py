@@ -119,7 +119,8 @@ def test_a_killed_process_ends_the_run(tmp_path):
 
 def test_refusals_name_the_figure(tmp_path):
     """More processes than the grid can be cut into; a restart from another case's checkpoint;
-    bodies over several processes (not yet): refused, every process ended, nothing hangs."""
+    bodies over several processes (not yet); a command other than run under mpiexec: refused,
+    every process ended, nothing hangs."""
     small = tmp_path / "small.toml"
     small.write_text(DAM_BREAK.read_text()
                      .replace("upper = [0.28575, 0.002286, 0.144018]",
@@ -139,6 +140,8 @@ def test_refusals_name_the_figure(tmp_path):
     result = riprap(2, "run", str(rock), "--out", str(tmp_path / "rock"), check=False,
                     timeout=120)
     assert result.returncode != 0 and "fluid alone" in result.stderr, result.stderr[-2000:]
+    result = riprap(2, "analyse", str(tmp_path / "small_one"), check=False, timeout=120)
+    assert result.returncode != 0 and "runs on one process" in result.stderr, result.stderr[-2000:]
 
 
 def test_without_mpi4py_asking_for_processes_says_what_to_install(monkeypatch):
