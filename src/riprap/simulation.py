@@ -361,7 +361,7 @@ class Simulation:
         self.prepare()
         model = self.model
         writers = self.writers(model)
-        if not model.writes_files:
+        if not _writes_files(model):
             # the other processes of a split run keep the schedules (the steps land on them)
             # and join the gathers, but write nothing
             writers = [_Silent(writer) for writer in writers]
@@ -374,7 +374,7 @@ class Simulation:
         start_steps = model.step_count
         end_reason = "end_time"
         good = model.state_arrays()
-        with _Progress(self.progress and model.writes_files, self.end_time,
+        with _Progress(self.progress and _writes_files(model), self.end_time,
                        self.progress_label or model.name) as progress:
             stalled = 0
             while not model.reached(self.end_time):
@@ -421,7 +421,7 @@ class Simulation:
                 model.after_good_chunk()
         wall = wallclock.perf_counter() - start_wall
         frames = self._frame_index
-        model.prepare_outputs()
+        _prepare_outputs(model)
         for schedule, due in schedules:
             if model.time - last_written[id(schedule)] > 0.5 * model.last_time_step():
                 # The run ended between entries (at rest, or an end time off the schedule): its
@@ -439,7 +439,7 @@ class Simulation:
                              case_file=self.case_file,
                              smoke=os.environ.get("RIPRAP_SMOKE", "") == "1",
                              **model.summary_fields(wall, steps))
-        if model.writes_files:
+        if _writes_files(model):
             write_json(out / "summary.json", summary.as_dict())
         return summary
 
@@ -470,7 +470,7 @@ class Simulation:
         return times
 
     def _write_entry(self, model, schedule, writers) -> None:
-        model.prepare_outputs()
+        _prepare_outputs(model)
         for writer in writers:
             writer.write(model, schedule.index)
         if model.reached(self.end_time):
@@ -599,7 +599,7 @@ class Simulation:
         if self.run_definition is not None:
             metadata["case_record"] = self.run_definition.values
         path = self.output_directory / name
-        if not model.writes_files:
+        if not _writes_files(model):
             return path
         return save_checkpoint(path, arrays=arrays, metadata=metadata)
 
@@ -753,6 +753,18 @@ class _Progress:
 
 #: The summary of a fluid run is the summary of any run (the name fluid runs had before).
 FluidRunSummary = RunSummary
+
+
+def _writes_files(model) -> bool:
+    """Whether this process writes the run's files (a model of one's own, not a
+    ``riprap.models.base.Model``, always does)."""
+    return bool(getattr(model, "writes_files", True))
+
+
+def _prepare_outputs(model) -> None:
+    prepare = getattr(model, "prepare_outputs", None)
+    if prepare is not None:
+        prepare()
 
 
 class _Silent:
