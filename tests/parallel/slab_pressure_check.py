@@ -2,6 +2,7 @@
 1000:1 problems (3D with drops and bubbles, 2D, a closed tank, listed cells); prints one line per
 problem and exits 1 if a slab's pressure differs from the one process's in any bit."""
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -10,40 +11,13 @@ from riprap.fluid.slab_pressure import DISTRIBUTED_LEVELS, SlabPressureSolver
 from riprap.parallel.communicator import world
 from riprap.parallel.slabs import cut_slabs
 
-WATER, AIR = 1000.0, 1.2
-
-
-def face_coefficients(density, open_top=True):
-    nx, ny, nz = density.shape
-    beta_x = np.zeros((nx + 1, ny, nz))
-    beta_y = np.zeros((nx, ny + 1, nz))
-    beta_z = np.zeros((nx, ny, nz + 1))
-    beta_x[1:-1] = 2.0 / (density[1:] + density[:-1])
-    if ny > 1:
-        beta_y[:, 1:-1] = 2.0 / (density[:, 1:] + density[:, :-1])
-    beta_z[:, :, 1:-1] = 2.0 / (density[:, :, 1:] + density[:, :, :-1])
-    if open_top:
-        beta_z[:, :, -1] = 1.0 / density[:, :, -1]
-    return beta_x, beta_y, beta_z
-
-
-def blob_density(shape, seed):
-    rng = np.random.default_rng(seed)
-    nx, ny, nz = shape
-    x, y, z = np.meshgrid((np.arange(nx) + 0.5) / nx, (np.arange(ny) + 0.5) / ny,
-                          (np.arange(nz) + 0.5) / nz, indexing="ij")
-    density = np.where(z < 0.45 + 0.1 * np.sin(7.0 * x) * np.cos(5.0 * y), WATER, AIR)
-    for _ in range(12):
-        centre = rng.random(3)
-        radius = 0.05 + 0.12 * rng.random()
-        inside = (x - centre[0]) ** 2 + (y - centre[1]) ** 2 * (ny > 1) + (z - centre[2]) ** 2
-        density = np.where(inside < radius ** 2, WATER if rng.random() < 0.5 else AIR, density)
-    return density
-
+# the one-process solver's tests' 1000:1 problems
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "unit"))
+from test_fluid_pressure import blob_density, face_coefficients  # noqa: E402
 
 def check(name, shape, seed, open_top=True, listed=False, comm=None):
     density = blob_density(shape, seed)
-    beta = face_coefficients(density, open_top)
+    beta = face_coefficients(density, open_top=open_top)
     rng = np.random.default_rng(seed + 1)
     rhs = rng.standard_normal(shape)
     guess = rng.standard_normal(shape) * 10.0

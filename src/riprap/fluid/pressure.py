@@ -46,7 +46,8 @@ from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.kernels import multigrid
 
 __all__ = ["PressureSolver", "PressureSolveReport", "apply_operator", "build_hierarchy",
-           "level_shapes", "build_levels", "outcome_report", "face_view", "cell_view"]
+           "level_shapes", "build_levels", "outcome_report", "face_view", "cell_view",
+           "listed_stencils_of"]
 
 # Coarsening stops once a level has at most this many cells; the coarsest level is then factored
 # directly (banded Cholesky, cost cells x (ny nz)^2: about a million operations for 8 x 8 x 8).
@@ -155,6 +156,19 @@ def outcome_report(iterations, relative_residual, largest, outcome, dt2, toleran
                                f"tolerance {tolerance:.1e}, grid {tuple(shape)}")
     return PressureSolveReport(int(iterations), float(relative_residual), volume_change,
                                bool(capped))
+
+
+def listed_stencils_of(betas, inverse_h2, cells, red) -> multigrid.ListedCells:
+    """The ``multigrid.ListedCells`` of ``cells`` (flat indices, ``red`` of them first) with
+    the face coefficients ``betas`` (three arrays) and ``inverse_h2`` (3,) 1/h^2."""
+    n = len(cells)
+    listed = multigrid.ListedCells(cells=cells, neighbours=np.zeros((n, 6), dtype=np.int64),
+                                   couplings=np.zeros((n, 6)), inverse_diagonal=np.zeros(n),
+                                   red=red)
+    if n:
+        multigrid.listed_stencils(*betas, *inverse_h2, cells, listed.neighbours, listed.couplings,
+                                  listed.inverse_diagonal)
+    return listed
 
 
 def level_shapes(shape) -> tuple[list, list]:
@@ -294,16 +308,8 @@ class PressureSolver:
 
     def _listed_stencils(self, cells, red):
         """The ``multigrid.ListedCells`` of ``cells`` with level 0's present coefficients."""
-        n = len(cells)
-        listed = multigrid.ListedCells(cells=cells, neighbours=np.zeros((n, 6), dtype=np.int64),
-                                       couplings=np.zeros((n, 6)), inverse_diagonal=np.zeros(n),
-                                       red=red)
-        if n:
-            inverse_h2 = self._hierarchy.inverse_spacing_squared[0]
-            multigrid.listed_stencils(*(self._face_view(0, axis) for axis in range(3)),
-                                      *inverse_h2, cells, listed.neighbours, listed.couplings,
-                                      listed.inverse_diagonal)
-        return listed
+        return listed_stencils_of([self._face_view(0, axis) for axis in range(3)],
+                                  self._hierarchy.inverse_spacing_squared[0], cells, red)
 
     def solve(self, beta_x, beta_y, beta_z, rhs, p_initial=None, listed_cells=None,
               time_step=None):

@@ -32,7 +32,8 @@ from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.kernels import multigrid
 from riprap.fluid.pressure import (LISTED_SWEEPS, SMOOTHING_SWEEPS, PressureSolveReport,
                                    _listed_cells, build_hierarchy, build_levels, cell_view,
-                                   face_view, level_shapes, outcome_report)
+                                   face_view, level_shapes, listed_stencils_of,
+                                   outcome_report)
 from riprap.parallel.kernels.ordered import ordered_largest, ordered_total
 
 __all__ = ["SlabPressureSolver", "DISTRIBUTED_LEVELS"]
@@ -176,15 +177,8 @@ class SlabPressureSolver:
         build_levels(whole)
 
     def _listed_stencils(self, cells, red):
-        n = len(cells)
-        listed = multigrid.ListedCells(cells=cells, neighbours=np.zeros((n, 6), dtype=np.int64),
-                                       couplings=np.zeros((n, 6)), inverse_diagonal=np.zeros(n),
-                                       red=red)
-        if n:
-            fine = self.levels[0]
-            multigrid.listed_stencils(*fine.beta, *fine.inverse_h2, cells, listed.neighbours,
-                                      listed.couplings, listed.inverse_diagonal)
-        return listed
+        fine = self.levels[0]
+        return listed_stencils_of(fine.beta, fine.inverse_h2, cells, red)
 
     # ------------------------------------------------------------------ the V-cycle
     def _smooth(self, level: _Level, colour: int) -> None:

@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 from riprap.errors import RiprapError
-from riprap.parallel.kernels.ordered import ordered_largest, ordered_total
+from riprap.parallel.kernels.ordered import ordered_total
 
 __all__ = ["SingleProcess", "MpiProcesses", "world", "launched_processes", "ParallelError"]
 
@@ -186,10 +186,6 @@ class MpiProcesses:
 
     def abort(self, code: int = 1) -> None:
         self.comm.Abort(code)
-
-
-def largest_of(values: np.ndarray) -> float:
-    return float(ordered_largest(np.ascontiguousarray(values, dtype=np.float64)))
 
 
 _WORLD = None
