@@ -269,8 +269,8 @@ class CoupledSolver:
         if self._carried is not None:
             fluid = self.fluid
             axis, index, values = self._carried
-            speed = float(listed_pore_speed(fluid.fraction, axis, index, values, fluid.open_part,
-                                            fluid.limit_air_speed))
+            speed = self._largest(float(listed_pore_speed(fluid.fraction, axis, index, values,
+                                                          fluid.open_part, fluid.limit_air_speed)))
             if speed > 0.0:
                 step = min(step, self.fluid.courant_number * self.fluid.h / speed)
         return step
@@ -494,7 +494,7 @@ class CoupledSolver:
         for a in range(3):
             loads[:, a] = np.bincount(body, vectors[:, a], minlength=len(loads))
             loads[:, 3 + a] = np.bincount(body, moments[:, a], minlength=len(loads))
-        return loads
+        return self._totals(loads)[0]
 
     def _check_bodies_in_grid(self) -> None:
         """Refuse a body that reaches outside the fluid box, or a moving body narrower than
@@ -678,9 +678,9 @@ class CoupledSolver:
         rhs = self._own_momentum(faces, centres, predicted, densities, rho_fluid, pressure_impulse,
                                  fluid_term, free)
         final = np.zeros((solids.n_bodies, 6))
-        entry_start = faces.entries[0]
+        in_fluid = self._bodies_with_faces(faces)
         for b in np.flatnonzero(free):
-            if entry_start[b + 1] > entry_start[b]:
+            if in_fluid[b]:
                 final[b] = np.linalg.solve(matrices[b], rhs[b])
             else:   # no face in the fluid (thrown out of the box): it flies on by itself
                 final[b] = predicted[b]
@@ -728,15 +728,39 @@ class CoupledSolver:
         n = self.solids.n_bodies
         matrices, body, rhs = np.zeros((n, 6, 6)), np.zeros((n, 6, 6)), np.zeros((n, len(velocities), 6))
         chosen = np.ones(n, dtype=np.bool_) if bodies is None else np.asarray(bodies, dtype=np.bool_)
-        rigid_coupling.momentum_systems(self._body_faces(faces), centres, densities, faces.phi,
+        rigid_coupling.momentum_systems(self._summed_faces(faces), centres, densities, faces.phi,
                                         rho_fluid, np.array(velocities), np.array(unaccounted),
                                         with_matrices, chosen, matrices, body, rhs)
-        return matrices, body, rhs
+        if with_matrices:
+            return self._totals(matrices, body, rhs)
+        return (matrices, body) + self._totals(rhs)
 
     def _body_faces(self, faces) -> rigid_coupling.BodyFaces:
         """The face set as the coupling kernels take it."""
         return rigid_coupling.BodyFaces(*faces.entries, faces.axis, faces.index, self._lower,
                                         self.fluid.h)
+
+    # The hooks of a coupling over several processes (riprap.coupling.slab_coupled): which faces
+    # each body's sums run over, and how the sums of all processes are added.
+    def _summed_faces(self, faces) -> rigid_coupling.BodyFaces:
+        """The entries each body's momentum sums run over: all of the set's."""
+        return self._body_faces(faces)
+
+    def _summed_face_mask(self, faces) -> np.ndarray:
+        """Which faces of the set the sums count (bool per face): all."""
+        return np.ones(len(faces.axis), dtype=bool)
+
+    def _totals(self, *arrays) -> tuple:
+        """Per-body sums over every process's faces: one process's are whole already."""
+        return arrays
+
+    def _largest(self, value: float) -> float:
+        """The largest of a value over every process's faces."""
+        return value
+
+    def _bodies_with_faces(self, faces) -> np.ndarray:
+        """Which bodies have any face in the fluid (bool per body)."""
+        return np.diff(faces.entries[0]) > 0
 
     def _porous_factors(self, faces) -> np.ndarray:
         """The fluid's porous factor (``FluidSolver._porous_factors``) on each face of the set;
@@ -767,10 +791,10 @@ class CoupledSolver:
                       fluid_term, bodies):
         """``rigid_coupling.own_momentum_rhs`` (bodies, 6) for the chosen bodies (bool each)."""
         rhs = np.zeros((self.solids.n_bodies, 6))
-        rigid_coupling.own_momentum_rhs(self._body_faces(faces), centres, motions, densities,
+        rigid_coupling.own_momentum_rhs(self._summed_faces(faces), centres, motions, densities,
                                         faces.phi, rho_fluid, pressure_impulse, fluid_term,
                                         np.asarray(bodies, dtype=np.bool_), rhs)
-        return rhs
+        return self._totals(rhs)[0]
 
     # ------------------------------------------------------------------ loads for the outputs
     # The loads on fixed bodies (and the pressure/viscous split) only go to the outputs: they are
@@ -826,10 +850,12 @@ class CoupledSolver:
         leaves the velocity as it was), so only the touched faces are summed."""
         volume = self.fluid.h ** 3
         balance = np.zeros(3)
+        counted = self._summed_face_mask(faces)
         for a in range(3):
-            on = faces.interior & (faces.axis == a)
+            on = faces.interior & (faces.axis == a) & counted
             balance[a] = volume * (np.sum((fluid_share * (after - before))[on])
                                    - np.sum(face_impulse[on]))
+        balance = self._totals(balance)[0]
         bodies = np.einsum("bij,bj->bi", body_matrices[free], final[free] - predicted[free])
         return balance + bodies[:, :3].sum(axis=0)
 

@@ -114,13 +114,18 @@ class SlabFluidSolver(FluidSolver):
 
     def exchange_halos(self) -> None:
         """The halo planes of the state from the neighbours' slabs."""
-        low, owned, high = self.low, self.owned, self.high
         for name, axis in _STATE:
-            array = getattr(self, name)
-            faces = 1 if axis == 0 else 0
-            self.comm.exchange(array, slice(low + faces, low + faces + low),
-                               slice(0, low), slice(low + owned - high, low + owned),
-                               slice(low + owned + faces, low + owned + faces + high))
+            self.exchange_planes(getattr(self, name), on_x_faces=axis == 0)
+
+    def exchange_planes(self, array: np.ndarray, *, on_x_faces: bool = False) -> None:
+        """The halo planes of a block array (of the cells, or of the faces of x) from the
+        neighbours' slabs, in place. The x-face between two slabs is each side's own and not
+        sent (both compute it alike)."""
+        low, owned, high = self.low, self.owned, self.high
+        faces = 1 if on_x_faces else 0
+        self.comm.exchange(array, slice(low + faces, low + faces + low),
+                           slice(0, low), slice(low + owned - high, low + owned),
+                           slice(low + owned + faces, low + owned + faces + high))
 
     def _check_finite(self) -> None:
         message = ""

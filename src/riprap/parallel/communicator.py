@@ -68,6 +68,9 @@ class SingleProcess:
     def gather_planes(self, local: np.ndarray, counts) -> np.ndarray:
         return local
 
+    def sum_arrays(self, values: np.ndarray) -> np.ndarray:
+        return np.array(values, dtype=np.float64)
+
     def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:
         return None
 
@@ -147,6 +150,20 @@ class MpiProcesses:
     def gather_planes(self, local: np.ndarray, counts) -> np.ndarray:
         """The whole array from every process's planes (axis 0), on every process."""
         return self.ordered_rows(local, counts)
+
+    def sum_arrays(self, values: np.ndarray) -> np.ndarray:
+        """Every process's ``values`` (the same shape on all) added element by element in rank
+        order, the same bits on every process (an MPI sum's order may differ between
+        processes; this one's does not)."""
+        started = time.perf_counter()
+        values = np.ascontiguousarray(values, dtype=np.float64)
+        every = np.empty((self.size,) + values.shape)
+        self.comm.Allgather(values, every)
+        total = every[0].copy()
+        for rank in range(1, self.size):
+            total += every[rank]
+        self._count("reduction", started, values.nbytes)
+        return total
 
     def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:
         """Planes of ``array`` along axis 0 to and from the neighbouring slabs: ``send_high``

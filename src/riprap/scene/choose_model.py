@@ -11,6 +11,7 @@ from typing import Callable
 
 from riprap.coupling.coupled import CoupledSolver, _same_plane, fluid_box_walls
 from riprap.coupling.deformable_coupled import DeformableBodies, DeformableCoupledSolver
+from riprap.coupling.slab_coupled import SlabCoupledSolver
 from riprap.coupling.obstacles import add_obstacle_bodies, name_obstacles_in_overlap
 from riprap.errors import CaseFileError, OverlapError, RiprapError
 from riprap.fluid.slab_solver import split_fluid
@@ -21,6 +22,7 @@ from riprap.models.fluid import CoupledModel, FluidModel
 from riprap.models.rigid import RigidModel, build_bodies, prepare_bodies
 from riprap.models.settings import ModelSettings
 from riprap.models.slab_features import add_parts_to_block
+from riprap.models.slab_coupled import SlabCoupledModel
 from riprap.models.slab_fluid import SlabFluidModel
 from riprap.parallel.communicator import world
 from riprap.scene.scene import Scene
@@ -164,12 +166,23 @@ def _slab_fluid_model(scene: Scene, settings: ModelSettings, restarted: bool) ->
                           scene.fluid)
 
 
+def _slab_coupled_model(scene: Scene, settings: ModelSettings,
+                        restarted: bool) -> SlabCoupledModel:
+    """Rigid bodies in the flow over the processes of the run: the whole coupling built as on
+    one process (walls, checks, the fixed bodies' deep cells closed), then each process's block
+    of its fluid, every process stepping every body."""
+    whole = _coupled_model(scene, settings, restarted).solver
+    block = split_fluid(whole.fluid, world(), add_parts=add_parts_to_block)
+    return SlabCoupledModel(SlabCoupledSolver(block, whole), whole)
+
+
 def _not_yet_over_processes(scene: Scene, settings: ModelSettings, restarted: bool) -> Model:
     held = sorted(scene.holds() - {"several processes"})
     raise CaseFileError(
         f"this run holds {', '.join(held) or 'nothing'}: over several processes riprap runs so "
-        "far the fluid alone (no bodies; porous zones, waves and gauges included); run this "
-        "case on one process (without mpiexec)")
+        "far the fluid alone and rigid bodies in a flow (porous zones, waves and gauges "
+        "included), not bodies without a fluid nor deformable bodies; run this case on one "
+        "process (without mpiexec)")
 
 
 #: Every model riprap has, with the scenes it serves (what ``Scene.holds()``: "rigid bodies",
@@ -190,11 +203,13 @@ MODEL_BUILDERS: list[ModelBuilder] = [
                         ("deformable bodies", "coupled solver", "rigid bodies")),
                  _deformable_coupled_model),
     ModelBuilder("slab_fluid", scenes(("fluid", "several processes")), _slab_fluid_model),
+    ModelBuilder("slab_coupled",
+                 scenes(("fluid", "rigid bodies", "several processes"),
+                        ("coupled solver", "several processes"),
+                        ("coupled solver", "rigid bodies", "several processes")),
+                 _slab_coupled_model),
     ModelBuilder("not_yet_over_processes",
                  scenes(("several processes",), ("rigid bodies", "several processes"),
-                        ("fluid", "rigid bodies", "several processes"),
-                        ("coupled solver", "several processes"),
-                        ("coupled solver", "rigid bodies", "several processes"),
                         ("deformable bodies", "several processes"),
                         ("deformable bodies", "rigid bodies", "several processes"),
                         ("deformable bodies", "fluid", "several processes"),

@@ -1,0 +1,66 @@
+"""Bodies in a flow over several processes (``riprap/coupling/slab_coupled.py``), as a model of
+the run loop: every process steps its block of the fluid and every body; the frames, the tables
+and the summary are those of one process's run, written by process 0 from the whole grid
+gathered there when they are due (as ``riprap/models/slab_fluid.py`` does for the fluid alone).
+"""
+from __future__ import annotations
+
+from riprap.models.fluid import CoupledModel
+
+__all__ = ["SlabCoupledModel"]
+
+
+class SlabCoupledModel(CoupledModel):
+    """``CoupledModel`` of a block (``SlabCoupledSolver``); ``whole`` the whole grid's
+    CoupledSolver, whose fluid the writers read (refreshed by ``prepare_outputs``) and whose
+    bodies are the block's."""
+
+    kind = "riprap coupled run"     # its checkpoints are one process's: any number restarts
+    name = "coupled"
+
+    def __init__(self, coupled, whole):
+        super().__init__(coupled)
+        self.whole = whole
+        self.processes = coupled.comm
+
+    @property
+    def fluid(self):
+        # the writers' and the reports' fluid: the whole grid (its clock is the block's)
+        return self.whole.fluid
+
+    @property
+    def step_count(self) -> int:
+        return self.solver.fluid.step_count
+
+    @property
+    def writes_files(self) -> bool:
+        return self.processes.rank == 0
+
+    def _after_step(self, dt: float, report) -> None:
+        block = self.solver.fluid
+        self.whole.fluid.last_report = block.last_report
+        self.whole.fluid.last_air_limit = block.last_air_limit
+        super()._after_step(dt, report)
+
+    def prepare_outputs(self) -> None:
+        """The whole grid's state from every process's slab, and the loads that only the
+        outputs read, summed over the processes (every process calls it)."""
+        coupled = self.solver
+        whole_state = coupled.fluid.gather_whole(coupled.fluid.state_arrays())
+        self.whole.fluid.load_state_arrays(whole_state)
+        coupled.fixed_body_loads       # noqa: B018 - summed now, on every process together
+
+    def body_fraction(self):
+        return self.whole.body_fraction()
+
+    def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
+        """One process's checkpoint of the whole grid (every process calls it): it restarts on
+        any number of processes."""
+        return super().checkpoint_content(self.solver.whole_state(state))
+
+    def summary_fields(self, wall_time: float, steps: int) -> dict:
+        fields = super().summary_fields(wall_time, steps)
+        block = self.solver.fluid
+        fields["processes"] = {"count": block.comm.size, "slabs": list(block.cut.starts),
+                               "halo_planes": block.halo}
+        return fields
