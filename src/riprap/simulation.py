@@ -360,6 +360,10 @@ class Simulation:
             self.restart(restart_from)
         self.prepare()
         model = self.model
+        if self.progress and _writes_files(model) and hasattr(model, "split_lines"):
+            print(f"riprap: split over {world().size} processes by x-planes:", flush=True)
+            for line in model.split_lines():
+                print(f"riprap:   {line}", flush=True)
         writers = self.writers(model)
         if not _writes_files(model):
             # the other processes of a split run keep the schedules (the steps land on them)

@@ -119,7 +119,8 @@ def test_a_killed_process_ends_the_run(tmp_path):
 
 def test_refusals_name_the_figure(tmp_path):
     """More processes than the grid can be cut into; a restart from another case's checkpoint;
-    bodies over several processes (not yet); a command other than run under mpiexec: refused,
+    deformable bodies over several processes (not yet); a command other than run under mpiexec:
+    refused,
     every process ended, nothing hangs."""
     small = tmp_path / "small.toml"
     small.write_text(DAM_BREAK.read_text()
@@ -136,10 +137,11 @@ def test_refusals_name_the_figure(tmp_path):
     result = riprap(2, "run", str(DAM_BREAK), "--out", str(tmp_path / "other"), "--restart",
                     str(tmp_path / "small_one" / "checkpoint.npz"), check=False, timeout=120)
     assert result.returncode != 0 and "cells was [16,1,63]" in result.stderr, result.stderr[-2000:]
-    rock = ROOT / "examples" / "01_rock_drop" / "case.toml"
-    result = riprap(2, "run", str(rock), "--out", str(tmp_path / "rock"), check=False,
+    impact = ROOT / "examples" / "07_unit_impact" / "case.toml"
+    result = riprap(2, "run", str(impact), "--out", str(tmp_path / "impact"), check=False,
                     timeout=120)
-    assert result.returncode != 0 and "fluid alone" in result.stderr, result.stderr[-2000:]
+    assert result.returncode != 0 and "not deformable bodies" in result.stderr, \
+        result.stderr[-2000:]
     result = riprap(2, "analyse", str(tmp_path / "small_one"), check=False, timeout=120)
     assert result.returncode != 0 and "runs on one process" in result.stderr, result.stderr[-2000:]
 

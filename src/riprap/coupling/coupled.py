@@ -291,7 +291,7 @@ class CoupledSolver:
         if self.adaptive_substep:
             # the next sub-step follows the contacts of the last force evaluation, which a
             # checkpoint does not hold (the solids make them again only at their next step)
-            arrays["coupling_contact_rate"] = np.array([contact_stability_rate(self.solids)])
+            arrays["coupling_contact_rate"] = np.array([self._contact_rate()])
         return arrays
 
     def load_state_arrays(self, arrays: dict) -> None:
@@ -322,6 +322,17 @@ class CoupledSolver:
     def body_fraction(self) -> np.ndarray:
         """Solid fraction of every cell held by the bodies, at their present poses (nx, ny, nz)."""
         return self._solid_volumes().solid_fraction()
+
+    def body_cells_per_x_plane(self) -> np.ndarray:
+        """How many cells of the exchange (cells holding some body, not closed) each x-plane of
+        the grid has, at the bodies' present poses: the coupling's work per plane."""
+        self._clip_moved_bodies()
+        cells = tuple(int(n) for n in self._cells)
+        flat = [index for index, _ in self._cell_lists if len(index)]
+        if not flat:
+            return np.zeros(cells[0])
+        return np.bincount(np.concatenate(flat) // (cells[1] * cells[2]),
+                           minlength=cells[0]).astype(np.float64)
 
     # ------------------------------------------------------------------ helpers
     def _solid_volumes(self):
@@ -758,6 +769,10 @@ class CoupledSolver:
         """The largest of a value over every process's faces."""
         return value
 
+    def _contact_rate(self) -> float:
+        """The contacts' stability rate (``contact_stability_rate``) over every process's."""
+        return contact_stability_rate(self.solids)
+
     def _bodies_with_faces(self, faces) -> np.ndarray:
         """Which bodies have any face in the fluid (bool per body)."""
         return np.diff(faces.entries[0]) > 0
@@ -865,7 +880,7 @@ class CoupledSolver:
         solids = self.solids
         rate = self._restored_contact_rate
         if rate is None:
-            rate = contact_stability_rate(solids)
+            rate = self._contact_rate()
         self._restored_contact_rate = None
         target = SUBSTEP_TARGET_RATIO / rate if rate > 0.0 else math.inf
         self.solid_time_step = min(self.solid_time_step * SUBSTEP_GROWTH, target,
@@ -884,5 +899,5 @@ class CoupledSolver:
         solids.torques += change[:, 3:]
         solids.external_loads[:] = self.fluid_loads
         solids.advance(substeps)
-        self.last_stability_ratio = solids.time_step * contact_stability_rate(solids)
+        self.last_stability_ratio = solids.time_step * self._contact_rate()
         return substeps

@@ -5,6 +5,8 @@ gathered there when they are due (as ``riprap/models/slab_fluid.py`` does for th
 """
 from __future__ import annotations
 
+import numpy as np
+
 from riprap.models.fluid import CoupledModel
 
 __all__ = ["SlabCoupledModel"]
@@ -49,6 +51,13 @@ class SlabCoupledModel(CoupledModel):
         whole_state = coupled.fluid.gather_whole(coupled.fluid.state_arrays())
         self.whole.fluid.load_state_arrays(whole_state)
         coupled.fixed_body_loads       # noqa: B018 - summed now, on every process together
+
+    def split_lines(self) -> list[str]:
+        """The split of the run over the processes, a line per process (printed at the start)."""
+        block = self.solver.fluid
+        grid = self.whole.fluid.grid
+        planes = np.floor((self.solids.positions[:, 0] - grid.lower[0]) / grid.cell_size)
+        return block.cut.describe(grid.cells[1] * grid.cells[2], planes.astype(int))
 
     def body_fraction(self):
         return self.whole.body_fraction()

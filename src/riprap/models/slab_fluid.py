@@ -46,6 +46,11 @@ class SlabFluidModel(FluidModel):
         whole_state = block.gather_whole(block.state_arrays())
         self.whole.load_state_arrays(whole_state)
 
+    def split_lines(self) -> list[str]:
+        """The split of the run over the processes, a line per process (printed at the start)."""
+        cells = self.whole.grid.cells
+        return self.solver.cut.describe(cells[1] * cells[2])
+
     def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
         """One process's checkpoint of the whole grid (every process calls it): it restarts on
         any number of processes."""

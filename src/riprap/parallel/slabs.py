@@ -46,6 +46,22 @@ class SlabCut:
         edges = [-(-start // scale) for start in self.starts]
         return [edges[r + 1] - edges[r] for r in range(self.processes)]
 
+    def describe(self, plane_cells: int, body_planes=None) -> list[str]:
+        """One line per slab: its x-planes and cells (``plane_cells`` per plane) and, given the
+        x-plane of each body's centre, the bodies whose centre it holds."""
+        owners = (None if body_planes is None else
+                  np.bincount([self.owner_of_plane(p) for p in body_planes],
+                              minlength=self.processes))
+        lines = []
+        for rank in range(self.processes):
+            planes = self.stop(rank) - self.first(rank)
+            text = (f"process {rank}: x-planes {self.first(rank)}..{self.stop(rank) - 1}, "
+                    f"{planes * plane_cells:,} cells")
+            if owners is not None:
+                text += f", {owners[rank]} bodies' centres"
+            lines.append(text)
+        return lines
+
     def owner_of_plane(self, plane: int) -> int:
         """The process whose slab holds x-plane ``plane`` (clipped into the grid)."""
         plane = min(max(int(plane), 0), self.cells - 1)

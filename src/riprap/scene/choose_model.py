@@ -11,7 +11,7 @@ from typing import Callable
 
 from riprap.coupling.coupled import CoupledSolver, _same_plane, fluid_box_walls
 from riprap.coupling.deformable_coupled import DeformableBodies, DeformableCoupledSolver
-from riprap.coupling.slab_coupled import SlabCoupledSolver
+from riprap.coupling.slab_coupled import SlabCoupledSolver, coupled_plane_costs
 from riprap.coupling.obstacles import add_obstacle_bodies, name_obstacles_in_overlap
 from riprap.errors import CaseFileError, OverlapError, RiprapError
 from riprap.fluid.slab_solver import split_fluid
@@ -24,6 +24,7 @@ from riprap.models.settings import ModelSettings
 from riprap.models.slab_features import add_parts_to_block
 from riprap.models.slab_coupled import SlabCoupledModel
 from riprap.models.slab_fluid import SlabFluidModel
+from riprap.models.split_rigid import SplitRigidModel
 from riprap.parallel.communicator import world
 from riprap.scene.scene import Scene
 from riprap.work_estimate import check_deformable_run
@@ -166,13 +167,23 @@ def _slab_fluid_model(scene: Scene, settings: ModelSettings, restarted: bool) ->
                           scene.fluid)
 
 
+def _split_rigid_model(scene: Scene, settings: ModelSettings,
+                       restarted: bool = False) -> SplitRigidModel:
+    """Rigid bodies without a fluid over the processes of the run: the contact pairs shared."""
+    return SplitRigidModel(scene.solver, processes=world(), meshes=scene.meshes,
+                           shape_names=scene.shape_names, settings=settings,
+                           accepted_overlaps=scene.accepted_overlaps,
+                           container_box=scene.container_box)
+
+
 def _slab_coupled_model(scene: Scene, settings: ModelSettings,
                         restarted: bool) -> SlabCoupledModel:
     """Rigid bodies in the flow over the processes of the run: the whole coupling built as on
     one process (walls, checks, the fixed bodies' deep cells closed), then each process's block
     of its fluid, every process stepping every body."""
     whole = _coupled_model(scene, settings, restarted).solver
-    block = split_fluid(whole.fluid, world(), add_parts=add_parts_to_block)
+    block = split_fluid(whole.fluid, world(), add_parts=add_parts_to_block,
+                        plane_costs=coupled_plane_costs(whole))
     return SlabCoupledModel(SlabCoupledSolver(block, whole), whole)
 
 
@@ -180,9 +191,9 @@ def _not_yet_over_processes(scene: Scene, settings: ModelSettings, restarted: bo
     held = sorted(scene.holds() - {"several processes"})
     raise CaseFileError(
         f"this run holds {', '.join(held) or 'nothing'}: over several processes riprap runs so "
-        "far the fluid alone and rigid bodies in a flow (porous zones, waves and gauges "
-        "included), not bodies without a fluid nor deformable bodies; run this case on one "
-        "process (without mpiexec)")
+        "far the fluid alone, rigid bodies in a flow (porous zones, waves and gauges included) "
+        "and rigid bodies alone, not deformable bodies; run this case on one process (without "
+        "mpiexec)")
 
 
 #: Every model riprap has, with the scenes it serves (what ``Scene.holds()``: "rigid bodies",
@@ -203,14 +214,15 @@ MODEL_BUILDERS: list[ModelBuilder] = [
                         ("deformable bodies", "coupled solver", "rigid bodies")),
                  _deformable_coupled_model),
     ModelBuilder("slab_fluid", scenes(("fluid", "several processes")), _slab_fluid_model),
+    ModelBuilder("split_rigid", scenes(("rigid bodies", "several processes")),
+                 _split_rigid_model),
     ModelBuilder("slab_coupled",
                  scenes(("fluid", "rigid bodies", "several processes"),
                         ("coupled solver", "several processes"),
                         ("coupled solver", "rigid bodies", "several processes")),
                  _slab_coupled_model),
     ModelBuilder("not_yet_over_processes",
-                 scenes(("several processes",), ("rigid bodies", "several processes"),
-                        ("deformable bodies", "several processes"),
+                 scenes(("several processes",), ("deformable bodies", "several processes"),
                         ("deformable bodies", "rigid bodies", "several processes"),
                         ("deformable bodies", "fluid", "several processes"),
                         ("deformable bodies", "fluid", "rigid bodies", "several processes")),

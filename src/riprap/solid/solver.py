@@ -65,6 +65,9 @@ class SolidSolver:
         never the forces. None: a tenth of the smallest median boundary sub-tet height; 0: no reuse.
         """
         self.gravity = np.asarray(gravity, dtype=np.float64)
+        #: The processes the contact pairs are shared among (``split_contacts_over``); None: all
+        #: evaluated here.
+        self._processes = None
         if not 0.0 <= local_damping < 1.0:
             raise CaseFileError(f"local_damping = {local_damping!r} must be in [0, 1)")
         if contact_skin is not None and not contact_skin >= 0.0:
@@ -361,6 +364,15 @@ class SolidSolver:
             "contact candidate buffer overflowed: a shape has too many tets per lookup cell; "
             "re-mesh it more uniformly or report this as a bug")
 
+    def split_contacts_over(self, processes) -> None:
+        """Share the contact pairs among ``processes`` (``riprap.parallel.communicator``): every
+        process steps every body, evaluates the pairs it owns (``stepper.owner_of_pair``, each
+        pair on one process for its whole life, with its spring) and adds its sums to the
+        rest after every force evaluation (``stepper.first_half_step``): the forces, the
+        springs, the contact records and the bodies are then those of one process, bit for bit,
+        on every process."""
+        self._processes = processes if processes.size > 1 else None
+
     def advance(self, n_steps: int) -> None:
         """Advance ``n_steps`` time steps in compiled code.
 
@@ -370,6 +382,9 @@ class SolidSolver:
         self.finalize()
         if n_steps <= 0:
             return
+        if self._processes is not None:
+            self._advance_split(n_steps)
+            return
         system, motion, history, settings = self._kernel_state(self.time_step)
         (done, status, history, results, body_pairs, wall_pairs, self._omegas,
          self._piece_cache) = stepper.advance(int(n_steps), system, motion, self._omegas, history,
@@ -377,6 +392,42 @@ class SolidSolver:
         self.history_keys, self.history_springs = history
         self.step_count += int(done)
         self.time = self.step_count * self.time_step if self._time_origin is None else self._time_origin + (self.step_count - self._step_origin) * self.time_step
+        self._store_results(results, body_pairs, wall_pairs)
+        if status == stepper.STATUS_OVERFLOW:
+            self._raise_overflow()
+        if status == stepper.STATUS_NOT_FINITE:
+            self.check_finite()
+
+    def _advance_split(self, n_steps: int) -> None:
+        """``advance`` with the contact pairs shared among the processes: each step's halves in
+        compiled code (``stepper.first_half_step``, ``second_half_step``), every process's
+        rows of contact results joined between them."""
+        processes = self._processes
+        system, motion, history, settings = self._kernel_state(self.time_step)
+        status, done = stepper.STATUS_OK, 0
+        omegas, cache = self._omegas, self._piece_cache
+        results = body_pairs = wall_pairs = None
+        for step in range(n_steps):
+            (body_pairs, wall_pairs, owners, own_rows, omegas, cache,
+             key_stride) = stepper.first_half_step(system, motion, omegas, history, settings,
+                                                   cache, processes.rank, processes.size)
+            results = np.empty((len(owners), interactions.C_SIZE))
+            for rank, rows in enumerate(processes.all_values(own_rows)):
+                results[owners == rank] = rows
+            history, overflow, finite = stepper.second_half_step(
+                system, motion, omegas, settings, body_pairs, wall_pairs, results, key_stride)
+            done = step + 1
+            if overflow:
+                status = stepper.STATUS_OVERFLOW
+                break
+            if not finite:
+                status = stepper.STATUS_NOT_FINITE
+                break
+        self._omegas, self._piece_cache = omegas, cache
+        self.history_keys, self.history_springs = history
+        self.step_count += int(done)
+        self.time = (self.step_count * self.time_step if self._time_origin is None else
+                     self._time_origin + (self.step_count - self._step_origin) * self.time_step)
         self._store_results(results, body_pairs, wall_pairs)
         if status == stepper.STATUS_OVERFLOW:
             self._raise_overflow()
