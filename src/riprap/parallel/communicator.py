@@ -71,6 +71,9 @@ class SingleProcess:
     def sum_arrays(self, values: np.ndarray) -> np.ndarray:
         return np.array(values, dtype=np.float64)
 
+    def join_rows(self, rows: np.ndarray, counts) -> np.ndarray:
+        return np.array(rows, dtype=np.float64)
+
     def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:
         return None
 
@@ -164,6 +167,19 @@ class MpiProcesses:
             total += every[rank]
         self._count("reduction", started, values.nbytes)
         return total
+
+    def join_rows(self, rows: np.ndarray, counts) -> np.ndarray:
+        """Every process's ``rows`` (counts[p], ...) one after the other in rank order, on every
+        process."""
+        started = time.perf_counter()
+        rows = np.ascontiguousarray(rows, dtype=np.float64)
+        per_row = int(np.prod(rows.shape[1:], dtype=np.int64))
+        counts = np.asarray(counts, dtype=np.int64) * per_row
+        out = np.empty((int(counts.sum()) // max(per_row, 1),) + rows.shape[1:])
+        displacements = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        self.comm.Allgatherv(rows, [out, counts, displacements, self._mpi.DOUBLE])
+        self._count("reduction", started, rows.nbytes)
+        return out
 
     def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:
         """Planes of ``array`` along axis 0 to and from the neighbouring slabs: ``send_high``

@@ -411,9 +411,11 @@ class SolidSolver:
             (body_pairs, wall_pairs, owners, own_rows, omegas, cache,
              key_stride) = stepper.first_half_step(system, motion, omegas, history, settings,
                                                    cache, processes.rank, processes.size)
+            # every process's rows, in rank order, put back in the broad phase's order
+            order = np.argsort(owners, kind="stable")
+            joined = processes.join_rows(own_rows, np.bincount(owners, minlength=processes.size))
             results = np.empty((len(owners), interactions.C_SIZE))
-            for rank, rows in enumerate(processes.all_values(own_rows)):
-                results[owners == rank] = rows
+            results[order] = joined
             history, overflow, finite = stepper.second_half_step(
                 system, motion, omegas, settings, body_pairs, wall_pairs, results, key_stride)
             done = step + 1
