@@ -148,3 +148,27 @@ def test_rigid_bodies_alone_over_two_and_three_processes(tmp_path):
         summary = json.loads((out / "summary.json").read_text())
         assert summary["processes"]["count"] == processes
         assert summary["contacts"] == json.loads((one / "summary.json").read_text())["contacts"]
+
+
+def test_deformable_body_in_water_over_two_processes_and_restarts(tmp_path):
+    """tests/parallel/cases/deformable_block.toml: a soft block sinking across the cut (every
+    process steps its elements; the pressure on its surface is the whole grid's, joined from the
+    slabs): nodes, stresses and fluid as on one process; stopped at 0.02 s on 2 processes and
+    continued on 1, and the other way round."""
+    case = HERE / "cases" / "deformable_block.toml"
+    one, two = tmp_path / "one", tmp_path / "two"
+    riprap(1, "run", str(case), "--out", str(one))
+    riprap(2, "run", str(case), "--out", str(two))
+    assert json.loads((two / "summary.json").read_text())["processes"]["slabs"] == [0, 12, 24]
+    assert_close_states(one / "checkpoint.npz", two / "checkpoint.npz")
+    assert_close_tables(one / "body_forces.csv", two / "body_forces.csv")
+    half = shortened(case, tmp_path, 0.02, "half")
+    try:
+        for first, then, folder in ((2, 1, tmp_path / "two_then_one"),
+                                    (1, 2, tmp_path / "one_then_two")):
+            riprap(first, "run", str(half), "--out", str(folder))
+            riprap(then, "run", str(case), "--out", str(folder), "--restart",
+                   str(folder / "checkpoint.npz"))
+            assert_close_states(one / "checkpoint.npz", folder / "checkpoint.npz")
+    finally:
+        half.unlink()

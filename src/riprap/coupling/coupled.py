@@ -402,7 +402,11 @@ class CoupledSolver:
 
     def _clip(self, stale) -> list:
         """Half-cell volume blocks of the ``stale`` bodies where ``_block_poses`` puts them."""
-        return rigid_body_half_cell_volumes(self.fluid.grid, self.solids, bodies=stale,
+        return self._clip_on(self.fluid.grid, stale)
+
+    def _clip_on(self, grid, stale) -> list:
+        """``_clip`` on the cells of ``grid``."""
+        return rigid_body_half_cell_volumes(grid, self.solids, bodies=stale,
                                             poses=self._block_poses[stale])
 
     def _cell_list(self, block):

@@ -455,7 +455,7 @@ class DeformableCoupledSolver(CoupledSolver):
                 k = body - n_rigid
                 clipped_nodes[offsets[k]:offsets[k + 1]] = nodes[offsets[k]:offsets[k + 1]]
 
-    def _clip(self, stale) -> list:
+    def _clip_on(self, grid, stale) -> list:
         bodies = self.solids
         stale = np.asarray(stale, dtype=np.int64)
         poses, nodes = self._split(self._block_poses)
@@ -463,7 +463,7 @@ class DeformableCoupledSolver(CoupledSolver):
         deformable = stale[stale >= bodies.n_rigid] - bodies.n_rigid
         blocks = {}
         if len(rigid):
-            fresh = rigid_body_half_cell_volumes(self.fluid.grid, bodies.rigid, bodies=rigid,
+            fresh = rigid_body_half_cell_volumes(grid, bodies.rigid, bodies=rigid,
                                                  poses=poses[rigid])
             blocks.update(zip(rigid.tolist(), fresh))
         if len(deformable):
@@ -473,7 +473,7 @@ class DeformableCoupledSolver(CoupledSolver):
                 part = bodies.triangles[bodies.triangle_start[k]:bodies.triangle_start[k + 1]]
                 parts.append(part)
                 starts.append(starts[-1] + len(part))
-            fresh = half_cell_volumes(self.fluid.grid, nodes, np.concatenate(parts),
+            fresh = half_cell_volumes(grid, nodes, np.concatenate(parts),
                                       np.asarray(starts, dtype=np.int64))
             blocks.update(zip((deformable + bodies.n_rigid).tolist(), fresh))
         return [blocks[int(body)] for body in stale]
@@ -504,7 +504,12 @@ class DeformableCoupledSolver(CoupledSolver):
                     f"needs at least {MINIMUM_CELLS_ACROSS} cells across: cells of "
                     f"{diameters[b] / MINIMUM_CELLS_ACROSS:.3g} m or smaller")
 
-    def _reference_pressure(self) -> float:
+    def _bodies_pressure(self):
+        """(the pressure over the cells the bodies' surfaces may be in, its grid's lower corner,
+        its obstacle cells): the fluid's own."""
+        return self.fluid.pressure, self._lower, self.fluid.solid
+
+    def _reference_pressure(self, pressure, solid) -> float:
         """The pressure the bodies' surfaces take as zero (Pa). Under an open top the solver's
         pressure is already the atmosphere's gauge. A closed box fixes its pressure only up to a
         constant (the solver's has zero mean): the mean of its top layer of cells is taken as
@@ -512,14 +517,15 @@ class DeformableCoupledSolver(CoupledSolver):
         depends on it: a constant pressure on a closed surface has no resultant."""
         if self.fluid.grid.open_top:
             return 0.0
-        top = ~self.fluid.solid[:, :, -1]
-        return float(self.fluid.pressure[:, :, -1][top].mean()) if top.any() else 0.0
+        top = ~solid[:, :, -1]
+        return float(pressure[:, :, -1][top].mean()) if top.any() else 0.0
 
     def _advance_solids(self, dt: float) -> int:
         bodies = self.solids
         # the loads' torques are about the centres of the step's start, where the nodes still are
-        bodies.apply_fluid_loads(self.fluid_loads, self.fluid.pressure, self._lower, self.fluid.h,
-                                 self._reference_pressure(), duration=dt)
+        pressure, lower, solid = self._bodies_pressure()
+        bodies.apply_fluid_loads(self.fluid_loads, pressure, lower, self.fluid.h,
+                                 self._reference_pressure(pressure, solid), duration=dt)
         substeps = max(1, math.ceil(dt / self.solid_time_step - 1e-9))
         check_substeps(substeps, dt, self.solid_time_step)
         system, every, done = bodies.system, self.steps_between_calls, 0

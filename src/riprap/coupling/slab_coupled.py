@@ -26,10 +26,11 @@ from __future__ import annotations
 import numpy as np
 
 from riprap.coupling.coupled import CoupledSolver
+from riprap.coupling.deformable_coupled import DeformableCoupledSolver
 from riprap.coupling.kernels import rigid_coupling
-from riprap.coupling.solid_volumes import rigid_body_half_cell_volumes
 
-__all__ = ["SlabCoupledSolver", "coupled_plane_costs", "BODY_CELL_COST"]
+__all__ = ["SlabCoupledSolver", "SlabDeformableCoupledSolver", "coupled_plane_costs",
+           "BODY_CELL_COST"]
 
 #: The coupling's work on a cell holding some body (clipping, the face set, the blends and sums)
 #: beyond the fluid's own, in units of a fluid cell's whole step (the pressure solve included).
@@ -68,13 +69,18 @@ class SlabCoupledSolver(CoupledSolver):
         self._end = block.stop + block.high
         self._last = block.comm.rank == block.comm.size - 1
         self._summed = None
-        super().__init__(block, whole.solids, solid_time_step=whole.solid_time_step,
-                         wall_material=None, check_momentum=whole.check_momentum,
-                         obstacle_bodies=whole.obstacle_bodies,
-                         adaptive_substep=whole.adaptive_substep)
+        self._start_coupling(block, whole)
         self.substep_ceiling = whole.substep_ceiling
-        # each contact pair evaluated by one process, every process adding all
-        self.solids.split_contacts_over(self.comm)
+        # each contact pair evaluated by one process, every process adding all (rigid bodies;
+        # deformable ones are stepped whole on every process)
+        if hasattr(self.solids, "split_contacts_over"):
+            self.solids.split_contacts_over(self.comm)
+
+    def _start_coupling(self, block, whole) -> None:
+        CoupledSolver.__init__(self, block, whole.solids, solid_time_step=whole.solid_time_step,
+                               wall_material=None, check_momentum=whole.check_momentum,
+                               obstacle_bodies=whole.obstacle_bodies,
+                               adaptive_substep=whole.adaptive_substep)
 
     # ------------------------------------------------------------------ set up from the whole
     def _check_bodies_in_grid(self) -> None:
@@ -104,22 +110,24 @@ class SlabCoupledSolver(CoupledSolver):
         """The ``stale`` bodies' half-cell volume blocks on the whole grid (the one process's
         numbers), cut to the block's planes; a body that cannot reach the block gets an empty
         block and is not clipped."""
-        whole_grid = self.whole.fluid.grid
-        h = self.fluid.h
-        poses = self._block_poses[stale]
-        solids = self.solids
-        radius = solids.bounding_radius[solids.shape_index[stale]] + h
-        x0 = whole_grid.lower[0] + self._begin * h
-        x1 = whole_grid.lower[0] + self._end * h
-        near = (poses[:, 0] + radius > x0) & (poses[:, 0] - radius < x1)
+        stale = np.asarray(stale, dtype=np.int64)
+        near = self._reaching(stale)
         blocks = [_EMPTY] * len(stale)
         if near.any():
-            chosen = np.asarray(stale)[near]
-            clipped = rigid_body_half_cell_volumes(whole_grid, solids, bodies=chosen,
-                                                   poses=poses[near])
+            clipped = self._clip_on(self.whole.fluid.grid, stale[near])
             for place, block in zip(np.flatnonzero(near), clipped):
                 blocks[place] = self._cut(block)
         return blocks
+
+    def _reaching(self, stale) -> np.ndarray:
+        """Whether each of the ``stale`` bodies may reach the block where it was last clipped
+        (its centre within its bounding radius and a cell of the block's planes)."""
+        whole_grid, h = self.whole.fluid.grid, self.fluid.h
+        poses = self._block_poses[stale]
+        radius = self.solids.bounding_radius[self.solids.shape_index[stale]] + h
+        x0 = whole_grid.lower[0] + self._begin * h
+        x1 = whole_grid.lower[0] + self._end * h
+        return (poses[:, 0] + radius > x0) & (poses[:, 0] - radius < x1)
 
     def _cut(self, block):
         """A whole-grid block (origin, cell volumes, half-cell volumes) cut to this block's
@@ -218,6 +226,28 @@ class SlabCoupledSolver(CoupledSolver):
             arrays["coupling_carried_values"] = np.asarray(arrays["coupling_carried_values"])[inside]
         super().load_state_arrays(arrays)
         self._summed = None
+
+
+class SlabDeformableCoupledSolver(SlabCoupledSolver, DeformableCoupledSolver):
+    """Deformable bodies (and rigid ones) in a flow over several processes: every process steps
+    every body alike (the deformable bodies' elements are not split), the coupling's face work and
+    sums as ``SlabCoupledSolver``; the pressure the bodies' surfaces read is the whole grid's,
+    joined from the slabs after every step."""
+
+    def _start_coupling(self, block, whole) -> None:
+        DeformableCoupledSolver.__init__(self, block, whole.solids,
+                                         check_momentum=whole.check_momentum)
+
+    def _reaching(self, stale) -> np.ndarray:
+        return np.ones(len(stale), dtype=bool)
+
+    def _bodies_pressure(self):
+        block = self.fluid
+        counts = block.cut.counts()
+        pressure = self.comm.gather_planes(block.pressure[block.low:block.low + block.owned],
+                                           counts)
+        whole = self.whole.fluid
+        return pressure, np.asarray(whole.grid.lower, dtype=np.float64), whole.solid
 
 
 #: The block of a body that does not reach this process's planes.

@@ -1,4 +1,4 @@
-"""Bodies in a flow over several processes (``riprap/coupling/slab_coupled.py``), as a model of
+"""Bodies in a flow over several processes (``riprap/coupling/slab_coupled.py``), as models of
 the run loop: every process steps its block of the fluid and every body; the frames, the tables
 and the summary are those of one process's run, written by process 0 from the whole grid
 gathered there when they are due (as ``riprap/models/slab_fluid.py`` does for the fluid alone).
@@ -7,23 +7,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from riprap.models.deformable_coupled import DeformableCoupledModel
 from riprap.models.fluid import CoupledModel
 
-__all__ = ["SlabCoupledModel"]
+__all__ = ["SlabCoupledModel", "SlabDeformableCoupledModel"]
 
 
-class SlabCoupledModel(CoupledModel):
-    """``CoupledModel`` of a block (``SlabCoupledSolver``); ``whole`` the whole grid's
-    CoupledSolver, whose fluid the writers read (refreshed by ``prepare_outputs``) and whose
-    bodies are the block's."""
+class _OverProcesses:
+    """What a coupled model over a block adds to its one-process model: the whole grid for the
+    writers, process 0 writing, the gathers when outputs or checkpoints are due. ``whole`` is
+    the whole grid's coupling, whose fluid the writers read (refreshed by ``prepare_outputs``)
+    and whose bodies are the block's."""
 
-    kind = "riprap coupled run"     # its checkpoints are one process's: any number restarts
-    name = "coupled"
-
-    def __init__(self, coupled, whole):
-        super().__init__(coupled)
-        self.whole = whole
-        self.processes = coupled.comm
+    whole = None
+    processes = None
 
     @property
     def fluid(self):
@@ -56,7 +53,8 @@ class SlabCoupledModel(CoupledModel):
         """The split of the run over the processes, a line per process (printed at the start)."""
         block = self.solver.fluid
         grid = self.whole.fluid.grid
-        planes = np.floor((self.solids.positions[:, 0] - grid.lower[0]) / grid.cell_size)
+        centres = self.solver.solids.positions
+        planes = np.floor((centres[:, 0] - grid.lower[0]) / grid.cell_size)
         return block.cut.describe(grid.cells[1] * grid.cells[2], planes.astype(int))
 
     def body_fraction(self):
@@ -73,3 +71,28 @@ class SlabCoupledModel(CoupledModel):
         fields["processes"] = {"count": block.comm.size, "slabs": list(block.cut.starts),
                                "halo_planes": block.halo}
         return fields
+
+
+class SlabCoupledModel(_OverProcesses, CoupledModel):
+    """``CoupledModel`` of a block (``SlabCoupledSolver``)."""
+
+    kind = "riprap coupled run"     # its checkpoints are one process's: any number restarts
+    name = "coupled"
+
+    def __init__(self, coupled, whole):
+        super().__init__(coupled)
+        self.whole = whole
+        self.processes = coupled.comm
+
+
+class SlabDeformableCoupledModel(_OverProcesses, DeformableCoupledModel):
+    """``DeformableCoupledModel`` of a block (``SlabDeformableCoupledSolver``); ``stresses``
+    keeps the stress records on every process alike (every process steps every body)."""
+
+    kind = "riprap deformable coupled run"
+    name = "deformable_coupled"
+
+    def __init__(self, coupled, stresses, whole):
+        super().__init__(coupled, stresses)
+        self.whole = whole
+        self.processes = coupled.comm

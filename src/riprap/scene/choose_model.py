@@ -11,7 +11,8 @@ from typing import Callable
 
 from riprap.coupling.coupled import CoupledSolver, _same_plane, fluid_box_walls
 from riprap.coupling.deformable_coupled import DeformableBodies, DeformableCoupledSolver
-from riprap.coupling.slab_coupled import SlabCoupledSolver, coupled_plane_costs
+from riprap.coupling.slab_coupled import (SlabCoupledSolver, SlabDeformableCoupledSolver,
+                                          coupled_plane_costs)
 from riprap.coupling.obstacles import add_obstacle_bodies, name_obstacles_in_overlap
 from riprap.errors import CaseFileError, OverlapError, RiprapError
 from riprap.fluid.slab_solver import split_fluid
@@ -22,7 +23,7 @@ from riprap.models.fluid import CoupledModel, FluidModel
 from riprap.models.rigid import RigidModel, build_bodies, prepare_bodies
 from riprap.models.settings import ModelSettings
 from riprap.models.slab_features import add_parts_to_block
-from riprap.models.slab_coupled import SlabCoupledModel
+from riprap.models.slab_coupled import SlabCoupledModel, SlabDeformableCoupledModel
 from riprap.models.slab_fluid import SlabFluidModel
 from riprap.models.split_rigid import SplitRigidModel
 from riprap.parallel.communicator import world
@@ -187,13 +188,26 @@ def _slab_coupled_model(scene: Scene, settings: ModelSettings,
     return SlabCoupledModel(SlabCoupledSolver(block, whole), whole)
 
 
+def _slab_deformable_coupled_model(scene: Scene, settings: ModelSettings,
+                                   restarted: bool) -> SlabDeformableCoupledModel:
+    """Deformable bodies (and rigid ones) in the flow over the processes of the run: the whole
+    coupling built as on one process, each process's block of its fluid, every process stepping
+    every body."""
+    whole_model = _deformable_coupled_model(scene, settings, restarted)
+    whole = whole_model.solver
+    block = split_fluid(whole.fluid, world(), add_parts=add_parts_to_block,
+                        plane_costs=coupled_plane_costs(whole))
+    return SlabDeformableCoupledModel(SlabDeformableCoupledSolver(block, whole),
+                                      whole_model.stresses, whole)
+
+
 def _not_yet_over_processes(scene: Scene, settings: ModelSettings, restarted: bool) -> Model:
     held = sorted(scene.holds() - {"several processes"})
     raise CaseFileError(
         f"this run holds {', '.join(held) or 'nothing'}: over several processes riprap runs so "
-        "far the fluid alone, rigid bodies in a flow (porous zones, waves and gauges included) "
-        "and rigid bodies alone, not deformable bodies; run this case on one process (without "
-        "mpiexec)")
+        "far the fluid alone, bodies in a flow (rigid or deformable; porous zones, waves and "
+        "gauges included) and rigid bodies alone, not deformable bodies without a fluid; run "
+        "this case on one process (without mpiexec)")
 
 
 #: Every model riprap has, with the scenes it serves (what ``Scene.holds()``: "rigid bodies",
@@ -223,8 +237,14 @@ MODEL_BUILDERS: list[ModelBuilder] = [
                  _slab_coupled_model),
     ModelBuilder("not_yet_over_processes",
                  scenes(("several processes",), ("deformable bodies", "several processes"),
-                        ("deformable bodies", "rigid bodies", "several processes"),
-                        ("deformable bodies", "fluid", "several processes"),
-                        ("deformable bodies", "fluid", "rigid bodies", "several processes")),
+                        ("deformable bodies", "rigid bodies", "several processes")),
                  _not_yet_over_processes),
+    # (with a CoupledSolver built by the caller: refused, naming why, as on one process)
+    ModelBuilder("slab_deformable_coupled",
+                 scenes(("deformable bodies", "fluid", "several processes"),
+                        ("deformable bodies", "fluid", "rigid bodies", "several processes"),
+                        ("deformable bodies", "coupled solver", "several processes"),
+                        ("deformable bodies", "coupled solver", "rigid bodies",
+                         "several processes")),
+                 _slab_deformable_coupled_model),
 ]
