@@ -12,7 +12,15 @@ with c the one-thread seconds per cell-step, s the pressure's share, r the share
 work on the gathered levels (both measured on one process), m_x, m_r, m_g the messages per step
 measured on two processes.
 
-    python bench/parallel_model.py [--cells 1000 200 100]
+With B bodies (``--bodies``; every process holds every body, the contact pairs shared out):
+  coupling work      = k_c (cells holding bodies) (n + 2H) / nx   clipping, face set, sums
+  contact sub-steps  = S (a B / P + b B + latency log2(P) + rows / bandwidth)
+with a the pair work and b the work every process repeats (broad phase, integration, the calls)
+per body and sub-step, measured on bench/parallel.py's placed layer (161 bodies, 69 sub-steps a
+step: 3.3 ms a sub-step on one process, 2.2 ms on two), S the sub-steps per fluid step, and the
+cells holding bodies 850 per body (137,000 for the layer's 161 at 11 cells across a unit).
+
+    python bench/parallel_model.py [--cells 1000 200 100] [--bodies 3678]
 """
 import argparse
 import math
@@ -26,18 +34,39 @@ EXCHANGES = 212               # messages per step per process with two neighbour
 EXCHANGED_PLANES = 6.24e6 / (44 * 101 * 8)   # fine-plane equivalents per step, measured
 REDUCTIONS = 49
 GATHERS = 16
+BODY_CELL_SECONDS = 0.15 / 137_000   # the coupling's seconds per cell holding bodies, a step
+BODY_CELLS = 850                      # cells holding a body, per body (11 cells across a unit)
+PAIR_SECONDS = 2.2e-3 / 161           # contact pair work per body and sub-step, one process
+REPEATED_SECONDS = 1.1e-3 / 161       # per body and sub-step, repeated on every process
+SUBSTEPS = 69                         # contact sub-steps per fluid step (the layer, adaptive)
+ROW_BYTES = 6 * 28 * 8                # the contact rows of a body's pairs (about 6), joined
 NETWORKS = {"shared memory (one node)": (0.5e-6, 10e9),
             "InfiniBand HDR": (2e-6, 12.5e9),
             "10 Gb Ethernet": (25e-6, 1.2e9)}
 
 
-def step_time(cells, processes, latency, bandwidth):
+def body_time(cells, bodies, processes, latency, bandwidth):
+    """The bodies' part of a step: their coupling on the slab's planes and the contact
+    sub-steps."""
+    if bodies == 0:
+        return 0.0
+    nx = cells[0]
+    n = nx / processes
+    planes = n + (2 * HALO if processes > 1 else 0)
+    coupling = BODY_CELL_SECONDS * BODY_CELLS * bodies * min(planes, nx) / nx
+    substep = PAIR_SECONDS * bodies / processes + REPEATED_SECONDS * bodies
+    if processes > 1:
+        substep += latency * math.log2(processes) + ROW_BYTES * bodies / bandwidth
+    return coupling + SUBSTEPS * substep
+
+
+def step_time(cells, processes, latency, bandwidth, bodies=0):
     nx, ny, nz = cells
     total = nx * ny * nz
     plane = ny * nz
     n = nx / processes
     if processes == 1:
-        return C * total
+        return C * total + body_time(cells, bodies, 1, latency, bandwidth)
     if n < max(HALO, 4):
         return math.inf
     work = (1 - PRESSURE_SHARE) * C * plane * (n + 2 * HALO)
@@ -45,23 +74,29 @@ def step_time(cells, processes, latency, bandwidth):
     exchange = 2 * (EXCHANGES * latency + EXCHANGED_PLANES * plane * 8 / bandwidth)
     reduce = REDUCTIONS * latency * math.log2(processes)
     gather = GATHERS * (latency * math.log2(processes) + total / 64 * 8 / bandwidth)
-    return work + exchange + reduce + gather
+    return work + exchange + reduce + gather + body_time(cells, bodies, processes, latency,
+                                                        bandwidth)
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--cells", type=int, nargs=3, default=[1000, 200, 100])
+    parser.add_argument("--bodies", type=int, default=3678,
+                        help="bodies (the seed's 242 Core-Locs on 3,436 rocks: 3678)")
     args = parser.parse_args()
     cells = tuple(args.cells)
-    one = step_time(cells, 1, 0, 1)
-    print(f"{cells[0]} x {cells[1]} x {cells[2]} cells: {one:.1f} s per step on one process")
-    for name, (latency, bandwidth) in NETWORKS.items():
-        row = []
-        for processes in (2, 8, 64, 512):
-            t = step_time(cells, processes, latency, bandwidth)
-            row.append(f"P={processes}: " + ("cannot cut" if math.isinf(t)
-                                             else f"{t:.3f} s, efficiency {one / (processes * t):.2f}"))
-        print(f"{name} ({latency * 1e6:g} us, {bandwidth / 1e9:g} GB/s): " + "; ".join(row))
+    for bodies in (0, args.bodies):
+        one = step_time(cells, 1, 0, 1, bodies)
+        print(f"{cells[0]} x {cells[1]} x {cells[2]} cells, {bodies} bodies: {one:.1f} s per step "
+              "on one process")
+        for name, (latency, bandwidth) in NETWORKS.items():
+            row = []
+            for processes in (2, 8, 64, 512):
+                t = step_time(cells, processes, latency, bandwidth, bodies)
+                row.append(f"P={processes}: " + (
+                    "cannot cut" if math.isinf(t)
+                    else f"{t:.3f} s, efficiency {one / (processes * t):.2f}"))
+            print(f"  {name} ({latency * 1e6:g} us, {bandwidth / 1e9:g} GB/s): " + "; ".join(row))
 
 
 if __name__ == "__main__":
