@@ -51,6 +51,17 @@ def assert_close_tables(expected_path, actual_path):
     assert np.array_equal(np.isnan(want), np.isnan(got))
 
 
+def assert_restarts_continue(half, whole, unbroken, tmp_path):
+    """``half`` run on 2 processes and continued to ``whole``'s end on 1, and the other way
+    round: each ends within the tolerance of the ``unbroken`` run's checkpoint."""
+    for first, then, folder in ((2, 1, tmp_path / "two_then_one"),
+                                (1, 2, tmp_path / "one_then_two")):
+        riprap(first, "run", str(half), "--out", str(folder))
+        riprap(then, "run", str(whole), "--out", str(folder), "--restart",
+               str(folder / "checkpoint.npz"))
+        assert_close_states(unbroken, folder / "checkpoint.npz")
+
+
 def shortened(source: Path, folder: Path, end_time: float, name: str) -> Path:
     """``source`` with another end time, written beside it (its relative files stay found)."""
     text = source.read_text()
@@ -74,12 +85,7 @@ def test_settling_sphere_over_two_processes_and_restarts(tmp_path):
         assert json.loads((two / "summary.json").read_text())["processes"]["slabs"] == [0, 20, 40]
         assert_close_states(one / "checkpoint.npz", two / "checkpoint.npz")
         assert_close_tables(one / "body_forces.csv", two / "body_forces.csv")
-        for first, then, folder in ((2, 1, tmp_path / "two_then_one"),
-                                    (1, 2, tmp_path / "one_then_two")):
-            riprap(first, "run", str(half), "--out", str(folder))
-            riprap(then, "run", str(whole), "--out", str(folder), "--restart",
-                   str(folder / "checkpoint.npz"))
-            assert_close_states(one / "checkpoint.npz", folder / "checkpoint.npz")
+        assert_restarts_continue(half, whole, one / "checkpoint.npz", tmp_path)
     finally:
         whole.unlink()
         half.unlink()
@@ -164,11 +170,6 @@ def test_deformable_body_in_water_over_two_processes_and_restarts(tmp_path):
     assert_close_tables(one / "body_forces.csv", two / "body_forces.csv")
     half = shortened(case, tmp_path, 0.02, "half")
     try:
-        for first, then, folder in ((2, 1, tmp_path / "two_then_one"),
-                                    (1, 2, tmp_path / "one_then_two")):
-            riprap(first, "run", str(half), "--out", str(folder))
-            riprap(then, "run", str(case), "--out", str(folder), "--restart",
-                   str(folder / "checkpoint.npz"))
-            assert_close_states(one / "checkpoint.npz", folder / "checkpoint.npz")
+        assert_restarts_continue(half, case, one / "checkpoint.npz", tmp_path)
     finally:
         half.unlink()
