@@ -368,7 +368,9 @@ class Simulation:
         if not _writes_files(model):
             # the other processes of a split run keep the schedules (the steps land on them)
             # and join the gathers, but write nothing
-            writers = [_Silent(writer) for writer in writers]
+            # (a writer of every process writes its own piece of each entry)
+            writers = [writer if getattr(writer, "every_process", False) else _Silent(writer)
+                       for writer in writers]
         schedules = self._open_writers(model, writers, out)
         last_written = {id(schedule): model.time for schedule, _ in schedules}
         if not self._restarted:
@@ -603,6 +605,9 @@ class Simulation:
         if self.run_definition is not None:
             metadata["case_record"] = self.run_definition.values
         path = self.output_directory / name
+        save_in_pieces = getattr(model, "save_checkpoint_in_pieces", None)
+        if save_in_pieces is not None:
+            return save_in_pieces(path, arrays, metadata)      # every process its piece
         if not _writes_files(model):
             return path
         return save_checkpoint(path, arrays=arrays, metadata=metadata)

@@ -5,6 +5,7 @@ import pytest
 
 from riprap.errors import CaseFileError, RiprapError
 from riprap.io.checkpoint import (
+    save_checkpoint_piece,
     CHECKPOINT_FORMAT,
     CheckpointError,
     load_checkpoint,
@@ -127,4 +128,66 @@ def test_other_checkpoint_format_version_is_refused(tmp_path):
     contents["__riprap_metadata__"] = np.array('{"checkpoint_format": 2}')
     np.savez(path, **contents)
     with pytest.raises(CheckpointError, match="checkpoint_format 2"):
+        load_checkpoint(path)
+
+
+# ---------------------------------------------------------------- checkpoints in pieces
+def _pieces(tmp_path, step=7, processes=3):
+    """A checkpoint of a run over ``processes``: each process's planes of a (6, 2) grid array
+    and of a (7,) x-face array (the last process its top face too), and a shared clock."""
+    path = tmp_path / "checkpoint.npz"
+    grid, faces = np.arange(12.0).reshape(6, 2), np.arange(7.0) * 0.5
+    cuts = np.linspace(0, 6, processes + 1).astype(int)
+    names = [save_checkpoint_piece(path, step=step, process=p, arrays={
+        "grid": grid[cuts[p]:cuts[p + 1]],
+        "faces": faces[cuts[p]:cuts[p + 1] + (1 if p == processes - 1 else 0)]})
+        for p in range(processes)]
+    save_checkpoint(path, arrays={"clock": np.array([0.5, float(step)])},
+                    metadata={"time": 0.5}, pieces=names)
+    return path, grid, faces, names
+
+
+def test_checkpoint_in_pieces_reads_back_whole(tmp_path):
+    """The pieces' arrays are joined in process order: the whole arrays, bit for bit; the
+    list of pieces is not part of what is read."""
+    path, grid, faces, names = _pieces(tmp_path)
+    arrays, metadata = load_checkpoint(path)
+    assert np.array_equal(arrays["grid"], grid) and np.array_equal(arrays["faces"], faces)
+    assert "pieces" not in metadata
+    assert names[1] == "checkpoint_pieces/step000000007_process0001.npz"
+
+
+def test_checkpoint_pieces_of_earlier_writes_are_removed(tmp_path):
+    """A later checkpoint in pieces removes the earlier's pieces once it is in place; a whole
+    checkpoint written over it (a restart on one process) removes them all."""
+    path, *_ = _pieces(tmp_path, step=7)
+    _pieces(tmp_path, step=9)
+    assert sorted(p.name for p in (tmp_path / "checkpoint_pieces").iterdir()) == [
+        f"step000000009_process000{k}.npz" for k in range(3)]
+    save_checkpoint(path, arrays={"grid": np.zeros((6, 2))}, metadata={})
+    assert not (tmp_path / "checkpoint_pieces").exists()
+    assert load_checkpoint(path)[0]["grid"].shape == (6, 2)
+
+
+def test_checkpoint_missing_or_foreign_piece_is_named(tmp_path):
+    """A missing piece, a piece of another step put in its place, a piece given as the
+    checkpoint, a piece of another process: each refused with a message naming it."""
+    path, _, _, names = _pieces(tmp_path)
+    piece = tmp_path / names[2]
+    kept = piece.read_bytes()
+    piece.unlink()
+    with pytest.raises(CheckpointError, match=r"piece checkpoint_pieces/step000000007_process0002"
+                                              r"\.npz \(process 2\) is missing"):
+        load_checkpoint(path)
+    save_checkpoint_piece(path, step=8, process=2, arrays={"grid": np.zeros((2, 2)),
+                                                          "faces": np.zeros(3)})
+    (tmp_path / "checkpoint_pieces" / "step000000008_process0002.npz").rename(piece)
+    with pytest.raises(CheckpointError, match="is of step 8, the checkpoint of step 7"):
+        load_checkpoint(path)
+    piece.write_bytes(kept)
+    with pytest.raises(CheckpointError, match="one process's piece of the checkpoint "
+                                              "checkpoint.npz"):
+        load_checkpoint(piece)
+    (tmp_path / names[1]).write_bytes(kept)
+    with pytest.raises(CheckpointError, match="is not the piece of process 1"):
         load_checkpoint(path)

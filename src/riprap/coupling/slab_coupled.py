@@ -198,15 +198,28 @@ class SlabCoupledSolver(CoupledSolver):
         indices (their order is not read)."""
         whole = self.fluid.gather_whole(state)
         if "coupling_carried_axis" in state:
-            axis = state["coupling_carried_axis"]
-            index = state["coupling_carried_index"].copy()
-            values = state["coupling_carried_values"]
-            mine = self._owned(axis, index[:, 0])
-            index[:, 0] += self._begin
-            parts = self.comm.all_values((axis[mine], index[mine], values[mine]))
-            for place, name in enumerate(("axis", "index", "values")):
-                whole[f"coupling_carried_{name}"] = np.concatenate([part[place] for part in parts])
+            parts = self.comm.all_values(self._carried_piece(state))
+            for name in parts[0]:
+                whole[name] = np.concatenate([part[name] for part in parts])
         return whole
+
+    def state_piece(self, state: dict) -> dict:
+        """This process's piece of a checkpoint of ``state`` (its ``state_arrays``): its own
+        planes of the grid and its own faces of the carrying field in whole-grid indices; the
+        pieces of all processes joined in order are ``whole_state``'s arrays."""
+        piece = self.fluid.owned_state(state)
+        if "coupling_carried_axis" in state:
+            piece.update(self._carried_piece(state))
+        return piece
+
+    def _carried_piece(self, state: dict) -> dict:
+        axis = state["coupling_carried_axis"]
+        index = state["coupling_carried_index"].copy()
+        values = state["coupling_carried_values"]
+        mine = self._owned(axis, index[:, 0])
+        index[:, 0] += self._begin
+        return {"coupling_carried_axis": axis[mine], "coupling_carried_index": index[mine],
+                "coupling_carried_values": values[mine]}
 
     def load_state_arrays(self, arrays: dict) -> None:
         """A block's state, or a whole grid's (a checkpoint of a run on any number of

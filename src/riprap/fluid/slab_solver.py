@@ -150,6 +150,11 @@ class SlabFluidSolver(FluidSolver):
             out[name] = np.ascontiguousarray(array[low:stop])
         return out
 
+    def state_piece(self, state: dict) -> dict:
+        """This process's piece of a checkpoint of ``state``: its own planes of the grid (the
+        pieces of all processes joined in order are ``gather_whole``'s arrays)."""
+        return self.owned_state(state)
+
     def gather_whole(self, state: dict) -> dict:
         """The whole grid's arrays of ``state`` (a block's ``state_arrays``) on every process:
         the slabs' own planes joined in order. What is not a grid array (the clock, gauges) is

@@ -9,6 +9,14 @@ The archive is first written to a temporary file in the same folder and then mov
 target with :func:`os.replace`, which is atomic on POSIX and Windows when both paths are on the
 same file system. A run killed while writing therefore leaves either the previous complete
 checkpoint or the new complete one, never a truncated file under the checkpoint's name.
+
+A run over several processes writes its checkpoint in pieces: each process the arrays of its own
+planes of the grid (:func:`save_checkpoint_piece`, into ``<name>_pieces/`` beside the checkpoint,
+named by the step), then process 0 the checkpoint itself with the rest and the list of pieces
+(``save_checkpoint(..., pieces=...)``), then the pieces of older checkpoints are removed. So the
+checkpoint named always has all its pieces, whenever a run is killed. :func:`load_checkpoint` joins
+the pieces' arrays along their first axis, in the order listed: what it returns is the whole
+grid's, as one process writes it, and restarts on any number of processes.
 """
 
 from __future__ import annotations
@@ -25,7 +33,8 @@ import numpy as np
 from riprap.errors import CaseFileError, RiprapError
 from riprap.io.output_folder import naming_the_file
 
-__all__ = ["CheckpointError", "CHECKPOINT_FORMAT", "save_checkpoint", "load_checkpoint"]
+__all__ = ["CheckpointError", "CHECKPOINT_FORMAT", "save_checkpoint", "load_checkpoint",
+           "save_checkpoint_piece"]
 
 #: Version of the checkpoint layout written by :func:`save_checkpoint`.
 CHECKPOINT_FORMAT = 1
@@ -87,6 +96,7 @@ def save_checkpoint(
     *,
     arrays: Mapping[str, np.ndarray],
     metadata: Mapping[str, object],
+    pieces: list[str] | None = None,
 ) -> Path:
     """Write arrays and metadata to one ``.npz`` checkpoint, atomically.
 
@@ -103,6 +113,10 @@ def save_checkpoint(
     metadata : mapping of str to JSON-serialisable values
         Scalars, strings, lists and dicts (numpy scalars are converted). The key
         ``"checkpoint_format"`` is set to :data:`CHECKPOINT_FORMAT`.
+    pieces : list of str, optional
+        The pieces of this checkpoint already written by :func:`save_checkpoint_piece` (their
+        names as it returned them, in the order their arrays join); once the checkpoint is in
+        place, the other files of its folder of pieces are removed.
 
     Returns
     -------
@@ -143,6 +157,8 @@ def save_checkpoint(
 
     full_metadata = dict(metadata)
     full_metadata["checkpoint_format"] = CHECKPOINT_FORMAT
+    if pieces is not None:
+        full_metadata[_PIECES_KEY] = list(pieces)
     try:
         # allow_nan=False: NaN and infinity are not JSON and other readers would reject them.
         text = json.dumps(full_metadata, default=_json_default, allow_nan=False, sort_keys=True)
@@ -157,16 +173,89 @@ def save_checkpoint(
         # A file object, not a name: np.savez would append ".npz" to a name lacking it.
         with open(temporary, "wb") as handle:
             np.savez(handle, **stored)
+    # the pieces of this checkpoint's earlier writes (and all of them where it is now whole: a
+    # run restarted on one process) are no longer named by it
+    _remove_other_pieces(path, pieces or [])
     return path
 
 
-def load_checkpoint(path: str | os.PathLike) -> tuple[dict[str, np.ndarray], dict]:
+_PIECES_KEY = "pieces"
+
+
+def _pieces_folder(path: Path) -> Path:
+    return path.with_name(f"{path.stem}_pieces")
+
+
+def save_checkpoint_piece(path: str | os.PathLike, *, step: int, process: int,
+                          arrays: Mapping[str, np.ndarray]) -> str:
+    """Write process ``process``'s piece of the checkpoint ``path`` at fluid step ``step``:
+    ``arrays`` (every piece the same names, each joined with the other pieces' along its first
+    axis). Returns its name relative to ``path``'s folder, for ``save_checkpoint(pieces=...)``."""
+    path = Path(path)
+    piece = _pieces_folder(path) / f"step{int(step):09d}_process{int(process):04d}.npz"
+    save_checkpoint(piece, arrays=arrays, metadata={"piece_of": path.name, "step": int(step),
+                                                    "process": int(process)})
+    return f"{piece.parent.name}/{piece.name}"
+
+
+def _remove_other_pieces(path: Path, pieces: list[str]) -> None:
+    folder = _pieces_folder(path)
+    if not folder.is_dir():
+        return
+    listed = {Path(name).name for name in pieces}
+    for old in folder.glob("step*_process*.npz"):
+        if old.name not in listed:
+            with contextlib.suppress(FileNotFoundError):
+                old.unlink()
+    if not pieces:
+        with contextlib.suppress(OSError):
+            folder.rmdir()
+
+
+def _joined_pieces(path: Path, contents: dict, pieces) -> None:
+    """Add the arrays of ``path``'s pieces to ``contents``, each joined along its first axis."""
+    if not isinstance(pieces, list) or not pieces or not all(isinstance(p, str) for p in pieces):
+        raise CheckpointError(f"checkpoint {path}: its list of pieces is damaged; restart from "
+                              "an earlier checkpoint")
+    parts = []
+    for process, name in enumerate(pieces):
+        piece = path.parent / name
+        if not piece.is_file():
+            raise CheckpointError(
+                f"checkpoint {path}: its piece {name} (process {process}) is missing; a checkpoint "
+                f"of a run over several processes needs its folder {_pieces_folder(path).name} "
+                "beside it")
+        arrays, metadata = load_checkpoint(piece, piece=True)
+        if metadata.get("process") != process:
+            raise CheckpointError(f"checkpoint {path}: {name} is not the piece of process "
+                                  f"{process}")
+        if "clock" in contents and metadata.get("step") != int(contents["clock"][1]):
+            raise CheckpointError(f"checkpoint {path}: its piece {name} is of step "
+                                  f"{metadata.get('step')}, the checkpoint of step "
+                                  f"{int(contents['clock'][1])}")
+        parts.append(arrays)
+    names = set(parts[0])
+    for process, arrays in enumerate(parts):
+        if set(arrays) != names:
+            raise CheckpointError(f"checkpoint {path}: the piece of process {process} holds "
+                                  f"{sorted(arrays)}, the first {sorted(names)}")
+    for name in sorted(names):
+        if name in contents:
+            raise CheckpointError(f"checkpoint {path}: {name!r} is both in it and in its pieces")
+        contents[name] = np.concatenate([arrays[name] for arrays in parts])
+
+
+def load_checkpoint(path: str | os.PathLike, *, piece: bool = False
+                    ) -> tuple[dict[str, np.ndarray], dict]:
     """Read a checkpoint written by :func:`save_checkpoint`.
 
     Parameters
     ----------
     path : str or os.PathLike
         Checkpoint file.
+    piece : bool
+        Read one process's piece (:func:`save_checkpoint_piece`) as it is; otherwise a piece is
+        refused, naming its checkpoint.
 
     Returns
     -------
@@ -237,4 +326,9 @@ def load_checkpoint(path: str | os.PathLike) -> tuple[dict[str, np.ndarray], dic
             f"checkpoint_format {CHECKPOINT_FORMAT}; use the riprap version that wrote it, or "
             "start the run again from the case file."
         )
+    if "piece_of" in metadata and not piece:
+        raise CheckpointError(f"{path} is one process's piece of the checkpoint "
+                              f"{metadata['piece_of']}; restart from that checkpoint")
+    if _PIECES_KEY in metadata:
+        _joined_pieces(path, contents, metadata.pop(_PIECES_KEY))
     return contents, metadata

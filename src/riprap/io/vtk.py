@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import shutil
 import xml.etree.ElementTree as ElementTree
 from collections.abc import Mapping
 from pathlib import Path
@@ -297,7 +298,21 @@ class ParaViewSeries:
         return self._add_frame(time, "vti", lambda path: write_vti(
             path, origin=origin, spacing=spacing, cells=cells, cell_data=cell_data))
 
-    def _add_frame(self, time: float, extension: str, write) -> Path:
+    def next_frame_stem(self, time: float) -> str:
+        """The name, without extension, that the frame at ``time`` will take (its checks and a
+        restart's trimming done now): for a frame written in pieces by several processes before
+        :meth:`list_frame` lists it."""
+        time = self._checked_time(time)
+        return f"{self.name}_{self._next_index():06d}"
+
+    def list_frame(self, time: float, file_name: str) -> None:
+        """List a frame written elsewhere (a ``.pvti`` and its pieces, named by
+        :meth:`next_frame_stem`) in the ``.pvd``."""
+        time = self._checked_time(time)
+        self._frames.append((time, file_name))
+        self._write_pvd()
+
+    def _checked_time(self, time: float) -> float:
         time = float(time)
         if not math.isfinite(time):
             raise CaseFileError(f"{self.pvd_path}: frame time {time} is not finite.")
@@ -310,15 +325,17 @@ class ParaViewSeries:
                 f"{self._frames[-1][0]!r} s; times must increase (use append=True to restart "
                 "a series from an earlier time)."
             )
-        file_name = f"{self.name}_{self._next_index():06d}.{extension}"
+        return time
+
+    def _add_frame(self, time: float, extension: str, write) -> Path:
+        file_name = f"{self.next_frame_stem(time)}.{extension}"
         path = self.directory / file_name
         write(path)
-        self._frames.append((time, file_name))
-        self._write_pvd()
+        self.list_frame(time, file_name)
         return path
 
     def _next_index(self) -> int:
-        pattern = re.compile(rf"^{re.escape(self.name)}_(\d+)\.vt[ui]$")
+        pattern = re.compile(rf"^{re.escape(self.name)}_(\d+)\.p?vt[ui]$")
         indices = [int(match.group(1)) for _, file_name in self._frames
                    if (match := pattern.match(file_name))]
         return max(indices, default=-1) + 1
@@ -335,6 +352,9 @@ class ParaViewSeries:
             candidate = self.directory / file_name
             if file_name not in kept_names and candidate.parent == self.directory:
                 candidate.unlink(missing_ok=True)
+                pieces = candidate.with_suffix("")      # a .pvti's folder of pieces
+                if candidate.suffix == ".pvti" and pieces.is_dir():
+                    shutil.rmtree(pieces, ignore_errors=True)
 
     def _read_pvd(self) -> list[tuple[float, str]]:
         try:

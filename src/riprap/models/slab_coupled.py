@@ -1,7 +1,8 @@
 """Bodies in a flow over several processes (``riprap/coupling/slab_coupled.py``), as models of
 the run loop: every process steps its block of the fluid and every body; the frames, the tables
 and the summary are those of one process's run, written by process 0 from the whole grid
-gathered there when they are due (as ``riprap/models/slab_fluid.py`` does for the fluid alone).
+gathered there when they are due (as ``riprap/models/slab_fluid.py`` does for the fluid alone);
+the frames' fields and the checkpoints in pieces, each process its own planes.
 """
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import numpy as np
 
 from riprap.models.deformable_coupled import DeformableCoupledModel
 from riprap.models.fluid import CoupledModel
+from riprap.models.split_files import FramePiece, save_checkpoint_in_pieces
 
 __all__ = ["SlabCoupledModel", "SlabDeformableCoupledModel"]
 
@@ -60,10 +62,15 @@ class _OverProcesses:
     def body_fraction(self):
         return self.whole.body_fraction()
 
-    def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
-        """One process's checkpoint of the whole grid (every process calls it): it restarts on
-        any number of processes."""
-        return super().checkpoint_content(self.solver.whole_state(state))
+    def frame_piece(self) -> FramePiece:
+        """This process's part of a fluid frame (``riprap/outputs/fluid.py`` writes it)."""
+        return FramePiece(self.solver.fluid, self.whole.fluid.grid, self.processes)
+
+    def save_checkpoint_in_pieces(self, path, arrays: dict, metadata: dict):
+        """Every process its piece of the checkpoint (its own planes of the grid, its own faces
+        of the carrying field), process 0 the rest: it restarts on any number of processes."""
+        return save_checkpoint_in_pieces(path, arrays, metadata,
+                                         self.solver.state_piece(arrays), self.processes)
 
     def summary_fields(self, wall_time: float, steps: int) -> dict:
         fields = super().summary_fields(wall_time, steps)

@@ -1,15 +1,18 @@
 """Air and water over several processes (``riprap/fluid/slab_solver.py``), as a model of the run
 loop: every process steps its block; the frames, the tables and the summary are those of one
-process's run, written by process 0 from the whole grid gathered there when they are due.
+process's run, written by process 0 from the whole grid gathered there when they are due; the
+frames' fields and the checkpoints are written in pieces, each process its own planes
+(``riprap/models/split_files.py``).
 
-Why gather for the outputs: a run's files are then the same whichever number of processes made
-them (the tests compare them bit for bit), and every reader of riprap's outputs (``riprap
-analyse``, the series, the reports) reads them unchanged. The gather costs one message of the
-slab's planes per frame, not per step.
+Why gather for the tables and pictures: a run's files are then the same whichever number of
+processes made them, and every reader of riprap's outputs (``riprap analyse``, the series, the
+reports) reads them unchanged. The gather costs one message of the slab's planes per output
+entry, not per step.
 """
 from __future__ import annotations
 
 from riprap.models.fluid import FluidModel
+from riprap.models.split_files import FramePiece, save_checkpoint_in_pieces
 
 __all__ = ["SlabFluidModel"]
 
@@ -51,11 +54,15 @@ class SlabFluidModel(FluidModel):
         cells = self.whole.grid.cells
         return self.solver.cut.describe(cells[1] * cells[2])
 
-    def checkpoint_content(self, state: dict) -> tuple[dict, dict]:
-        """One process's checkpoint of the whole grid (every process calls it): it restarts on
-        any number of processes."""
-        whole_state = self.solver.gather_whole(state)
-        return super().checkpoint_content(whole_state)
+    def frame_piece(self) -> FramePiece:
+        """This process's part of a fluid frame (``riprap/outputs/fluid.py`` writes it)."""
+        return FramePiece(self.solver, self.whole.grid, self.processes)
+
+    def save_checkpoint_in_pieces(self, path, arrays: dict, metadata: dict):
+        """Every process its piece of the checkpoint (its own planes), process 0 the rest: it
+        restarts on any number of processes."""
+        return save_checkpoint_in_pieces(path, arrays, metadata,
+                                         self.solver.state_piece(arrays), self.processes)
 
     def summary_fields(self, wall_time: float, steps: int) -> dict:
         fields = super().summary_fields(wall_time, steps)
