@@ -69,11 +69,12 @@ def assert_close_tables(expected_path, actual_path):
     assert np.array_equal(np.isnan(want), np.isnan(got))
 
 
-def assert_restarts_continue(half, whole, unbroken, tmp_path):
+def assert_restarts_continue(half, whole, unbroken, tmp_path, rounds=((2, 1), (1, 2))):
     """``half`` run on 2 processes and continued to ``whole``'s end on 1, and the other way
-    round: each ends within the tolerance of the ``unbroken`` run's checkpoint."""
-    for first, then, folder in ((2, 1, tmp_path / "two_then_one"),
-                                (1, 2, tmp_path / "one_then_two")):
+    round (or the ``rounds`` given): each ends within the tolerance of the ``unbroken`` run's
+    checkpoint."""
+    for first, then in rounds:
+        folder = tmp_path / f"{first}_then_{then}"
         riprap(first, "run", str(half), "--out", str(folder))
         riprap(then, "run", str(whole), "--out", str(folder), "--restart",
                str(folder / "checkpoint.npz"))
@@ -133,7 +134,7 @@ def test_placed_layer_in_dam_break_wave_over_two_processes(tmp_path):
 def test_body_crossing_and_contact_across_the_cut(tmp_path):
     """tests/parallel/cases/crossing_spheres.toml: a sphere rolls across the cut into another
     resting beyond it, on 2 and 3 processes: positions, speeds, contact springs and the fluid as
-    on one process."""
+    on one process; a run on 3 processes continued on 2 ends as the unbroken run."""
     case = HERE / "cases" / "crossing_spheres.toml"
     one = tmp_path / "one"
     riprap(1, "run", str(case), "--out", str(one))
@@ -148,6 +149,14 @@ def test_body_crossing_and_contact_across_the_cut(tmp_path):
         assert any(start[0] < cut < end[0] for cut in cuts), (start, end, cuts)
         assert_close_states(one / "checkpoint.npz", out / "checkpoint.npz")
         assert_close_tables(one / "body_forces.csv", out / "body_forces.csv")
+    # N -> M: stopped at 0.04 s on 3 processes, its
+    # checkpoint in 3 pieces, and continued on 2 (the cut elsewhere)
+    half = shortened(case, tmp_path, 0.04, "half")
+    try:
+        assert_restarts_continue(half, case, one / "checkpoint.npz", tmp_path, rounds=((3, 2),))
+    finally:
+        half.unlink()
+    assert len(list((tmp_path / "3_then_2" / "checkpoint_pieces").iterdir())) == 2
 
 
 def test_rigid_bodies_alone_over_two_and_three_processes(tmp_path):
