@@ -14,11 +14,15 @@ measured on two processes.
 
 With B bodies (``--bodies``; every process holds every body, the contact pairs shared out):
   coupling work      = k_c (cells holding bodies) (n + 2H) / nx   clipping, face set, sums
-  contact sub-steps  = S (a B / P + b B + latency log2(P) + rows / bandwidth)
-with a the pair work and b the work every process repeats (broad phase, integration, the calls)
-per body and sub-step, measured on bench/parallel.py's placed layer (161 bodies, 69 sub-steps a
-step: 3.3 ms a sub-step on one process, 2.2 ms on two), S the sub-steps per fluid step, and the
-cells holding bodies 850 per body (137,000 for the layer's 161 at 11 cells across a unit).
+  contact sub-steps  = S (a B / P + b B + [P > 1] (f + latency log2(P) + rows / bandwidth))
+with b the work every process repeats per body and sub-step (broad phase, integration, the sums
+of the contact rows: 2.6 us at 3,888 bodies, bench/substep_parts.py; 1.1 us at 192), f the
+fixed cost of a split sub-step (its two compiled halves entered from Python, the join's
+bookkeeping; one process runs its sub-steps in one compiled call), a the pair work per body and
+sub-step, S the sub-steps per fluid step. a and f are fitted to bench/parallel.py's placed layer
+(161 bodies, 69 sub-steps a step: 3.3 ms a sub-step on one process = a B + b B, 2.2 ms on two =
+a B / 2 + b B + f, b = 1.1 us). The cells holding bodies: 850 per body (137,000 for the layer's
+161 at 11 cells across a unit).
 
     python bench/parallel_model.py [--cells 1000 200 100] [--bodies 3678]
 """
@@ -36,8 +40,10 @@ REDUCTIONS = 49
 GATHERS = 16
 BODY_CELL_SECONDS = 0.15 / 137_000   # the coupling's seconds per cell holding bodies, a step
 BODY_CELLS = 850                      # cells holding a body, per body (11 cells across a unit)
-PAIR_SECONDS = 2.2e-3 / 161           # contact pair work per body and sub-step, one process
-REPEATED_SECONDS = 1.1e-3 / 161       # per body and sub-step, repeated on every process
+REPEATED_SECONDS = 2.6e-6             # per body and sub-step, repeated on every process
+LAYER_REPEATED = 1.1e-6 * 161         # the same for the layer's 161 bodies (192 measured)
+PAIR_SECONDS = (3.3e-3 - LAYER_REPEATED) / 161          # pair work per body and sub-step
+SPLIT_SUBSTEP_SECONDS = 2.2e-3 - PAIR_SECONDS * 161 / 2 - LAYER_REPEATED   # f, per sub-step
 SUBSTEPS = 69                         # contact sub-steps per fluid step (the layer, adaptive)
 ROW_BYTES = 6 * 28 * 8                # the contact rows of a body's pairs (about 6), joined
 NETWORKS = {"shared memory (one node)": (0.5e-6, 10e9),
@@ -56,7 +62,8 @@ def body_time(cells, bodies, processes, latency, bandwidth):
     coupling = BODY_CELL_SECONDS * BODY_CELLS * bodies * min(planes, nx) / nx
     substep = PAIR_SECONDS * bodies / processes + REPEATED_SECONDS * bodies
     if processes > 1:
-        substep += latency * math.log2(processes) + ROW_BYTES * bodies / bandwidth
+        substep += (SPLIT_SUBSTEP_SECONDS + latency * math.log2(processes)
+                    + ROW_BYTES * bodies / bandwidth)
     return coupling + SUBSTEPS * substep
 
 
