@@ -10,19 +10,18 @@ import numpy as np
 
 from riprap.models.deformable_coupled import DeformableCoupledModel
 from riprap.models.fluid import CoupledModel
-from riprap.models.split_files import FramePiece, save_checkpoint_in_pieces
+from riprap.models.over_processes import OverProcesses
 
 __all__ = ["SlabCoupledModel", "SlabDeformableCoupledModel"]
 
 
-class _OverProcesses:
+class _CoupledOverProcesses(OverProcesses):
     """What a coupled model over a block adds to its one-process model: the whole grid for the
-    writers, process 0 writing, the gathers when outputs or checkpoints are due. ``whole`` is
-    the whole grid's coupling, whose fluid the writers read (refreshed by ``prepare_outputs``)
-    and whose bodies are the block's."""
+    writers, the gathers when outputs are due (``OverProcesses`` the rest). ``whole`` is the
+    whole grid's coupling, whose fluid the writers read (refreshed by ``prepare_outputs``) and
+    whose bodies are the block's."""
 
     whole = None
-    processes = None
 
     @property
     def fluid(self):
@@ -30,18 +29,12 @@ class _OverProcesses:
         return self.whole.fluid
 
     @property
-    def step_count(self) -> int:
-        return self.solver.fluid.step_count
+    def block(self):
+        return self.solver.fluid
 
     @property
-    def writes_files(self) -> bool:
-        return self.processes.rank == 0
-
-    def _after_step(self, dt: float, report) -> None:
-        block = self.solver.fluid
-        self.whole.fluid.last_report = block.last_report
-        self.whole.fluid.last_air_limit = block.last_air_limit
-        super()._after_step(dt, report)
+    def step_count(self) -> int:
+        return self.solver.fluid.step_count
 
     def prepare_outputs(self) -> None:
         """The whole grid's state from every process's slab, and the loads that only the
@@ -62,25 +55,8 @@ class _OverProcesses:
     def body_fraction(self):
         return self.whole.body_fraction()
 
-    def frame_piece(self) -> FramePiece:
-        """This process's part of a fluid frame (``riprap/outputs/fluid.py`` writes it)."""
-        return FramePiece(self.solver.fluid, self.whole.fluid.grid, self.processes)
 
-    def save_checkpoint_in_pieces(self, path, arrays: dict, metadata: dict):
-        """Every process its piece of the checkpoint (its own planes of the grid, its own faces
-        of the carrying field), process 0 the rest: it restarts on any number of processes."""
-        return save_checkpoint_in_pieces(path, arrays, metadata,
-                                         self.solver.state_piece(arrays), self.processes)
-
-    def summary_fields(self, wall_time: float, steps: int) -> dict:
-        fields = super().summary_fields(wall_time, steps)
-        block = self.solver.fluid
-        fields["processes"] = {"count": block.comm.size, "slabs": list(block.cut.starts),
-                               "halo_planes": block.halo}
-        return fields
-
-
-class SlabCoupledModel(_OverProcesses, CoupledModel):
+class SlabCoupledModel(_CoupledOverProcesses, CoupledModel):
     """``CoupledModel`` of a block (``SlabCoupledSolver``)."""
 
     kind = "riprap coupled run"     # its checkpoints are one process's: any number restarts
@@ -92,7 +68,7 @@ class SlabCoupledModel(_OverProcesses, CoupledModel):
         self.processes = coupled.comm
 
 
-class SlabDeformableCoupledModel(_OverProcesses, DeformableCoupledModel):
+class SlabDeformableCoupledModel(_CoupledOverProcesses, DeformableCoupledModel):
     """``DeformableCoupledModel`` of a block (``SlabDeformableCoupledSolver``); ``stresses``
     keeps the stress records on every process alike (every process steps every body)."""
 

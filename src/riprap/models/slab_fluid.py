@@ -2,7 +2,7 @@
 loop: every process steps its block; the frames, the tables and the summary are those of one
 process's run, written by process 0 from the whole grid gathered there when they are due; the
 frames' fields and the checkpoints are written in pieces, each process its own planes
-(``riprap/models/split_files.py``).
+(``riprap/models/over_processes.py``).
 
 Why gather for the tables and pictures: a run's files are then the same whichever number of
 processes made them, and every reader of riprap's outputs (``riprap analyse``, the series, the
@@ -12,12 +12,12 @@ entry, not per step.
 from __future__ import annotations
 
 from riprap.models.fluid import FluidModel
-from riprap.models.split_files import FramePiece, save_checkpoint_in_pieces
+from riprap.models.over_processes import OverProcesses
 
 __all__ = ["SlabFluidModel"]
 
 
-class SlabFluidModel(FluidModel):
+class SlabFluidModel(OverProcesses, FluidModel):
     """``FluidModel`` of a block (``SlabFluidSolver``); ``whole`` the whole grid's FluidSolver
     that the writers read (refreshed by ``prepare_outputs``)."""
 
@@ -35,13 +35,8 @@ class SlabFluidModel(FluidModel):
         return self.whole
 
     @property
-    def writes_files(self) -> bool:
-        return self.processes.rank == 0
-
-    def _after_step(self, dt: float, report) -> None:
-        self.whole.last_report = self.solver.last_report
-        self.whole.last_air_limit = self.solver.last_air_limit
-        super()._after_step(dt, report)
+    def block(self):
+        return self.solver
 
     def prepare_outputs(self) -> None:
         """The whole grid's state from every process's slab (every process calls it)."""
@@ -53,20 +48,3 @@ class SlabFluidModel(FluidModel):
         """The split of the run over the processes, a line per process (printed at the start)."""
         cells = self.whole.grid.cells
         return self.solver.cut.describe(cells[1] * cells[2])
-
-    def frame_piece(self) -> FramePiece:
-        """This process's part of a fluid frame (``riprap/outputs/fluid.py`` writes it)."""
-        return FramePiece(self.solver, self.whole.grid, self.processes)
-
-    def save_checkpoint_in_pieces(self, path, arrays: dict, metadata: dict):
-        """Every process its piece of the checkpoint (its own planes), process 0 the rest: it
-        restarts on any number of processes."""
-        return save_checkpoint_in_pieces(path, arrays, metadata,
-                                         self.solver.state_piece(arrays), self.processes)
-
-    def summary_fields(self, wall_time: float, steps: int) -> dict:
-        fields = super().summary_fields(wall_time, steps)
-        block = self.solver
-        fields["processes"] = {"count": block.comm.size, "slabs": list(block.cut.starts),
-                               "halo_planes": block.halo}
-        return fields
