@@ -168,8 +168,13 @@ def run_series(case, *, output_directory=None, progress: bool = True, say=print,
         if done:
             say(f"riprap: series step {sea.number}/{len(steps)}: done before, not run again "
                 f"({step.folder})")
+            # its pace counts in the estimate of the time to go (a resumed step's summary has
+            # the wall time of its last part only: the estimate is then a little short)
+            wall += float(read_json_object(step.folder / "summary.json", "step summary",
+                                           "delete the step's folder to run it again")
+                          .get("wall_time", 0.0))
         else:
-            to_go = ("" if simulated == 0 else
+            to_go = ("" if simulated == 0 or wall == 0 else
                      f"; about {(total - simulated) * wall / simulated / 3600:.2g} h of the series "
                      "to go at the pace so far")
             say(f"riprap: series step {sea.number}/{len(steps)}: Hm0 = {sea.significant_height:g} "
