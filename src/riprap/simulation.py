@@ -607,10 +607,15 @@ class Simulation:
         path = self.output_directory / name
         save_in_pieces = getattr(model, "save_checkpoint_in_pieces", None)
         if save_in_pieces is not None:
-            return save_in_pieces(path, arrays, metadata)      # every process its piece
-        if not _writes_files(model):
-            return path
-        return save_checkpoint(path, arrays=arrays, metadata=metadata)
+            save_in_pieces(path, arrays, metadata)      # every process its piece
+        elif _writes_files(model):
+            save_checkpoint(path, arrays=arrays, metadata=metadata)
+        processes = getattr(model, "processes", None)
+        if processes is not None:
+            # no process goes on (to end the run on an error, say) before the checkpoint is on
+            # disk: a process that ends first ends them all
+            processes.barrier()
+        return path
 
     def check_restart(self, path) -> tuple[dict, dict]:
         """Every check of a restart from ``path`` (``riprap check --restart`` makes them too): a

@@ -97,6 +97,30 @@ def test_dam_break_over_two_processes_and_restarts(tmp_path):
         assert same_state(one / "checkpoint.npz", folder / "checkpoint.npz"), folder.name
 
 
+def test_a_blow_up_on_one_process_stops_all_with_the_failure_checkpoint(tmp_path):
+    """A non-finite pressure found by process 1 after the dam break's fifth step
+    (tests/parallel/blow_up_run.py): every process stops with exit 2 and one message naming the
+    process, the cell in the case's grid and the time; the failure checkpoint (in pieces) holds
+    the last good state, and continued from it on one process the run ends as the unbroken
+    one-process run, bit for bit."""
+    half = tmp_path / "half.toml"
+    half.write_text(DAM_BREAK.read_text().replace("end_time = 0.2 ", "end_time = 0.1 "))
+    broken = tmp_path / "broken"
+    result = launch(2, sys.executable, str(HERE / "blow_up_run.py"), "run", str(half), "--out",
+                    str(broken), check=False, timeout=300)
+    assert result.returncode != 0
+    assert re.search(r"pressure became non-finite at index \[66, 0, 5\] .* at t = 0\.01\d* s "
+                     r".*\(process 1 of 2\)", result.stderr), result.stderr[-3000:]
+    failure = broken / "failure_checkpoint.npz"
+    assert f"was written to {failure}" in result.stderr
+    assert len(list((broken / "failure_checkpoint_pieces").iterdir())) == 2
+    arrays, _ = load_checkpoint(failure)
+    assert arrays["fraction"].shape == (125, 1, 63) and np.isfinite(arrays["pressure"]).all()
+    riprap(1, "run", str(half), "--out", str(broken), "--restart", str(failure))
+    riprap(1, "run", str(half), "--out", str(tmp_path / "unbroken"))
+    assert same_state(tmp_path / "unbroken" / "checkpoint.npz", broken / "checkpoint.npz")
+
+
 def test_wave_flume_over_two_processes():
     """examples/09's regular waves (wave-making and absorbing zones, eight surface gauges), 600
     steps of 0.01 s (the waves cross the cut at x = 6.32 m from t of about 5 s): the whole

@@ -127,6 +127,9 @@ class SlabFluidSolver(FluidSolver):
                            slice(0, low), slice(low + owned - high, low + owned),
                            slice(low + owned + faces, low + owned + faces + high))
 
+    def _grid_index(self, index) -> list:
+        return [int(index[0]) + self.first - self.low] + [int(i) for i in index[1:]]
+
     def _check_finite(self) -> None:
         message = ""
         try:

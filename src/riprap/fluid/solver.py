@@ -602,10 +602,16 @@ class FluidSolver:
                 position = [self.grid.lower[a] + (min(where[a], self.grid.cells[a] - 1) + 0.5) * self.h
                             for a in range(3)]
                 raise InstabilityError(
-                    f"fluid: {name} became non-finite at index {where.tolist()} (near x, y, z = "
+                    f"fluid: {name} became non-finite at index {self._grid_index(where)} (near "
+                    f"x, y, z = "
                     f"{', '.join(f'{v:.4g}' for v in position)} m) at t = {self.time:.6g} s (step "
                     f"{self.step_count}, dt = {self.time_step:.3e} s); reduce courant_number or "
                     "max_time_step, or refine the grid")
+
+    def _grid_index(self, index) -> list:
+        """A cell or face index of this solver's arrays as the case's grid numbers it (a block of
+        a run over several processes shifts it)."""
+        return [int(i) for i in index]
 
     # ------------------------------------------------------------------ state
     def state_arrays(self) -> dict:
