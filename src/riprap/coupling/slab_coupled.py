@@ -192,21 +192,10 @@ class SlabCoupledSolver(CoupledSolver):
         rigid_coupling.gather(axis, index, *fields, values)
 
     # ------------------------------------------------------------------ the whole run's state
-    def whole_state(self, state: dict) -> dict:
-        """A one-process checkpoint's arrays from every block's ``state_arrays`` (every process
-        calls it): the whole grid, the carrying field's faces of every slab in whole-grid
-        indices (their order is not read)."""
-        whole = self.fluid.gather_whole(state)
-        if "coupling_carried_axis" in state:
-            parts = self.comm.all_values(self._carried_piece(state))
-            for name in parts[0]:
-                whole[name] = np.concatenate([part[name] for part in parts])
-        return whole
-
     def state_piece(self, state: dict) -> dict:
         """This process's piece of a checkpoint of ``state`` (its ``state_arrays``): its own
         planes of the grid and its own faces of the carrying field in whole-grid indices; the
-        pieces of all processes joined in order are ``whole_state``'s arrays."""
+        pieces of all processes joined in order are one process's arrays (``load_checkpoint``)."""
         piece = self.fluid.owned_state(state)
         if "coupling_carried_axis" in state:
             piece.update(self._carried_piece(state))
