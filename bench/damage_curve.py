@@ -4,9 +4,12 @@ on a porous core at laboratory scale, untuned, from below the start of damage to
 The section (Froude-scaled laboratory flume, fresh water): cubes of Dn = 4.6 cm (2300 kg/m^3,
 Delta = 1.3) placed by ``riprap place`` on a 1:1.5 slope (Van der Meer's 1988 cube tests' slope)
 over one layer of fixed underlayer rocks (Dn50 = Dn / 2.3, the filter rule), a porous core
-(porosity 0.4, core stone 1 cm), water depth 0.5 m, crest freeboard 0.12 m, section 0.105 m wide
-(2.3 Dn: two units a row, 16 rows, placed lying on the face within 15 degrees at a packing
-density of 0.7; the flume's water reaches half a cell beyond each side wall, as in examples/10). The flume: boundary wave maker with active absorption 2.6 m seaward of
+(porosity 0.4, core stone 1 cm), water depth 0.5 m, crest freeboard 0.12 m, section 0.12 m wide
+(2.6 Dn: two units a row, 19 rows up to 4 cm below the crest, placed lying on the face,
+square to the slope within 5 degrees of spin and 5 of tilt, at a design packing density of
+0.65: randomly spun cubes need up to 1.4 Dn each, and at 2.3 Dn and 0.7 riprap place set 9 of
+32 units on others; the flume's water reaches half a cell beyond each side wall, as in
+examples/10). The flume: boundary wave maker with active absorption 2.6 m seaward of
 the toe, three gauges for the incident waves, a run-up gauge on the face and an overtopping
 gauge at the crest's landward edge; cells of 1.5 cm (3 across a cube, 7 across the smallest Hm0).
 
@@ -40,7 +43,7 @@ DELTA = 2300.0 / 1000.0 - 1.0
 DEPTH = 0.5                # m
 FREEBOARD = 0.12           # m
 COT = 1.5
-WIDTH = 0.105              # m: 7 cells, two cubes a row
+WIDTH = 0.12               # m: 8 cells, two cubes a row (2.6 Dn)
 STEEPNESS = 0.035
 CELL = 0.015               # m
 
@@ -103,12 +106,13 @@ nominal_diameter = {DN}
 mesh_size = {DN / 2}             # a cube's faces are flat: a coarse mesh is exact, and softer
 
 [placement]
-rows = 16
+rows = 19
 units_per_row = 2
-packing_density_coefficient = 0.7
+packing_density_coefficient = 0.65
 release = "on_contact"
 orientation = "random_within"
-max_tilt_deg = 15.0
+max_tilt_deg = 5.0
+max_spin_deg = 5.0
 settle_time = 2.0
 rest_speed = 0.01
 

@@ -567,6 +567,11 @@ KEYS: tuple[Key, ...] = (
         "from the grid file.", default="random", choices=("random", "random_within", "user")),
     Key("placement", "max_tilt_deg", "number", "deg", "Largest tilt for random_within.",
         default=30.0, valid_range=Range(minimum=0.0, maximum=180.0)),
+    Key("placement", "max_spin_deg", "number", "deg",
+        "random_within: largest spin about the face normal away from square to the slope (a "
+        "unit's sides along and across the slope); 180: any spin. Cubes set square (a few "
+        "degrees) fit two to a row where random spins would need 1.4 Dn each.",
+        default=180.0, valid_range=Range(minimum=0.0, maximum=180.0)),
     Key("placement", "initial_velocity", "vector", "m/s",
         "Velocity of every unit at the start (deposits faster).", default=_ZERO),
     Key("placement", "deposition", "string", "-",

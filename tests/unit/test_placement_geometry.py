@@ -126,6 +126,41 @@ def test_limited_random_orientations_stay_within_the_tilt_of_the_face():
     assert abs(x_axes.mean(axis=0)).max() < 0.15      # no preferred spin
 
 
+def test_a_spin_limit_keeps_units_square_to_the_slope_and_the_tilts_unchanged():
+    """random_within with max_spin_deg: each unit's x axis, seen from the face normal, turns at
+    most max_spin_deg away from up the slope (spins drawn either way); the tilts are those of the
+    same seed without a limit (one draw per unit either way); a limit outside 0..180 is
+    refused with its value."""
+    from scipy.spatial.transform import Rotation
+
+    from riprap.placement import unit_orientations
+
+    slope = Slope(cotangent=1.5, width=3.0, length=6.0)
+
+    def rotations(**limits):
+        q = unit_orientations(400, mode="random_within", slope=slope, seed=3, max_tilt_deg=0.0,
+                              **limits)
+        return Rotation.from_quat(np.concatenate([q[:, 1:], q[:, :1]], axis=1))
+
+    up_slope = np.array([np.cos(slope.angle), 0.0, np.sin(slope.angle)])
+    x_axes = rotations(max_spin_deg=5.0).apply([1.0, 0.0, 0.0])
+    spin = np.degrees(np.arctan2(x_axes[:, 1], x_axes @ up_slope))
+    assert abs(spin).max() <= 5.0 + 1e-9
+    assert spin.min() < -4.0 and spin.max() > 4.0
+    free = rotations().apply([1.0, 0.0, 0.0])
+    assert abs(np.degrees(np.arctan2(free[:, 1], free @ up_slope))).max() > 170.0
+
+    def tilts(**limits):
+        q = unit_orientations(50, mode="random_within", slope=slope, seed=3, max_tilt_deg=20.0,
+                              **limits)
+        r = Rotation.from_quat(np.concatenate([q[:, 1:], q[:, :1]], axis=1))
+        return np.degrees(np.arccos(np.clip(r.apply([0.0, 0.0, 1.0]) @ slope.normal, -1, 1)))
+
+    np.testing.assert_allclose(tilts(max_spin_deg=3.0), tilts(), atol=1e-9)
+    with pytest.raises(CaseFileError, match="max_spin_deg = -1.0 must lie in 0..180"):
+        unit_orientations(3, mode="random_within", slope=slope, max_spin_deg=-1.0)
+
+
 def test_orientation_mode_errors():
     from riprap.placement import unit_orientations
 

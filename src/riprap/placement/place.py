@@ -222,12 +222,14 @@ def _stick_to_face(sim: Simulation) -> bool:
 def unit_orientations(count: int, *, mode: str, slope,
                       seed: int = default_of("placement", "seed"),
                       max_tilt_deg: float = default_of("placement", "max_tilt_deg"),
+                      max_spin_deg: float = default_of("placement", "max_spin_deg"),
                       user=None) -> np.ndarray:
     """Quaternions (w, x, y, z) rotating the unit as built into the world.
 
     ``mode``: ``"user"`` (``user`` quaternions), ``"random"`` (uniform on rotations) or
-    ``"random_within"`` (the unit's z axis turned to the face normal, then a random spin about it
-    and a tilt up to ``max_tilt_deg`` about a random horizontal axis).
+    ``"random_within"`` (the unit's z axis turned to the face normal, then a random spin about it,
+    within ``max_spin_deg`` either way of square to the slope, and a tilt up to ``max_tilt_deg``
+    about a random horizontal axis).
     """
     rng = np.random.default_rng(seed)
     if mode == "user":
@@ -240,8 +242,13 @@ def unit_orientations(count: int, *, mode: str, slope,
     elif mode == "random_within":
         if not 0.0 <= max_tilt_deg <= 180.0:
             raise CaseFileError(f"max_tilt_deg = {max_tilt_deg!r} must lie in 0..180 degrees")
+        if not 0.0 <= max_spin_deg <= 180.0:
+            raise CaseFileError(f"max_spin_deg = {max_spin_deg!r} must lie in 0..180 degrees")
         to_face = Rotation.from_rotvec(np.array([0.0, -slope.angle, 0.0]))
-        spin = Rotation.from_euler("z", rng.uniform(0.0, 2.0 * np.pi, count)[:, None])
+        # one draw per unit either way, so that the tilts after it are those of any spin limit
+        spins = (rng.uniform(0.0, 2.0 * np.pi, count) if max_spin_deg >= 180.0 else
+                 rng.uniform(-np.radians(max_spin_deg), np.radians(max_spin_deg), count))
+        spin = Rotation.from_euler("z", spins[:, None])
         azimuth = rng.uniform(0.0, 2.0 * np.pi, count)
         tilt = np.radians(max_tilt_deg) * np.sqrt(rng.uniform(0.0, 1.0, count))
         axes = np.stack([np.cos(azimuth), np.sin(azimuth), np.zeros(count)], axis=1)

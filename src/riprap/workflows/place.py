@@ -201,7 +201,8 @@ def _orientations(case, slope, count: int, user):
     ``riprap check`` and ``riprap place``)."""
     pl = case.placement
     return unit_orientations(count, mode=pl.orientation, slope=slope, seed=pl.seed,
-                             max_tilt_deg=pl.max_tilt_deg, user=user)
+                             max_tilt_deg=pl.max_tilt_deg, max_spin_deg=pl.max_spin_deg,
+                             user=user)
 
 
 def _unit_orientations(case, slope, grid):
