@@ -24,7 +24,7 @@ import numpy as np
 from riprap.errors import CaseFileError
 from riprap.schema import default_of
 
-__all__ = ["FluidGrid", "BOUNDARY_KINDS", "SIDES"]
+__all__ = ["BlockGrid", "FluidGrid", "BOUNDARY_KINDS", "SIDES"]
 
 #: Sides of the box, in the order of the ``boundaries`` mapping.
 SIDES = ("x_low", "x_high", "y_low", "y_high", "z_low", "z_high")
@@ -123,6 +123,11 @@ class FluidGrid:
     def open_top(self) -> bool:
         return self.boundaries["z_high"] == "open"
 
+    @property
+    def whole_grid(self) -> FluidGrid:
+        """The grid of the whole box: this one (a :class:`BlockGrid` answers its whole's)."""
+        return self
+
     def centres(self, axis: int) -> np.ndarray:
         """Cell-centre coordinates along ``axis`` (m)."""
         n = self.cells[axis]
@@ -146,3 +151,66 @@ class FluidGrid:
                                     f"{list(self.lower)} .. {list(self.upper)}")
             index.append(i)
         return tuple(index)
+
+    def block(self, first: int, stop: int, *, boundaries: dict | None = None) -> BlockGrid:
+        """The x-planes ``first`` .. ``stop`` - 1 of this grid as a grid of their own, whose
+        coordinates are this grid's to the bit (:class:`BlockGrid`); ``boundaries`` replaces
+        the sides' kinds (a block's ends inside the grid are no walls of the box)."""
+        if not (isinstance(first, (int, np.integer)) and isinstance(stop, (int, np.integer))
+                and 0 <= first < stop <= self.cells[0]):
+            raise CaseFileError(f"fluid grid: a block of x-planes {first!r} .. {stop!r} does not "
+                                f"lie within the grid's 0 .. {self.cells[0]}")
+        faces = self.faces(0)
+        lower = (float(faces[first]),) + self.lower[1:]
+        upper = (float(faces[stop]),) + self.upper[1:]
+        return BlockGrid(lower=lower, upper=upper, cells=(int(stop - first),) + self.cells[1:],
+                         boundaries=dict(self.boundaries if boundaries is None else boundaries),
+                         whole=self, first=int(first))
+
+
+@dataclass(frozen=True)
+class BlockGrid(FluidGrid):
+    """Some x-planes of a grid (``whole``), from plane ``first`` on (``FluidGrid.block``): a
+    grid of their own whose cell size, centres, faces and cells of points are the whole grid's,
+    to the bit, so that whatever is built on the block (water, obstacles, porous zones, waves)
+    is what the whole grid builds on those planes. Its ``lower`` and ``upper`` along x are the
+    whole grid's faces at its ends."""
+
+    whole: FluidGrid | None = None
+    first: int = 0
+
+    def __post_init__(self):
+        super().__post_init__()
+        if not isinstance(self.whole, FluidGrid) or isinstance(self.whole, BlockGrid):
+            raise CaseFileError("a block grid needs the whole FluidGrid it is part of")
+
+    @property
+    def cell_size(self) -> float:
+        return self.whole.cell_size
+
+    @property
+    def whole_grid(self) -> FluidGrid:
+        return self.whole
+
+    @property
+    def stop(self) -> int:
+        """The whole grid's x-plane after the block's last."""
+        return self.first + self.cells[0]
+
+    def centres(self, axis: int) -> np.ndarray:
+        if axis != 0:
+            return self.whole.centres(axis)
+        return self.whole.centres(0)[self.first:self.stop]
+
+    def faces(self, axis: int) -> np.ndarray:
+        if axis != 0:
+            return self.whole.faces(axis)
+        return self.whole.faces(0)[self.first:self.stop + 1]
+
+    def cell_of(self, point) -> tuple:
+        i, j, k = self.whole.cell_of(point)
+        if not self.first <= i < self.stop:
+            raise CaseFileError(f"point {np.asarray(point, dtype=float).tolist()} lies outside "
+                                f"the block {list(self.lower)} .. {list(self.upper)} (x-planes "
+                                f"{self.first} .. {self.stop - 1} of the fluid box)")
+        return i - self.first, j, k

@@ -90,6 +90,20 @@ class PorousZone:
                     "; list the points in order around the zone's outline (a crossed outline "
                     "leaves part of the zone out)")
 
+    def covers_any(self, grid) -> bool:
+        """Whether the zone covers any part of ``grid`` (as ``cover(grid).any()``, from one
+        x-z plane and the box's axes, not the whole grid's cells)."""
+        if self.polygon is None:
+            return all(bool(np.any((np.minimum(self.upper[a], grid.faces(a)[1:])
+                                    - np.maximum(self.lower[a], grid.faces(a)[:-1])) > 0.0))
+                       for a in ((0, 2) if grid.two_dimensional else (0, 1, 2)))
+        # a polygon's cover is the same in every y-plane: one of them, with the grid's x and z
+        plane = type(grid.whole_grid)(lower=grid.lower, upper=(grid.upper[0],
+                                                               grid.lower[1] + grid.cell_size,
+                                                               grid.upper[2]),
+                                      cells=(grid.cells[0], 1, grid.cells[2]))
+        return bool(self.cover(plane).any())
+
     def cover(self, grid) -> np.ndarray:
         """Fraction of every cell of ``grid`` inside the zone (nx, ny, nz)."""
         if self.polygon is None:
@@ -132,7 +146,8 @@ class PorousMedium:
         added = np.zeros(shape)
         for zone in self.zones:
             cover = zone.cover(grid)
-            if not cover.any():
+            # a block of a split grid may miss a zone that the whole grid holds
+            if not (cover.any() if grid.whole_grid is grid else zone.covers_any(grid.whole_grid)):
                 raise CaseFileError(f"{zone.name}: covers no part of the fluid grid "
                                     f"{list(grid.lower)} .. {list(grid.upper)} m")
             n, d = zone.porosity, zone.stone_diameter

@@ -221,9 +221,10 @@ class FluidSolver:
         if np.any(upper <= lower):
             raise CaseFileError(f"fluid water box {lower.tolist()} .. {upper.tolist()}: upper must "
                                 "exceed lower in every direction")
-        if np.any(upper <= np.asarray(g.lower)) or np.any(lower >= np.asarray(g.upper)):
+        box = g.whole_grid                  # a block's box is the whole grid's
+        if np.any(upper <= np.asarray(box.lower)) or np.any(lower >= np.asarray(box.upper)):
             raise CaseFileError(f"fluid water box {lower.tolist()} .. {upper.tolist()} lies outside "
-                                f"the fluid box {list(g.lower)} .. {list(g.upper)}")
+                                f"the fluid box {list(box.lower)} .. {list(box.upper)}")
         if g.two_dimensional:
             lower[1], upper[1] = g.lower[1], g.upper[1]
         self.fraction = np.minimum(1.0, self.fraction + _box_overlap_fractions(g, lower, upper))
@@ -247,24 +248,33 @@ class FluidSolver:
         self.fraction[mask] = 0.0
 
     def add_obstacle_box(self, lower, upper) -> None:
-        """A fixed solid: every cell whose centre lies inside lower..upper (m)."""
+        """A fixed solid: every cell whose centre lies inside lower..upper (m). On a block of a
+        split grid (``FluidGrid.block``) the box and its check are the whole grid's."""
         g = self.grid
-        inside = [(g.centres(a) >= lower[a]) & (g.centres(a) <= upper[a]) for a in range(3)]
-        if g.two_dimensional:
-            inside[1] = np.ones(1, dtype=bool)
-        mask = inside[0][:, None, None] & inside[1][None, :, None] & inside[2][None, None, :]
-        if not mask.any():
+        whole = g.whole_grid
+
+        def inside_along(grid):
+            inside = [(grid.centres(a) >= lower[a]) & (grid.centres(a) <= upper[a])
+                      for a in range(3)]
+            if grid.two_dimensional:
+                inside[1] = np.ones(1, dtype=bool)
+            return inside
+
+        inside = inside_along(whole)
+        if not all(along.any() for along in inside):
             raise CaseFileError(f"fluid obstacle {list(lower)} .. {list(upper)} holds no cell "
                                 f"centre (cells are {self.h:g} m)")
+        here = inside_along(g) if g is not whole else inside
+        mask = here[0][:, None, None] & here[1][None, :, None] & here[2][None, None, :]
         self.solid |= mask
         self.fraction[mask] = 0.0
         first = [int(np.argmax(inside[a])) for a in range(3)]
         last = [len(inside[a]) - int(np.argmax(inside[a][::-1])) for a in range(3)]
-        origin = np.asarray(g.lower, dtype=np.float64)
+        origin = np.asarray(whole.lower, dtype=np.float64)
         box_lower = origin + np.array(first) * self.h
-        box_upper = np.minimum(origin + np.array(last) * self.h, g.upper)
-        if g.two_dimensional:
-            box_lower[1], box_upper[1] = g.lower[1], g.upper[1]
+        box_upper = np.minimum(origin + np.array(last) * self.h, whole.upper)
+        if whole.two_dimensional:
+            box_lower[1], box_upper[1] = whole.lower[1], whole.upper[1]
         self.obstacle_boxes.append((box_lower, box_upper))
 
     def add_porous_zones(self, zones) -> None:

@@ -1,0 +1,79 @@
+"""A block of a fluid grid's x-planes (``FluidGrid.block``) has the whole grid's coordinates to
+the bit, so that water, obstacles and porous zones built on the block are the whole grid's cells
+on those planes, bit for bit: what a process of a split run needs to build its block without the
+whole grid (issue 39, the memory split)."""
+import numpy as np
+import pytest
+
+from riprap.errors import CaseFileError
+from riprap.fluid.grid import BlockGrid, FluidGrid
+from riprap.fluid.porous import PorousZone
+from riprap.fluid.solver import FluidSolver
+
+# the damage curve's flume: a corner and a cell size that do not add up exactly in binary
+WHOLE = FluidGrid(lower=(-2.595, -0.0075, 0.0), upper=(1.5, 0.1275, 0.75), cells=(273, 9, 50))
+BLOCKS = [(0, 68), (60, 140), (133, 273), (265, 273)]
+
+
+@pytest.mark.parametrize("first, stop", BLOCKS)
+def test_a_block_has_the_whole_grids_coordinates_to_the_bit(first, stop):
+    block = WHOLE.block(first, stop)
+    assert isinstance(block, BlockGrid) and block.cells == (stop - first, 9, 50)
+    assert block.cell_size == WHOLE.cell_size
+    np.testing.assert_array_equal(block.centres(0), WHOLE.centres(0)[first:stop])
+    np.testing.assert_array_equal(block.faces(0), WHOLE.faces(0)[first:stop + 1])
+    for axis in (1, 2):
+        np.testing.assert_array_equal(block.centres(axis), WHOLE.centres(axis))
+        np.testing.assert_array_equal(block.faces(axis), WHOLE.faces(axis))
+    assert block.lower[0] == WHOLE.faces(0)[first] and block.upper[0] == WHOLE.faces(0)[stop]
+    point = (float(block.centres(0)[-1]), 0.05, 0.3)
+    i, j, k = WHOLE.cell_of(point)
+    assert block.cell_of(point) == (i - first, j, k)
+
+
+def test_a_block_outside_the_grid_and_a_point_outside_the_block_are_refused():
+    with pytest.raises(CaseFileError, match="x-planes 10 .. 300 does not lie within"):
+        WHOLE.block(10, 300)
+    with pytest.raises(CaseFileError, match="x-planes 5 .. 5"):
+        WHOLE.block(5, 5)
+    with pytest.raises(CaseFileError, match=r"outside the block .* \(x-planes 60 .. 139 of"):
+        WHOLE.block(60, 140).cell_of((1.4, 0.05, 0.3))
+
+
+def _flume(grid):
+    fluid = FluidSolver(grid)
+    fluid.set_still_water_level(0.5)
+    fluid.add_water_box((-0.4, -0.0075, 0.0), (0.3, 0.1275, 0.6371))
+    fluid.add_obstacle_box((-0.9031, 0.0, 0.0), (-0.2, 0.1275, 0.0602))
+    fluid.add_porous_zones([
+        PorousZone(porosity=0.4, stone_diameter=0.01, name="core",
+                   polygon=[[-0.6, 0.0], [0.87, 0.6], [1.2, 0.6], [1.2, 0.0]]),
+        PorousZone(porosity=0.5, stone_diameter=0.02, name="filter",
+                   lower=(-0.71, -0.0075, 0.0), upper=(0.1, 0.1275, 0.1333))])
+    return fluid
+
+
+def test_water_obstacles_and_porous_zones_built_on_a_block_are_the_whole_grids_cells():
+    whole = _flume(WHOLE)
+    for first, stop in [(0, 40), (60, 140), (133, 273)]:     # (0, 40) misses the zones
+        block = _flume(WHOLE.block(first, stop))
+        assert block.h == whole.h
+        np.testing.assert_array_equal(block.fraction, whole.fraction[first:stop])
+        np.testing.assert_array_equal(block.solid, whole.solid[first:stop])
+        np.testing.assert_array_equal(block.porous.porosity, whole.porous.porosity[first:stop])
+
+
+def test_a_block_refuses_what_the_whole_grid_refuses_and_only_that():
+    """A zone, obstacle or water box that misses the block but not the whole grid is built
+    (nothing on the block); one that misses the whole grid is refused on every block."""
+    block = FluidSolver(WHOLE.block(0, 40))
+    block.add_obstacle_box((-0.9031, 0.0, 0.0), (-0.2, 0.1275, 0.0602))
+    block.add_water_box((-0.4, -0.0075, 0.0), (0.3, 0.1275, 0.6371))
+    assert not block.solid.any() and not block.fraction.any()
+    with pytest.raises(CaseFileError, match="holds no cell centre"):
+        block.add_obstacle_box((2.0, 0.0, 0.0), (3.0, 0.1, 0.1))
+    with pytest.raises(CaseFileError, match="lies outside the fluid box .-2.595"):
+        block.add_water_box((2.0, 0.0, 0.0), (3.0, 0.1, 0.1))
+    with pytest.raises(CaseFileError, match="far: covers no part of the fluid grid"):
+        block.add_porous_zones([PorousZone(porosity=0.4, stone_diameter=0.01, name="far",
+                                           polygon=[[2.0, 0.0], [3.0, 0.6], [3.0, 0.0]])])
