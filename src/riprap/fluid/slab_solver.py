@@ -24,7 +24,6 @@ from __future__ import annotations
 import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError
-from riprap.fluid.grid import FluidGrid
 from riprap.fluid.kernels.plane_sums import plane_sums
 from riprap.fluid.slab_pressure import DISTRIBUTED_LEVELS, SlabPressureSolver
 from riprap.fluid.solver import FluidSolver, boundary_inflow_planes
@@ -218,19 +217,14 @@ def split_fluid(whole: FluidSolver, comm, *, halo: int = HALO_PLANES, plane_cost
         boundaries["x_low"] = "free_slip"
     if high:
         boundaries["x_high"] = "free_slip"
-    lower = list(whole.grid.lower)
-    upper = list(whole.grid.upper)
-    lower[0] = whole.grid.lower[0] + (first - low) * h
-    upper[0] = whole.grid.lower[0] + (stop + high) * h
-    grid = FluidGrid(lower=tuple(lower), upper=tuple(upper),
-                     cells=(stop + high - (first - low), ny, nz), boundaries=boundaries)
+    # the block's coordinates are the whole grid's to the bit (FluidGrid.block)
+    grid = whole.grid.block(first - low, stop + high, boundaries=boundaries)
     block = SlabFluidSolver(
         grid, water=whole.water, air=whole.air, gravity=whole.gravity,
         courant_number=whole.courant_number, pressure_tolerance=whole.pressure_solver.tolerance,
         pressure_volume_tolerance=whole.pressure_solver.volume_tolerance,
         max_time_step=whole.max_time_step, surface_tension=whole.surface_tension,
         limit_air_speed=whole.limit_air_speed)
-    block.h = h                      # the whole grid's, bit for bit (the block's own may round)
     block.comm, block.cut, block.halo = comm, cut, halo
     block.whole_cells = (nx, ny, nz)
     block.first, block.stop, block.low, block.high = first, stop, low, high
