@@ -77,3 +77,54 @@ def test_a_block_refuses_what_the_whole_grid_refuses_and_only_that():
     with pytest.raises(CaseFileError, match="far: covers no part of the fluid grid"):
         block.add_porous_zones([PorousZone(porosity=0.4, stone_diameter=0.01, name="far",
                                            polygon=[[2.0, 0.0], [3.0, 0.6], [3.0, 0.0]])])
+
+
+def test_relaxation_zones_prepared_on_a_block_are_the_whole_grids_cut_to_it():
+    """The wave-making and absorbing zones prepared on a block's own coordinates give the same
+    cells, faces and weights as the whole grid's zones cut to the block
+    (``riprap.models.slab_features.relaxation_of_block``, which the split runs use today); a
+    block that holds no part of a zone leaves it out, one that the whole grid misses is refused."""
+    import copy
+
+    from riprap.models.slab_features import relaxation_of_block
+    from riprap.waves.relaxation import ABSORPTION, GENERATION, RelaxationZone, WaveRelaxation
+    from riprap.waves.theory import LinearWave
+
+    zones = [RelaxationZone(GENERATION, -2.595, -1.6), RelaxationZone(ABSORPTION, 0.9, 1.5)]
+    wave = LinearWave(height=0.05, period=1.2, depth=0.5)
+    whole = WaveRelaxation(wave, 0.5, zones)
+    whole._prepare(FluidSolver(WHOLE))
+    for first, stop in [(0, 68), (60, 140), (190, 273)]:
+        cut = relaxation_of_block(copy.copy(whole), None, first, stop)
+        own = WaveRelaxation(wave, 0.5, zones)
+        own._prepare(FluidSolver(WHOLE.block(first, stop)))
+        assert len(own._cache[0]) == len(cut._cache[0])
+        for mine, theirs in zip(own._cache[0], cut._cache[0]):
+            assert mine[0] is theirs[0]
+            for a, b in zip(mine[1:], theirs[1:]):
+                np.testing.assert_array_equal(a, b)
+        for a, b in zip(own._cache[1:5], cut._cache[1:5]):
+            np.testing.assert_array_equal(a, b)
+    with pytest.raises(CaseFileError, match="zone x = 2 .. 3 m holds no cell centre"):
+        WaveRelaxation(None, 0.5, [RelaxationZone(ABSORPTION, 2.0, 3.0)])._prepare(
+            FluidSolver(WHOLE.block(0, 68)))
+
+
+def test_porous_zones_built_on_a_block_are_the_whole_grids_cut_to_it():
+    """Porous zones built on a block's coordinates: the cells' porosity and every face's
+    coefficients inside the block, and the list of porous faces, are those of the whole grid's
+    zones cut to the block (``porous_of_block``); only the block's two end x-faces (walls of the
+    block, which its halo covers) may differ."""
+    from riprap.models.slab_features import porous_of_block
+
+    whole = _flume(WHOLE).porous
+    for first, stop in [(60, 140), (133, 273)]:
+        cut = porous_of_block(whole, first, stop)
+        own = _flume(WHOLE.block(first, stop)).porous
+        np.testing.assert_array_equal(own.porosity, cut.porosity)
+        for axis in range(3):
+            inner = slice(1, -1) if axis == 0 else slice(None)
+            for name in ("face_porosity", "scale", "linear_coefficient", "quadratic_coefficient"):
+                np.testing.assert_array_equal(getattr(own, name)[axis][inner],
+                                              getattr(cut, name)[axis][inner], err_msg=name)
+            np.testing.assert_array_equal(own.faces[axis], cut.faces[axis])

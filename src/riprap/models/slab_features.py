@@ -30,7 +30,7 @@ def add_parts_to_block(block, whole) -> None:
     if whole.wave_maker is not None and block.comm.rank == 0:
         whole.wave_maker.attach(block)          # the x-low boundary is the first slab's
     if whole.gauges is not None:
-        block.gauges = BlockGauges(whole.gauges, whole, block.comm, block.cut, begin,
+        block.gauges = BlockGauges(whole.gauges, whole.grid, block.comm, block.cut, begin,
                                    block.stop, block.halo)
 
 
@@ -101,12 +101,12 @@ class BlockGauges:
     the gauge); after every step the readings are joined on every process into ``whole``
     (the whole grid's GaugeSet, which the writers and the checkpoint read)."""
 
-    def __init__(self, whole_gauges: GaugeSet, whole_fluid, comm, cut, begin: int, stop: int,
+    def __init__(self, whole_gauges: GaugeSet, whole_grid, comm, cut, begin: int, stop: int,
                  halo: int):
         self.whole = whole_gauges
         self.comm = comm
         if whole_gauges._where is None:
-            whole_gauges._locate(whole_fluid)
+            whole_gauges.locate_on(whole_grid)
         where, h, bottom = whole_gauges._where
         mine, places, self.owner = [], [], []
         for gauge, place in zip(whole_gauges.gauges, where):

@@ -110,8 +110,12 @@ class GaugeSet:
                                     f"fluid box {list(grid.lower)} .. {list(grid.upper)} m")
 
     def _locate(self, fluid):
-        grid = fluid.grid
-        h = fluid.h
+        self.locate_on(fluid.grid)
+
+    def locate_on(self, grid):
+        """Find each gauge's cells on ``grid`` (the whole grid's, also for a split run's
+        gauges, which then read them from the block that holds them: ``BlockGauges``)."""
+        h = grid.cell_size
         lower = np.asarray(grid.lower, dtype=float)
         cells = grid.cells
         where = []

@@ -120,9 +120,14 @@ class WaveRelaxation:
                                    & (np.arange(x_faces.size) > 0)
                                    & (np.arange(x_faces.size) < x_faces.size - 1))
             if cells.size == 0:
+                whole = grid.whole_grid.centres(0)
+                if grid.whole_grid is not grid and np.any((whole >= zone.start)
+                                                          & (whole <= zone.end)):
+                    continue            # on another block of a split grid
                 raise CaseFileError(f"waves: the {zone.kind} zone x = {zone.start:g} .. "
                                     f"{zone.end:g} m holds no cell centre of the fluid grid "
-                                    f"(cells of {fluid.h:g} m from x = {grid.lower[0]:g} m)")
+                                    f"(cells of {fluid.h:g} m from x = "
+                                    f"{grid.whole_grid.lower[0]:g} m)")
             prepared.append((zone, cells, faces, relaxation_weight(zone.chi(x_cells[cells])),
                              relaxation_weight(zone.chi(x_faces[faces]))))
         z_cells = grid.centres(2)
