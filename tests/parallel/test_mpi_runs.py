@@ -131,6 +131,17 @@ def test_wave_flume_over_two_processes():
     assert "bit for bit" in result.stdout, result.stdout
 
 
+def test_porous_flume_with_boundary_waves_and_every_gauge_over_two_processes():
+    """A test series' flume (tests/parallel/cases/porous_flume.toml: a porous core across the
+    cut, waves from the x-low boundary with active absorption, surface, run-up and overtopping
+    gauges), 400 steps: the whole grid and every gauge's record bit for bit those of one
+    process, compared every 50 steps."""
+    case = HERE / "cases" / "porous_flume.toml"
+    result = launch(2, sys.executable, str(HERE / "slab_fluid_check.py"), str(case), "400", "8",
+                    "50", timeout=600)
+    assert "bit for bit" in result.stdout, result.stdout
+
+
 def test_a_killed_process_ends_the_run(tmp_path):
     """One process of two killed mid-run: the launcher ends the other, within 30 s."""
     longer = tmp_path / "long.toml"

@@ -2,6 +2,8 @@
 the bit, so that water, obstacles and porous zones built on the block are the whole grid's cells
 on those planes, bit for bit: what a process of a split run needs to build its block without the
 whole grid (issue 39, the memory split)."""
+import copy
+
 import numpy as np
 import pytest
 
@@ -82,11 +84,9 @@ def test_a_block_refuses_what_the_whole_grid_refuses_and_only_that():
 def test_relaxation_zones_prepared_on_a_block_are_the_whole_grids_cut_to_it():
     """The wave-making and absorbing zones prepared on a block's own coordinates give the same
     cells, faces and weights as the whole grid's zones cut to the block
-    (``riprap.models.slab_features.relaxation_of_block``, which the split runs use today); a
+    (``_relaxation_cut``, what the split runs did before); a
     block that holds no part of a zone leaves it out, one that the whole grid misses is refused."""
-    import copy
 
-    from riprap.models.slab_features import relaxation_of_block
     from riprap.waves.relaxation import ABSORPTION, GENERATION, RelaxationZone, WaveRelaxation
     from riprap.waves.theory import LinearWave
 
@@ -95,7 +95,7 @@ def test_relaxation_zones_prepared_on_a_block_are_the_whole_grids_cut_to_it():
     whole = WaveRelaxation(wave, 0.5, zones)
     whole._prepare(FluidSolver(WHOLE))
     for first, stop in [(0, 68), (60, 140), (190, 273)]:
-        cut = relaxation_of_block(copy.copy(whole), None, first, stop)
+        cut = _relaxation_cut(copy.copy(whole), None, first, stop)
         own = WaveRelaxation(wave, 0.5, zones)
         own._prepare(FluidSolver(WHOLE.block(first, stop)))
         assert len(own._cache[0]) == len(cut._cache[0])
@@ -113,13 +113,11 @@ def test_relaxation_zones_prepared_on_a_block_are_the_whole_grids_cut_to_it():
 def test_porous_zones_built_on_a_block_are_the_whole_grids_cut_to_it():
     """Porous zones built on a block's coordinates: the cells' porosity and every face's
     coefficients inside the block, and the list of porous faces, are those of the whole grid's
-    zones cut to the block (``porous_of_block``); only the block's two end x-faces (walls of the
+    zones cut to the block (``_porous_cut``); only the block's two end x-faces (walls of the
     block, which its halo covers) may differ."""
-    from riprap.models.slab_features import porous_of_block
-
     whole = _flume(WHOLE).porous
     for first, stop in [(60, 140), (133, 273)]:
-        cut = porous_of_block(whole, first, stop)
+        cut = _porous_cut(whole, first, stop)
         own = _flume(WHOLE.block(first, stop)).porous
         np.testing.assert_array_equal(own.porosity, cut.porosity)
         for axis in range(3):
@@ -128,3 +126,46 @@ def test_porous_zones_built_on_a_block_are_the_whole_grids_cut_to_it():
                 np.testing.assert_array_equal(getattr(own, name)[axis][inner],
                                               getattr(cut, name)[axis][inner], err_msg=name)
             np.testing.assert_array_equal(own.faces[axis], cut.faces[axis])
+
+
+# ---- the whole grid's parts cut to a block's planes: the reference the block's own are held to
+# (what the split runs did before session 25: porous zones and relaxation zones built on the
+# whole grid, their cells and faces shifted into the block)
+def _porous_cut(porous, begin: int, stop: int):
+    """``PorousMedium`` of the block's planes begin..stop-1: its arrays cut along x, its list of
+    porous faces re-made, the block's two end x-faces left out (they are walls of the block)."""
+    block = copy.copy(porous)
+    block.porosity = np.ascontiguousarray(porous.porosity[begin:stop])
+    block.face_porosity, block.scale, block.linear_coefficient = [], [], []
+    block.quadratic_coefficient, block.faces = [], []
+    for axis in range(3):
+        end = stop + (1 if axis == 0 else 0)
+        for name in ("face_porosity", "scale", "linear_coefficient", "quadratic_coefficient"):
+            getattr(block, name).append(np.ascontiguousarray(getattr(porous, name)[axis][begin:end]))
+        mask = np.zeros(porous.face_porosity[axis].shape, dtype=bool)
+        mask.reshape(-1)[porous.faces[axis]] = True
+        mask = mask[begin:end].copy()
+        if axis == 0:
+            mask[0] = mask[-1] = False
+        block.faces.append(np.flatnonzero(mask))
+    return block
+
+
+def _relaxation_cut(relaxation, whole, begin: int, stop: int):
+    """``WaveRelaxation`` whose prepared zones are the whole grid's, cut to the block's planes
+    (the block's end x-faces left out)."""
+    if relaxation._cache is None:
+        relaxation._prepare(whole)
+    prepared, x_cells, x_faces, z_cells, z_faces, h = relaxation._cache
+    block_prepared = []
+    for zone, cells, faces, cell_weight, face_weight in prepared:
+        keep_cells = (cells >= begin) & (cells < stop)
+        keep_faces = (faces > begin) & (faces < stop)
+        if not keep_cells.any() and not keep_faces.any():
+            continue
+        block_prepared.append((zone, cells[keep_cells] - begin, faces[keep_faces] - begin,
+                               cell_weight[keep_cells], face_weight[keep_faces]))
+    block = copy.copy(relaxation)
+    block._cache = (block_prepared, x_cells[begin:stop], x_faces[begin:stop + 1], z_cells,
+                    z_faces, h)
+    return block

@@ -1,10 +1,11 @@
-"""The parts of a fluid that live on its grid, cut to one process's block
+"""The parts of a fluid that live on its grid, given to one process's block
 (``riprap/fluid/slab_solver.py``): porous zones, wave-making and absorbing zones, the boundary
 wave maker and the gauges.
 
-Each is taken from the whole grid's, built the same on every process, and its cells and faces
-shifted into the block, never recomputed from the block's own coordinates (which may round
-differently in the last bit), so that the block sees exactly the one process's numbers.
+The porous zones and the relaxation zones are built on the block's own coordinates, which are
+the whole grid's to the bit (``FluidGrid.block``), so their cells are the one process's; only the
+block's two end x-faces differ (walls of the block, inside its halo). The boundary wave maker is
+the first block's; each gauge is located on the whole grid and read by the block that holds it.
 """
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ import numpy as np
 from riprap.errors import CaseFileError
 from riprap.waves.gauges import OVERTOPPING, RUN_UP, SURFACE, GaugeSet
 
-__all__ = ["porous_of_block", "relaxation_of_block", "BlockGauges", "add_parts_to_block"]
+__all__ = ["BlockGauges", "add_parts_to_block"]
 
 
 def add_parts_to_block(block, whole) -> None:
@@ -23,55 +24,17 @@ def add_parts_to_block(block, whole) -> None:
     its planes."""
     begin, stop = block.first - block.low, block.stop + block.high
     if whole.porous is not None:
-        block.porous = porous_of_block(whole.porous, begin, stop)
-        block._open_part = block.porous.porosity
+        # built on the block's coordinates, which are the whole grid's (FluidGrid.block)
+        block.add_porous_zones(whole.porous.zones)
     if whole.relaxation is not None:
-        block.relaxation = relaxation_of_block(whole.relaxation, whole, begin, stop)
+        block.relaxation = copy.copy(whole.relaxation)
+        block.relaxation._cache = None
+        block.relaxation._prepare(block)
     if whole.wave_maker is not None and block.comm.rank == 0:
         whole.wave_maker.attach(block)          # the x-low boundary is the first slab's
     if whole.gauges is not None:
         block.gauges = BlockGauges(whole.gauges, whole.grid, block.comm, block.cut, begin,
                                    block.stop, block.halo)
-
-
-def porous_of_block(porous, begin: int, stop: int):
-    """``PorousMedium`` of the block's planes begin..stop-1: its arrays cut along x, its list of
-    porous faces re-made, the block's two end x-faces left out (they are walls of the block)."""
-    block = copy.copy(porous)
-    block.porosity = np.ascontiguousarray(porous.porosity[begin:stop])
-    block.face_porosity, block.scale, block.linear_coefficient = [], [], []
-    block.quadratic_coefficient, block.faces = [], []
-    for axis in range(3):
-        end = stop + (1 if axis == 0 else 0)
-        for name in ("face_porosity", "scale", "linear_coefficient", "quadratic_coefficient"):
-            getattr(block, name).append(np.ascontiguousarray(getattr(porous, name)[axis][begin:end]))
-        mask = np.zeros(porous.face_porosity[axis].shape, dtype=bool)
-        mask.reshape(-1)[porous.faces[axis]] = True
-        mask = mask[begin:end].copy()
-        if axis == 0:
-            mask[0] = mask[-1] = False
-        block.faces.append(np.flatnonzero(mask))
-    return block
-
-
-def relaxation_of_block(relaxation, whole, begin: int, stop: int):
-    """``WaveRelaxation`` whose prepared zones are the whole grid's, cut to the block's planes
-    (the block's end x-faces left out)."""
-    if relaxation._cache is None:
-        relaxation._prepare(whole)
-    prepared, x_cells, x_faces, z_cells, z_faces, h = relaxation._cache
-    block_prepared = []
-    for zone, cells, faces, cell_weight, face_weight in prepared:
-        keep_cells = (cells >= begin) & (cells < stop)
-        keep_faces = (faces > begin) & (faces < stop)
-        if not keep_cells.any() and not keep_faces.any():
-            continue
-        block_prepared.append((zone, cells[keep_cells] - begin, faces[keep_faces] - begin,
-                               cell_weight[keep_cells], face_weight[keep_faces]))
-    block = copy.copy(relaxation)
-    block._cache = (block_prepared, x_cells[begin:stop], x_faces[begin:stop + 1], z_cells,
-                    z_faces, h)
-    return block
 
 
 def _x_planes(gauge, place) -> list[int]:
