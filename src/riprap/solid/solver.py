@@ -166,10 +166,14 @@ class SolidSolver:
 
     def start_at_rest_from(self, arrays: dict) -> None:
         """Take the poses and contact history of another run's end state (its
-        :meth:`state_arrays`) with every body at rest, and evaluate the forces there (at rest the
-        tangential springs do not grow: the history is kept as it was); this run's clock and time
-        step stay. A step of a test series starts so, where the step before ended, as a flume
-        test goes on once the water is still."""
+        :meth:`state_arrays`) with every body at rest, and evaluate the forces there; this run's
+        clock and time step stay. A step of a test series starts so, where the step before
+        ended, as a flume test goes on once the water is still.
+
+        The history stays the one taken, to the bit: the evaluation at rest gives the forces of
+        the first step only. (Kept from it, a spring could change: its cap, friction times the
+        normal force, loses the damping the end state's speeds gave, and the pieces of the
+        contact, found afresh, sum its stiffness in another order.)"""
         self.finalize()
         for name in ("positions", "quaternions"):
             value = np.asarray(arrays[name], dtype=np.float64)
@@ -177,13 +181,15 @@ class SolidSolver:
                 raise CaseFileError(f"the bodies' end state has '{name}' of shape {value.shape}, "
                                     f"this run {getattr(self, name).shape}: not the same bodies")
             setattr(self, name, np.ascontiguousarray(value.copy()))
-        self.history_keys = np.ascontiguousarray(np.asarray(arrays["history_keys"]).copy())
-        self.history_springs = np.ascontiguousarray(np.asarray(arrays["history_springs"]).copy())
+        keys = np.ascontiguousarray(np.asarray(arrays["history_keys"]).copy())
+        springs = np.ascontiguousarray(np.asarray(arrays["history_springs"]).copy())
+        self.history_keys, self.history_springs = keys, springs
         self.velocities[:] = 0.0
         self.angular_momenta[:] = 0.0
         self.external_loads[:] = 0.0
         self._piece_cache = interactions.empty_piece_cache()
         self._compute_forces(self.time_step)
+        self.history_keys, self.history_springs = keys.copy(), springs.copy()
 
     def clear_contact_records(self) -> None:
         """Make the contact records again from the last force evaluation when next asked (after
