@@ -358,7 +358,8 @@ KEYS: tuple[Key, ...] = (
         "Cundall's non-viscous local damping: numerical damping, not physics; 0 switches it off.",
         default=0.0, valid_range=Range(minimum=0.0, maximum=1.0, maximum_inclusive=False)),
     Key("simulation", "rest_speed", "number", "m/s",
-        "If > 0, stop early once every free body is slower than this; 0 never stops early.",
+        "If > 0, stop early once every free body is slower than this and its net force under "
+        "5 % of its weight; 0 never stops early.",
         default=0.0, valid_range=_NON_NEGATIVE),
     Key("simulation", "seed", "integer", "-",
         "Seed of the random orientations, shape choices and jitter of body grids.",
@@ -581,7 +582,8 @@ KEYS: tuple[Key, ...] = (
         "Longest simulated time of the placement run (of each row's run, row by row).",
         default=10.0, valid_range=_POSITIVE),
     Key("placement", "rest_speed", "number", "m/s",
-        "Units rest when every one is slower than this (with rotation at its bounding radius).",
+        "Units rest when every one is slower than this (with rotation at its bounding radius) "
+        "and its net force is under 5 % of its weight.",
         default=0.02, valid_range=_POSITIVE),
     Key("placement", "rest_kinetic_energy", "number", "J",
         "... and their total kinetic energy is below this; 0: no energy condition.", default=0.0,

@@ -6,7 +6,9 @@ Checks and sources:
 - Static equilibrium (the seed paper: at the end of a POSITIT run "the particles are touching and
   in static force equilibrium"): for every unit, the contact forces read back from the pack
   (``contacts.csv``) balance its weight within ``EQUILIBRIUM_TOLERANCE`` = 5 % of the weight
-  (measured here: 0.0-2.1 %; units resting at 0.02 m/s still rock a little).
+  (measured here: 0.0-4.2 %; the placement stops once every unit is slower than 0.02 m/s and
+  its net force is under 5 % of its weight, ``riprap.models.rigid.at_rest``; with 10 % there,
+  a unit still rocking came out at 5.8 % on CI).
 - Coordination numbers within the range the seed paper reports for its 242-unit Core-Loc layer,
   2 to 10 (Xiang et al., Fig. 3b).
 - The layer figures equal those that ``riprap place`` reported for the same layer (one definition,

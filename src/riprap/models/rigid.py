@@ -38,7 +38,7 @@ _ADAPT_CHUNK_STEPS = 50
 # limit of an undamped spring; rotation about the contact lowers the effective mass, hence margin).
 _MAX_STABILITY_RATIO = 0.5
 # A body rests when its net force is below this fraction of its weight (and it is slow).
-_REST_FORCE_RATIO = 0.1
+_REST_FORCE_RATIO = 0.05
 # Gravity above this (m/s^2) is named as the likely cause of a blow-up (a centrifuge model runs
 # at tens of g; more is a typo).
 _ABSURD_GRAVITY = 1000.0
