@@ -61,9 +61,11 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
         deformable = f" ({len(sim.deformable_bodies)} deformable)" if sim.deformable_bodies else ""
         bodies = (f", {sim.solver.n_bodies + len(sim.deformable_bodies)} bodies{deformable} "
                   "coupled to the flow" if sim.coupled else "")
+        # (only process 0 prints, and only it holds the whole grid's water once split)
+        water = sim.fluid.water_volume() if world().rank == 0 else 0.0
         print(f"riprap: fluid case {path}: {grid.cells[0]} x {grid.cells[1]} x {grid.cells[2]} "
               f"cells of {grid.cell_size:.4g} m ({'2D' if grid.two_dimensional else '3D'}), water "
-              f"{sim.fluid.water_volume():.4g} m^3{bodies}")
+              f"{water:.4g} m^3{bodies}")
     else:
         print(f"riprap: case {path}: {case.body_count} bodies, {len(case.shapes)} shapes, "
               f"{len(case.walls)} wall entries")

@@ -244,6 +244,11 @@ class CoupledSolver:
         self._check_bodies_in_grid()
         self._close_fixed_interiors()
 
+    def drop_grid_arrays(self) -> None:
+        """Let go of the arrays over the grid's faces (a whole grid's coupling on a process
+        that steps only its block: ``riprap/models/slab_coupled.py``)."""
+        self._slots = None
+
     # ------------------------------------------------------------------ the run loop's view
     # (riprap.models.fluid.CoupledModel drives a CoupledSolver as FluidModel drives a FluidSolver)
     @property

@@ -266,8 +266,8 @@ class PressureSolver:
         With ``solve(time_step=dt)``: a solve also stops once no cell's volume changes by more
         than this fraction over the step (dt^2 max|r|); 0 leaves that test out.
 
-    The multigrid levels are allocated here once; ``solve`` only refills them. One instance is not
-    safe to use from two threads at the same time.
+    The multigrid levels are allocated once, by the first ``solve``; later solves only refill
+    them. One instance is not safe to use from two threads at the same time.
     """
 
     def __init__(self, shape, cell_size, *, tolerance: float = 1e-8, max_iterations: int = 200,
@@ -292,8 +292,15 @@ class PressureSolver:
         self.max_iterations = int(max_iterations)
         self.volume_tolerance = float(volume_tolerance)
 
+        self.levels = [tuple(int(n) for n in row) for row in level_shapes(shape)[0]]
+        self._hierarchy = None             # allocated by the first solve (_allocate)
+
+    def _allocate(self) -> None:
+        """The multigrid levels and the solve's work arrays, once, at the first solve: a solver
+        that never solves (the whole grid's, when a run is split over processes and each solves
+        its slab) holds none of them."""
+        shape = self.shape
         self._hierarchy = build_hierarchy(shape, np.full(3, self.cell_size))
-        self.levels = [tuple(int(n) for n in row) for row in self._hierarchy.shapes]
         self._system_rhs = np.zeros(shape)
         self._direction = np.zeros(shape)
         self._product = np.zeros(shape)
@@ -328,6 +335,8 @@ class PressureSolver:
         """
         arrays = {"rhs": rhs} if p_initial is None else {"rhs": rhs, "p_initial": p_initial}
         _check_shapes(self.shape, beta_x, beta_y, beta_z, arrays)
+        if self._hierarchy is None:
+            self._allocate()
         beta_x, beta_y, beta_z = (_as_float_array(beta) for beta in (beta_x, beta_y, beta_z))
         rhs = _as_float_array(rhs)
         listed_flat, red = _listed_cells(listed_cells, self.shape)

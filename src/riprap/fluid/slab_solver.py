@@ -157,20 +157,23 @@ class SlabFluidSolver(FluidSolver):
         pieces of all processes joined in order are ``gather_whole``'s arrays)."""
         return self.owned_state(state)
 
-    def gather_whole(self, state: dict) -> dict:
-        """The whole grid's arrays of ``state`` (a block's ``state_arrays``) on every process:
-        the slabs' own planes joined in order. What is not a grid array (the clock, gauges) is
-        every process's own copy, the same on all."""
+    def gather_whole(self, state: dict, *, on_first: bool = False) -> dict | None:
+        """The whole grid's arrays of ``state`` (a block's ``state_arrays``) on every process
+        (``on_first``: on process 0 only, None on the others): the slabs' own planes joined in
+        order. What is not a grid array (the clock, gauges) is every process's own copy, the
+        same on all."""
         counts = self.cut.counts()
         face_counts = list(counts)
         face_counts[-1] += 1
         own = self.owned_state(state)
+        gather = self.comm.gather_planes_on_first if on_first else self.comm.gather_planes
         whole = dict(state)
         for name, axis in _STATE + (("solid", None),):
             values = own[name].astype(np.float64)
-            gathered = self.comm.gather_planes(values, face_counts if axis == 0 else counts)
-            whole[name] = gathered.astype(bool) if name == "solid" else gathered
-        return whole
+            gathered = gather(values, face_counts if axis == 0 else counts)
+            if gathered is not None:    # (every process joins every gather)
+                whole[name] = gathered.astype(bool) if name == "solid" else gathered
+        return whole if not on_first or self.comm.rank == 0 else None
 
     def block_of(self, whole: dict) -> dict:
         """A block state from a whole grid's (a checkpoint of a run on any number of
@@ -237,8 +240,9 @@ def split_fluid(whole: FluidSolver, comm, *, halo: int = HALO_PLANES, plane_cost
     block.obstacle_boxes = list(whole.obstacle_boxes)
     if add_parts is not None:
         add_parts(block, whole)
-    state = whole.state_arrays()
-    block.load_state_arrays(block.block_of(state))
+    # whole's own arrays, not copies: the block copies its planes only, and the whole grid's
+    # arrays never written (zeros) then take no memory on any process
+    block.load_state_arrays(block.block_of(whole.state_arrays(copy=False)))
     block.water_added = whole.water_added
     block.initial_water_volume = whole.initial_water_volume
     return block

@@ -623,25 +623,48 @@ class FluidSolver:
         a run over several processes shifts it)."""
         return [int(i) for i in index]
 
+    def drop_cell_arrays(self) -> None:
+        """Let go of every array over the cells and faces, keeping the description (grid,
+        phases, gauges, wave source, clock): the whole grid of a run split over processes, on a
+        process that steps only its block and writes none of the whole grid's files, then holds
+        only its block's arrays. Reading a dropped array afterwards fails at once (None)."""
+        for name in ("fraction", "u", "v", "w", "pressure", "solid", "_open_part",
+                     "_porous_factors", "last_water_fluxes", "_planes"):
+            setattr(self, name, None)
+        self.pressure_solver = None
+        if self.porous is not None:                 # its zones stay, their arrays go
+            for name in ("porosity", "face_porosity", "scale", "linear_coefficient",
+                         "quadratic_coefficient", "faces"):
+                setattr(self.porous, name, None)
+        if self.relaxation is not None:
+            self.relaxation._cache = None
+
     # ------------------------------------------------------------------ state
-    def state_arrays(self) -> dict:
-        arrays = {"fraction": self.fraction.copy(), "u": self.u.copy(), "v": self.v.copy(),
-                  "w": self.w.copy(), "pressure": self.pressure.copy(), "solid": self.solid.copy(),
+    def state_arrays(self, *, copy: bool = True) -> dict:
+        """The state as arrays by name (a checkpoint's); ``copy=False`` gives the solver's own
+        grid arrays, to be read before the next step only."""
+        held = (self.fraction, self.u, self.v, self.w, self.pressure, self.solid)
+        fraction, u, v, w, pressure, solid = (a.copy() for a in held) if copy else held
+        arrays = {"fraction": fraction, "u": u, "v": v, "w": w, "pressure": pressure,
+                  "solid": solid,
                   "clock": np.array([self.time, float(self.step_count), self.time_step,
                                      self.initial_water_volume or 0.0, self.water_added])}
         if self.gauges is not None:
             arrays.update(self.gauges.record_arrays())
         return arrays
 
-    def load_state_arrays(self, arrays: dict) -> None:
+    def load_state_arrays(self, arrays: dict, *, copy: bool = True) -> None:
+        """The state of ``arrays`` (``state_arrays``'s); ``copy=False`` takes the grid arrays
+        themselves (arrays made for this solver alone, as a gather's)."""
         for name in ("fraction", "u", "v", "w", "pressure", "solid"):
-            if arrays[name].shape != getattr(self, name).shape:
+            if arrays[name].shape != np.shape(getattr(self, name)):
                 raise CaseFileError(f"fluid checkpoint: {name} has shape {arrays[name].shape}, the "
-                                    f"grid needs {getattr(self, name).shape}")
-        self.fraction = arrays["fraction"].copy()
-        self.u, self.v, self.w = arrays["u"].copy(), arrays["v"].copy(), arrays["w"].copy()
-        self.pressure = arrays["pressure"].copy()
-        self.solid = arrays["solid"].astype(bool).copy()
+                                    f"grid needs {np.shape(getattr(self, name))}")
+        take = np.array if copy else np.asarray
+        taken = [take(arrays[name], dtype=np.float64) for name in ("fraction", "u", "v", "w",
+                                                                    "pressure")]
+        self.fraction, self.u, self.v, self.w, self.pressure = taken
+        self.solid = take(arrays["solid"], dtype=bool)
         self.time = float(arrays["clock"][0])
         self.step_count = int(arrays["clock"][1])
         self.time_step = float(arrays["clock"][2])

@@ -36,13 +36,30 @@ class _CoupledOverProcesses(OverProcesses):
     def step_count(self) -> int:
         return self.solver.fluid.step_count
 
+    #: Whether the processes other than 0 hold the whole grid's fluid arrays (the deformable
+    #: bodies' surfaces read the whole grid's solid cells on every process).
+    whole_fluid_everywhere = False
+
     def prepare_outputs(self) -> None:
-        """The whole grid's state from every process's slab, and the loads that only the
+        """The whole grid's state on process 0 (on every process with
+        ``whole_fluid_everywhere``) from every process's slab, and the loads that only the
         outputs read, summed over the processes (every process calls it)."""
         coupled = self.solver
-        whole_state = coupled.fluid.gather_whole(coupled.fluid.state_arrays())
-        self.whole.fluid.load_state_arrays(whole_state)
+        block = coupled.fluid
+        whole_state = block.gather_whole(block.state_arrays(),
+                                         on_first=not self.whole_fluid_everywhere)
+        if whole_state is not None:
+            self.whole.fluid.load_state_arrays(whole_state, copy=False)
+        else:                       # the clock, which every process reports
+            self.whole.fluid.time, self.whole.fluid.step_count = block.time, block.step_count
         coupled.fixed_body_loads       # noqa: B018 - summed now, on every process together
+
+    def _hold_the_whole_on_first_only(self) -> None:
+        """On the processes other than 0, let go of the whole grid's arrays: they step their
+        block and write none of the whole grid's files."""
+        if self.processes.rank != 0 and not self.whole_fluid_everywhere:
+            self.whole.fluid.drop_cell_arrays()
+            self.whole.drop_grid_arrays()
 
     def split_lines(self) -> list[str]:
         """The split of the run over the processes, a line per process (printed at the start)."""
@@ -66,6 +83,7 @@ class SlabCoupledModel(_CoupledOverProcesses, CoupledModel):
         super().__init__(coupled)
         self.whole = whole
         self.processes = coupled.comm
+        self._hold_the_whole_on_first_only()
 
 
 class SlabDeformableCoupledModel(_CoupledOverProcesses, DeformableCoupledModel):
@@ -74,6 +92,7 @@ class SlabDeformableCoupledModel(_CoupledOverProcesses, DeformableCoupledModel):
 
     kind = "riprap deformable coupled run"
     name = "deformable_coupled"
+    whole_fluid_everywhere = True
 
     def __init__(self, coupled, stresses, whole):
         super().__init__(coupled, stresses)

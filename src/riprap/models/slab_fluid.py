@@ -19,7 +19,8 @@ __all__ = ["SlabFluidModel"]
 
 class SlabFluidModel(OverProcesses, FluidModel):
     """``FluidModel`` of a block (``SlabFluidSolver``); ``whole`` the whole grid's FluidSolver
-    that the writers read (refreshed by ``prepare_outputs``)."""
+    that the writers read (refreshed by ``prepare_outputs``), whose arrays only process 0 keeps
+    (``FluidSolver.drop_cell_arrays`` on the others)."""
 
     kind = "riprap fluid run"          # its checkpoints are one process's: any number restarts
     name = "fluid"
@@ -28,6 +29,9 @@ class SlabFluidModel(OverProcesses, FluidModel):
         super().__init__(block)
         self.whole = whole
         self.processes = block.comm
+        if self.processes.rank != 0:
+            # only process 0 writes from the whole grid; the others hold their block alone
+            whole.drop_cell_arrays()
 
     @property
     def fluid(self):
@@ -39,10 +43,14 @@ class SlabFluidModel(OverProcesses, FluidModel):
         return self.solver
 
     def prepare_outputs(self) -> None:
-        """The whole grid's state from every process's slab (every process calls it)."""
+        """The whole grid's state on process 0 from every process's slab (every process calls
+        it)."""
         block = self.solver
-        whole_state = block.gather_whole(block.state_arrays())
-        self.whole.load_state_arrays(whole_state)
+        whole_state = block.gather_whole(block.state_arrays(), on_first=True)
+        if whole_state is not None:
+            self.whole.load_state_arrays(whole_state, copy=False)
+        else:                       # the clock and the gauges, which every process reports
+            self.whole.time, self.whole.step_count = block.time, block.step_count
 
     def split_lines(self) -> list[str]:
         """The split of the run over the processes, a line per process (printed at the start)."""

@@ -68,6 +68,9 @@ class SingleProcess:
     def gather_planes(self, local: np.ndarray, counts) -> np.ndarray:
         return local
 
+    def gather_planes_on_first(self, local: np.ndarray, counts):
+        return local
+
     def sum_arrays(self, values: np.ndarray) -> np.ndarray:
         return np.array(values, dtype=np.float64)
 
@@ -153,6 +156,24 @@ class MpiProcesses:
     def gather_planes(self, local: np.ndarray, counts) -> np.ndarray:
         """The whole array from every process's planes (axis 0), on every process."""
         return self.ordered_rows(local, counts)
+
+    def gather_planes_on_first(self, local: np.ndarray, counts):
+        """The whole array from every process's planes (axis 0) on process 0 (the writer of
+        the run's tables and pictures); None on the others, which then hold no whole-grid
+        array."""
+        started = time.perf_counter()
+        local = np.ascontiguousarray(local, dtype=np.float64)
+        per_row = int(np.prod(local.shape[1:], dtype=np.int64))
+        counts = np.asarray(counts, dtype=np.int64) * per_row
+        out = None
+        receive = None
+        if self.rank == 0:
+            out = np.empty((int(counts.sum() // max(per_row, 1)),) + local.shape[1:])
+            displacements = np.concatenate([[0], np.cumsum(counts)[:-1]])
+            receive = [out, counts, displacements, self._mpi.DOUBLE]
+        self.comm.Gatherv(local, receive, root=0)
+        self._count("gather", started, local.nbytes)
+        return out
 
     def sum_arrays(self, values: np.ndarray) -> np.ndarray:
         """Every process's ``values`` (the same shape on all) added element by element in rank
