@@ -175,7 +175,11 @@ def main() -> None:
     parser.add_argument("--layer-warmup", type=int, default=3)
     parser.add_argument("--worker", choices=("column", "layer"), help=argparse.SUPPRESS)
     parser.add_argument("--state", default="bench_out/parallel_state.npz")
+    parser.add_argument("--repeats", type=int, default=3,
+                        help="runs of each count of processes, in turn; the fastest is taken")
     args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error(f"--repeats must be 1 or more, got {args.repeats}")
     if args.worker == "column":
         worker(args.warmup, args.steps, args.state)
         return
@@ -189,7 +193,7 @@ def main() -> None:
     mpiexec = str(Path(sys.executable).parent / "mpiexec")
     print("the water column alone (0.89 M cells):", flush=True)
     column = _compare(me, mpiexec, env, lambda r: f"  the same state as one process, bit for "
-                                                 f"bit: {r['bit_for_bit']}")
+                                                 f"bit: {r['bit_for_bit']}", args.repeats)
     print(f"METRIC parallel_efficiency_2_fluid {column:.3f} ratio", flush=True)
     layer_state = str(Path(args.state).with_name("parallel_layer_state.npz"))
     me = [sys.executable, __file__, "--worker", "layer", "--steps", str(args.layer_steps),
@@ -197,18 +201,27 @@ def main() -> None:
     print("the placed layer in its dam-break flume (0.91 M cells, 161 bodies):", flush=True)
     layer = _compare(me, mpiexec, env, lambda r: "  largest difference from one process, of "
                      "each array's largest value: " + ", ".join(
-                         f"{k} {v:.1e}" for k, v in r["largest_relative_difference"].items()))
+                         f"{k} {v:.1e}" for k, v in r["largest_relative_difference"].items()),
+                     args.repeats)
     print(f"METRIC parallel_efficiency_2 {layer:.3f} ratio")
 
 
-def _compare(me, mpiexec, env, check_line) -> float:
-    """Run ``me`` on one process and on two; print what each did; the efficiency."""
-    runs = {}
-    for processes, command in ((1, me), (2, [mpiexec, "-n", "2", *me])):
-        output = subprocess.run(command, env=env, capture_output=True, text=True, check=True)
-        results = [json.loads(line[7:]) for line in output.stdout.splitlines()
-                   if line.startswith("RESULT ")]
-        runs[processes] = results
+def _compare(me, mpiexec, env, check_line, repeats: int) -> float:
+    """Run ``me`` on one process and on two, in turn, ``repeats`` times each; print what the
+    fastest run of each did; the efficiency from the fastest runs (this shared 2-core machine's
+    noise only ever slows a run down)."""
+    runs = {1: None, 2: None}
+    for _ in range(repeats):
+        for processes, command in ((1, me), (2, [mpiexec, "-n", "2", *me])):
+            output = subprocess.run(command, env=env, capture_output=True, text=True, check=True)
+            results = [json.loads(line[7:]) for line in output.stdout.splitlines()
+                       if line.startswith("RESULT ")]
+            slowest = max(r["seconds_per_step"] for r in results)
+            if runs[processes] is None or slowest < max(r["seconds_per_step"]
+                                                        for r in runs[processes]):
+                runs[processes] = results
+    for processes in (1, 2):
+        results = runs[processes]
         slowest = max(r["seconds_per_step"] for r in results)
         text = (f"{processes} process(es): {slowest:.3f} s per step, peak memory "
                 f"{max(r['peak_memory_mb'] for r in results):.0f} MB a process, ")

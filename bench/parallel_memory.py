@@ -91,6 +91,8 @@ def main() -> None:
     if args.worker:
         worker(*args.worker)
         return
+    if min(args.processes) < 1:
+        parser.error(f"--processes must be counts of 1 or more, got {args.processes}")
     mpiexec = shutil.which("mpiexec")
     if mpiexec is None:
         sys.exit("bench/parallel_memory.py needs mpiexec: python3 -m pip install 'riprap[mpi]'")
