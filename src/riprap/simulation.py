@@ -623,9 +623,11 @@ class Simulation:
         change), with the model's own checks (meshes, cells, bodies). Returns its arrays and
         metadata."""
 
-        arrays, metadata = load_checkpoint(path)
-        self._check_same_run(path, metadata)
         model = self.model
+        # a process of a split run reads its own planes of the grid alone
+        reading = getattr(model, "checkpoint_reading", dict)()
+        arrays, metadata = load_checkpoint(path, **reading)
+        self._check_same_run(path, metadata)
         kind = metadata.get("kind")
         if kind not in _ACCEPTED_KINDS[model.kind]:
             raise RiprapError(f"{path}: a checkpoint of a {kind!r} run; this case is a "

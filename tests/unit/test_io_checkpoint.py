@@ -191,3 +191,31 @@ def test_checkpoint_missing_or_foreign_piece_is_named(tmp_path):
     (tmp_path / names[1]).write_bytes(kept)
     with pytest.raises(CheckpointError, match="is not the piece of process 1"):
         load_checkpoint(path)
+
+
+def test_a_process_reads_only_the_pieces_holding_its_planes(tmp_path):
+    """With ``planes``, the grid's arrays come from the pieces that hold those planes alone,
+    whole-shaped with zeros elsewhere; other arrays (and every piece's step) are read as before.
+    Shown by damaging the data of the piece of planes 4-5, which a read of planes 0-2 never
+    opens, and which a whole read refuses."""
+    path, grid, faces, names = _pieces(tmp_path)          # 3 pieces of 2 planes each
+    far = tmp_path / names[2]
+    arrays, _ = load_checkpoint(far, piece=True)
+    save_checkpoint(far, arrays={"grid": arrays["grid"], "faces": arrays["faces"]},
+                    metadata={"piece_of": path.name, "step": 7, "process": 2})
+    import zipfile
+    damaged = tmp_path / "damaged.npz"
+    with zipfile.ZipFile(far) as source, zipfile.ZipFile(damaged, "w") as target:
+        for item in source.infolist():
+            data = source.read(item)
+            target.writestr(item, data[:-8] if item.filename == "grid.npy" else data)
+    damaged.replace(far)
+    arrays, _ = load_checkpoint(path, planes=(0, 3), plane_arrays=("grid",))
+    assert arrays["grid"].shape == grid.shape
+    assert np.array_equal(arrays["grid"][:4], grid[:4])      # the pieces of planes 0-1 and 2-3
+    assert not arrays["grid"][4:].any()
+    assert np.array_equal(arrays["faces"], faces)            # not a plane array: every piece
+    with pytest.raises(CheckpointError, match="grid is truncated or corrupt"):
+        load_checkpoint(path)
+    with pytest.raises(CheckpointError, match="grid is truncated or corrupt"):
+        load_checkpoint(path, planes=(3, 5), plane_arrays=("grid",))

@@ -29,13 +29,15 @@ from riprap.fluid.slab_pressure import DISTRIBUTED_LEVELS, SlabPressureSolver
 from riprap.fluid.solver import FluidSolver, boundary_inflow_planes
 from riprap.parallel.slabs import cut_slabs
 
-__all__ = ["SlabFluidSolver", "split_fluid", "HALO_PLANES"]
+__all__ = ["SlabFluidSolver", "split_fluid", "HALO_PLANES", "PLANE_ARRAYS"]
 
 #: Planes of each neighbour's slab a block holds on either side.
 HALO_PLANES = 8
 
 # The arrays of the state, and whether each lives on the cells or on the faces of an axis.
 _STATE = (("fraction", None), ("u", 0), ("v", None), ("w", None), ("pressure", None))
+#: The arrays of a checkpoint whose first axis is the grid's x-planes (written in pieces).
+PLANE_ARRAYS = tuple(name for name, _ in _STATE) + ("solid",)
 
 
 class _BlockPressure:
@@ -174,6 +176,11 @@ class SlabFluidSolver(FluidSolver):
             if gathered is not None:    # (every process joins every gather)
                 whole[name] = gathered.astype(bool) if name == "solid" else gathered
         return whole if not on_first or self.comm.rank == 0 else None
+
+    def checkpoint_planes(self) -> tuple[int, int]:
+        """The whole grid's x-planes this block reads from a checkpoint: its slab and halos, and
+        the x-face above them."""
+        return self.first - self.low, self.stop + self.high + 1
 
     def block_of(self, whole: dict) -> dict:
         """A block state from a whole grid's (a checkpoint of a run on any number of

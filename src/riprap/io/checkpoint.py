@@ -212,41 +212,114 @@ def _remove_other_pieces(path: Path, pieces: list[str]) -> None:
             folder.rmdir()
 
 
-def _joined_pieces(path: Path, contents: dict, pieces) -> None:
-    """Add the arrays of ``path``'s pieces to ``contents``, each joined along its first axis."""
+def _joined_pieces(path: Path, contents: dict, pieces, planes=None, plane_arrays=()) -> None:
+    """Add the arrays of ``path``'s pieces to ``contents``, each joined along its first axis.
+
+    With ``planes`` = (first, stop), the arrays named in ``plane_arrays`` (a grid's, whose first
+    axis is the x-planes) are read only from the pieces that hold planes first .. stop - 1; the
+    joined array has the whole grid's shape, with zeros on the other planes, which numpy leaves
+    unwritten and so take no memory: a process restarting its block reads its planes alone."""
     if not isinstance(pieces, list) or not pieces or not all(isinstance(p, str) for p in pieces):
         raise CheckpointError(f"checkpoint {path}: its list of pieces is damaged; restart from "
                               "an earlier checkpoint")
-    parts = []
-    for process, name in enumerate(pieces):
-        piece = path.parent / name
-        if not piece.is_file():
-            raise CheckpointError(
-                f"checkpoint {path}: its piece {name} (process {process}) is missing; a checkpoint "
-                f"of a run over several processes needs its folder {_pieces_folder(path).name} "
-                "beside it")
-        arrays, metadata = load_checkpoint(piece, piece=True)
-        if metadata.get("process") != process:
-            raise CheckpointError(f"checkpoint {path}: {name} is not the piece of process "
-                                  f"{process}")
-        if "clock" in contents and metadata.get("step") != int(contents["clock"][1]):
-            raise CheckpointError(f"checkpoint {path}: its piece {name} is of step "
-                                  f"{metadata.get('step')}, the checkpoint of step "
-                                  f"{int(contents['clock'][1])}")
-        parts.append(arrays)
-    names = set(parts[0])
-    for process, arrays in enumerate(parts):
-        if set(arrays) != names:
-            raise CheckpointError(f"checkpoint {path}: the piece of process {process} holds "
-                                  f"{sorted(arrays)}, the first {sorted(names)}")
-    for name in sorted(names):
-        if name in contents:
-            raise CheckpointError(f"checkpoint {path}: {name!r} is both in it and in its pieces")
-        contents[name] = np.concatenate([arrays[name] for arrays in parts])
+    opened = []
+    try:
+        for process, name in enumerate(pieces):
+            piece = path.parent / name
+            if not piece.is_file():
+                raise CheckpointError(
+                    f"checkpoint {path}: its piece {name} (process {process}) is missing; a "
+                    f"checkpoint of a run over several processes needs its folder "
+                    f"{_pieces_folder(path).name} beside it")
+            archive, metadata = _open_piece(piece)
+            opened.append((piece, archive))
+            if metadata.get("process") != process:
+                raise CheckpointError(f"checkpoint {path}: {name} is not the piece of process "
+                                      f"{process}")
+            if "clock" in contents and metadata.get("step") != int(contents["clock"][1]):
+                raise CheckpointError(f"checkpoint {path}: its piece {name} is of step "
+                                      f"{metadata.get('step')}, the checkpoint of step "
+                                      f"{int(contents['clock'][1])}")
+        names = _names(opened[0][1])
+        for process, (_, archive) in enumerate(opened):
+            if _names(archive) != names:
+                raise CheckpointError(f"checkpoint {path}: the piece of process {process} holds "
+                                      f"{sorted(_names(archive))}, the first {sorted(names)}")
+        for name in sorted(names):
+            if name in contents:
+                raise CheckpointError(f"checkpoint {path}: {name!r} is both in it and in its "
+                                      "pieces")
+            if planes is not None and name in plane_arrays:
+                contents[name] = _planes_of(opened, name, planes)
+            else:
+                contents[name] = np.concatenate([_member(piece, archive, name)
+                                                 for piece, archive in opened])
+    finally:
+        for _, archive in opened:
+            archive.close()
 
 
-def load_checkpoint(path: str | os.PathLike, *, piece: bool = False
-                    ) -> tuple[dict[str, np.ndarray], dict]:
+def _names(archive) -> set:
+    return set(archive.files) - {_METADATA_KEY}
+
+
+def _open_piece(piece: Path):
+    """A piece's archive, whose members are read when asked (``_member``), and its
+    metadata."""
+    try:
+        archive = np.load(piece, allow_pickle=False)
+        if not isinstance(archive, np.lib.npyio.NpzFile) or _METADATA_KEY not in archive.files:
+            raise CheckpointError(f"{piece} is not a piece of a riprap checkpoint")
+        metadata = json.loads(str(archive[_METADATA_KEY]))
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+        raise CheckpointError(f"checkpoint piece {piece} is truncated or corrupt "
+                              f"({type(error).__name__}: {error}); restart from an earlier "
+                              "checkpoint") from error
+    if not isinstance(metadata, dict) or metadata.get("checkpoint_format") != CHECKPOINT_FORMAT:
+        raise CheckpointError(f"checkpoint piece {piece}: not of checkpoint_format "
+                              f"{CHECKPOINT_FORMAT}; restart from an earlier checkpoint")
+    return archive, metadata
+
+
+def _member(piece: Path, archive, name: str) -> np.ndarray:
+    try:
+        return archive[name]
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+        raise CheckpointError(f"checkpoint piece {piece}: {name} is truncated or corrupt "
+                              f"({type(error).__name__}: {error}); restart from an earlier "
+                              "checkpoint") from error
+
+
+def _member_shape(piece: Path, archive, name: str) -> tuple:
+    """The shape and dtype of a member, from its header alone."""
+    try:
+        with archive.zip.open(f"{name}.npy") as stream:
+            version = np.lib.format.read_magic(stream)
+            read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                    else np.lib.format.read_array_header_2_0)
+            shape, _, dtype = read(stream)
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+        raise CheckpointError(f"checkpoint piece {piece}: {name} is truncated or corrupt "
+                              f"({type(error).__name__}: {error}); restart from an earlier "
+                              "checkpoint") from error
+    return shape, dtype
+
+
+def _planes_of(opened, name: str, planes) -> np.ndarray:
+    first, stop = planes
+    shapes = [_member_shape(piece, archive, name) for piece, archive in opened]
+    counts = [shape[0] for shape, _ in shapes]
+    whole = np.zeros((sum(counts),) + tuple(shapes[0][0][1:]), dtype=shapes[0][1])
+    begin = 0
+    for (piece, archive), count in zip(opened, counts):
+        if begin < stop and begin + count > first:
+            whole[begin:begin + count] = _member(piece, archive, name)
+        begin += count
+    return whole
+
+
+def load_checkpoint(path: str | os.PathLike, *, piece: bool = False, planes=None,
+                    plane_arrays=()) -> tuple[dict[str, np.ndarray], dict]:
     """Read a checkpoint written by :func:`save_checkpoint`.
 
     Parameters
@@ -256,6 +329,10 @@ def load_checkpoint(path: str | os.PathLike, *, piece: bool = False
     piece : bool
         Read one process's piece (:func:`save_checkpoint_piece`) as it is; otherwise a piece is
         refused, naming its checkpoint.
+    planes : (first, stop) or None
+        Of a checkpoint in pieces, the x-planes a process needs: the arrays named in
+        ``plane_arrays`` are read from the pieces holding those planes only, with zeros (which
+        take no memory) on the other planes. None reads every piece whole.
 
     Returns
     -------
@@ -330,5 +407,5 @@ def load_checkpoint(path: str | os.PathLike, *, piece: bool = False
         raise CheckpointError(f"{path} is one process's piece of the checkpoint "
                               f"{metadata['piece_of']}; restart from that checkpoint")
     if _PIECES_KEY in metadata:
-        _joined_pieces(path, contents, metadata.pop(_PIECES_KEY))
+        _joined_pieces(path, contents, metadata.pop(_PIECES_KEY), planes, plane_arrays)
     return contents, metadata

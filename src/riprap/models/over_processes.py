@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from riprap.fluid.slab_solver import PLANE_ARRAYS
 from riprap.io.checkpoint import save_checkpoint, save_checkpoint_piece
 
 __all__ = ["OverProcesses", "FramePiece", "save_checkpoint_in_pieces"]
@@ -39,6 +40,11 @@ class OverProcesses:
         whole.last_report = block.last_report
         whole.last_air_limit = block.last_air_limit
         super()._after_step(dt, report)
+
+    def checkpoint_reading(self) -> dict:
+        """How this process reads a checkpoint to restart: the grid's arrays from the pieces
+        that hold its block's planes only (``riprap.io.checkpoint.load_checkpoint``)."""
+        return {"planes": self.block.checkpoint_planes(), "plane_arrays": PLANE_ARRAYS}
 
     def frame_piece(self) -> FramePiece:
         """This process's part of a fluid frame (``riprap/outputs/fluid.py`` writes it)."""
