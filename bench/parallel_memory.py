@@ -37,6 +37,7 @@ z_high = "open"
 type = "box"
 lower = [0.0, 0.0, 0.0]
 upper = [{column}, {width}, {column_height}]
+{porous}
 [output]
 directory = "out"
 paraview = true
@@ -44,15 +45,27 @@ picture = false
 """
 
 
-def write_case(folder: Path, *, tiny: bool = False) -> Path:
+POROUS = """[[porous_zones]]
+type = "box"
+porosity = 0.4
+stone_diameter = 0.01
+lower = [{start}, 0.0, 0.0]
+upper = [{length}, {width}, {top}]
+"""
+
+
+def write_case(folder: Path, *, tiny: bool = False, porous: bool = False) -> Path:
     # bench/parallel.py's column: a = 0.05715 m, 40 cells across it, 44 cells wide (tiny: 8
     # cells across, 2 wide: what the interpreter and the compiled code take, without a grid)
     a, per_a, across = (0.05715, 8, 2) if tiny else (0.05715, 40, 44)
     h = a / per_a
     nx, nz = 5 * per_a, int(2.52 * per_a) + 1
     path = folder / ("tiny.toml" if tiny else "column.toml")
+    # with porous: a porous bed (the rubble of a core) under the right half of the flume
+    zone = POROUS.format(start=2.5 * a, length=nx * h, width=across * h, top=0.5 * a)
     path.write_text(CASE.format(end_time=2e-3, length=nx * h, width=across * h, height=nz * h,
-                                nx=nx, ny=across, nz=nz, column=a, column_height=2 * a))
+                                nx=nx, ny=across, nz=nz, column=a, column_height=2 * a,
+                                porous=zone if porous else ""))
     return path
 
 
@@ -86,6 +99,8 @@ def worker(case_file: str, out: str, restart: str | None = None) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--processes", type=int, nargs="+", default=[1, 2, 4])
+    parser.add_argument("--porous", action="store_true",
+                        help="a porous bed under the right half of the flume")
     parser.add_argument("--worker", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
@@ -99,7 +114,7 @@ def main() -> None:
     env = dict(os.environ, NUMBA_NUM_THREADS="1", OMP_NUM_THREADS="1")
     peaks = {}
     with tempfile.TemporaryDirectory() as folder:
-        case = write_case(Path(folder))
+        case = write_case(Path(folder), porous=args.porous)
         tiny = write_case(Path(folder), tiny=True)
         command = [mpiexec, "-n", "1", sys.executable, __file__, "--worker", str(tiny),
                    str(Path(folder) / "out_tiny")]

@@ -134,20 +134,21 @@ def test_porous_zones_built_on_a_block_are_the_whole_grids_cut_to_it():
 def _porous_cut(porous, begin: int, stop: int):
     """``PorousMedium`` of the block's planes begin..stop-1: its arrays cut along x, its list of
     porous faces re-made, the block's two end x-faces left out (they are walls of the block)."""
-    block = copy.copy(porous)
-    block.porosity = np.ascontiguousarray(porous.porosity[begin:stop])
-    block.face_porosity, block.scale, block.linear_coefficient = [], [], []
-    block.quadratic_coefficient, block.faces = [], []
+    names = ("face_porosity", "scale", "linear_coefficient", "quadratic_coefficient")
+    cut = {name: [] for name in names + ("faces",)}
     for axis in range(3):
         end = stop + (1 if axis == 0 else 0)
-        for name in ("face_porosity", "scale", "linear_coefficient", "quadratic_coefficient"):
-            getattr(block, name).append(np.ascontiguousarray(getattr(porous, name)[axis][begin:end]))
+        for name in names:
+            cut[name].append(np.ascontiguousarray(getattr(porous, name)[axis][begin:end]))
         mask = np.zeros(porous.face_porosity[axis].shape, dtype=bool)
         mask.reshape(-1)[porous.faces[axis]] = True
         mask = mask[begin:end].copy()
         if axis == 0:
             mask[0] = mask[-1] = False
-        block.faces.append(np.flatnonzero(mask))
+        cut["faces"].append(np.flatnonzero(mask))
+    block = copy.copy(porous)
+    block.porosity = np.ascontiguousarray(porous.porosity[begin:stop])
+    block._face_arrays, block._cells = cut, None       # (the face arrays PorousMedium makes)
     return block
 
 

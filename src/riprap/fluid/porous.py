@@ -162,23 +162,58 @@ class PorousMedium:
             added = added * (1.0 - cover) + cover * zone.added_mass
         self.porosity = porosity
         self.minimum_porosity = float(porosity.min())
-        self.face_porosity, self.scale, self.linear_coefficient = [], [], []
-        self.quadratic_coefficient, self.faces = [], []
-        for axis in range(3):
-            n_face = face_means(porosity, axis)
-            c_face = face_means(added, axis)
-            self.face_porosity.append(n_face)
-            self.scale.append(n_face / (1.0 + c_face))
-            self.linear_coefficient.append(face_means(linear, axis))
-            self.quadratic_coefficient.append(face_means(quadratic, axis))
-            # interior faces only: walls carry no flow, and the open top's face keeps its own
-            # coefficient (1/rho of the top cell)
-            porous_face = (n_face < 1.0) | (c_face > 0.0)
-            boundary = [slice(None)] * 3
-            for end in (0, -1):
-                boundary[axis] = end
-                porous_face[tuple(boundary)] = False
-            self.faces.append(np.flatnonzero(porous_face))
+        # The face arrays (about 15 x 8 bytes a cell) are made when first read: the whole grid
+        # of a run split over processes, which never steps, never makes them.
+        self._cells = (linear, quadratic, added)
+        self._face_arrays = None
+
+    def _faces_made(self) -> dict:
+        if self._face_arrays is None:
+            linear, quadratic, added = self._cells
+            arrays = {name: [] for name in ("face_porosity", "scale", "linear_coefficient",
+                                            "quadratic_coefficient", "faces")}
+            for axis in range(3):
+                n_face = face_means(self.porosity, axis)
+                c_face = face_means(added, axis)
+                arrays["face_porosity"].append(n_face)
+                arrays["scale"].append(n_face / (1.0 + c_face))
+                arrays["linear_coefficient"].append(face_means(linear, axis))
+                arrays["quadratic_coefficient"].append(face_means(quadratic, axis))
+                # interior faces only: walls carry no flow, and the open top's face keeps its
+                # own coefficient (1/rho of the top cell)
+                porous_face = (n_face < 1.0) | (c_face > 0.0)
+                boundary = [slice(None)] * 3
+                for end in (0, -1):
+                    boundary[axis] = end
+                    porous_face[tuple(boundary)] = False
+                arrays["faces"].append(np.flatnonzero(porous_face))
+            self._face_arrays, self._cells = arrays, None
+        return self._face_arrays
+
+    @property
+    def face_porosity(self) -> list:
+        return self._faces_made()["face_porosity"]
+
+    @property
+    def scale(self) -> list:
+        return self._faces_made()["scale"]
+
+    @property
+    def linear_coefficient(self) -> list:
+        return self._faces_made()["linear_coefficient"]
+
+    @property
+    def quadratic_coefficient(self) -> list:
+        return self._faces_made()["quadratic_coefficient"]
+
+    @property
+    def faces(self) -> list:
+        return self._faces_made()["faces"]
+
+    def drop_arrays(self) -> None:
+        """Let go of the cell and face arrays, keeping the zones (``FluidSolver.drop_cell_arrays``):
+        reading them afterwards fails."""
+        self.porosity = self._cells = self._face_arrays = None
 
 
 def _first_crossing(points: np.ndarray):

@@ -633,9 +633,7 @@ class FluidSolver:
             setattr(self, name, None)
         self.pressure_solver = None
         if self.porous is not None:                 # its zones stay, their arrays go
-            for name in ("porosity", "face_porosity", "scale", "linear_coefficient",
-                         "quadratic_coefficient", "faces"):
-                setattr(self.porous, name, None)
+            self.porous.drop_arrays()
         if self.relaxation is not None:
             self.relaxation._cache = None
 
