@@ -190,25 +190,11 @@ class PorousMedium:
             self._face_arrays, self._cells = arrays, None
         return self._face_arrays
 
-    @property
-    def face_porosity(self) -> list:
-        return self._faces_made()["face_porosity"]
-
-    @property
-    def scale(self) -> list:
-        return self._faces_made()["scale"]
-
-    @property
-    def linear_coefficient(self) -> list:
-        return self._faces_made()["linear_coefficient"]
-
-    @property
-    def quadratic_coefficient(self) -> list:
-        return self._faces_made()["quadratic_coefficient"]
-
-    @property
-    def faces(self) -> list:
-        return self._faces_made()["faces"]
+    face_porosity = property(lambda self: self._faces_made()["face_porosity"])
+    scale = property(lambda self: self._faces_made()["scale"])
+    linear_coefficient = property(lambda self: self._faces_made()["linear_coefficient"])
+    quadratic_coefficient = property(lambda self: self._faces_made()["quadratic_coefficient"])
+    faces = property(lambda self: self._faces_made()["faces"])
 
     def drop_arrays(self) -> None:
         """Let go of the cell and face arrays, keeping the zones (``FluidSolver.drop_cell_arrays``):
