@@ -88,15 +88,20 @@ def _boundary_inflow(fluxes) -> float:
     return ends + float(ordered_total(sides))
 
 
-def _box_overlap_fractions(grid: FluidGrid, lower, upper) -> np.ndarray:
-    """Fraction of each cell inside the axis-aligned box lower..upper (exact)."""
+def _box_overlap_fractions(grid: FluidGrid, lower, upper) -> list[np.ndarray]:
+    """Fraction of each cell's extent along each axis inside the box lower..upper (exact): the
+    cell's share of the box is the product of its three."""
     fractions = []
     for axis in range(3):
         faces = grid.faces(axis)
         low = np.clip(lower[axis], faces[:-1], faces[1:])
         high = np.clip(upper[axis], faces[:-1], faces[1:])
         fractions.append(np.maximum(high - low, 0.0) / np.diff(faces))
-    return fractions[0][:, None, None] * fractions[1][None, :, None] * fractions[2][None, None, :]
+    return fractions
+
+
+# x-planes filled at a time: a box's water is added without whole-grid temporaries.
+_FILL_PLANES = 16
 
 
 class FluidSolver:
@@ -227,7 +232,15 @@ class FluidSolver:
                                 f"the fluid box {list(box.lower)} .. {list(box.upper)}")
         if g.two_dimensional:
             lower[1], upper[1] = g.lower[1], g.upper[1]
-        self.fraction = np.minimum(1.0, self.fraction + _box_overlap_fractions(g, lower, upper))
+        along_x, along_y, along_z = _box_overlap_fractions(g, lower, upper)
+        planes = np.flatnonzero(along_x)        # the others gain nothing (f + 0 is f)
+        if len(planes):
+            first, stop = int(planes[0]), int(planes[-1]) + 1
+            for start in range(first, stop, _FILL_PLANES):
+                chunk = slice(start, min(start + _FILL_PLANES, stop))
+                # (x share times y share) times z share, in that order: the bits of the product
+                share = along_x[chunk, None, None] * along_y[None, :, None] * along_z[None, None, :]
+                self.fraction[chunk] = np.minimum(1.0, self.fraction[chunk] + share)
         self.initial_water_volume = None
 
     def set_still_water_level(self, level: float) -> None:
