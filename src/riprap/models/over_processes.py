@@ -41,6 +41,17 @@ class OverProcesses:
         whole.last_air_limit = block.last_air_limit
         super()._after_step(dt, report)
 
+    def _gather_onto(self, whole_fluid, *, on_first: bool = True) -> None:
+        """``whole_fluid`` (the whole grid's FluidSolver the writers read) refreshed from every
+        process's slab: on process 0 alone with ``on_first``, elsewhere only its clock (every
+        process calls it)."""
+        block = self.block
+        state = block.gather_whole(block.state_arrays(), on_first=on_first)
+        if state is not None:
+            whole_fluid.load_state_arrays(state, copy=False)
+        else:
+            whole_fluid.time, whole_fluid.step_count = block.time, block.step_count
+
     def checkpoint_reading(self) -> dict:
         """How this process reads a checkpoint to restart: the grid's arrays from the pieces
         that hold its block's planes only (``riprap.io.checkpoint.load_checkpoint``)."""

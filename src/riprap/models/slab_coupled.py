@@ -44,15 +44,8 @@ class _CoupledOverProcesses(OverProcesses):
         """The whole grid's state on process 0 (on every process with
         ``whole_fluid_everywhere``) from every process's slab, and the loads that only the
         outputs read, summed over the processes (every process calls it)."""
-        coupled = self.solver
-        block = coupled.fluid
-        whole_state = block.gather_whole(block.state_arrays(),
-                                         on_first=not self.whole_fluid_everywhere)
-        if whole_state is not None:
-            self.whole.fluid.load_state_arrays(whole_state, copy=False)
-        else:                       # the clock, which every process reports
-            self.whole.fluid.time, self.whole.fluid.step_count = block.time, block.step_count
-        coupled.fixed_body_loads       # noqa: B018 - summed now, on every process together
+        self._gather_onto(self.whole.fluid, on_first=not self.whole_fluid_everywhere)
+        self.solver.fixed_body_loads   # noqa: B018 - summed now, on every process together
 
     def _hold_the_whole_on_first_only(self) -> None:
         """On the processes other than 0, let go of the whole grid's arrays: they step their

@@ -45,12 +45,7 @@ class SlabFluidModel(OverProcesses, FluidModel):
     def prepare_outputs(self) -> None:
         """The whole grid's state on process 0 from every process's slab (every process calls
         it)."""
-        block = self.solver
-        whole_state = block.gather_whole(block.state_arrays(), on_first=True)
-        if whole_state is not None:
-            self.whole.load_state_arrays(whole_state, copy=False)
-        else:                       # the clock and the gauges, which every process reports
-            self.whole.time, self.whole.step_count = block.time, block.step_count
+        self._gather_onto(self.whole)
 
     def split_lines(self) -> list[str]:
         """The split of the run over the processes, a line per process (printed at the start)."""
