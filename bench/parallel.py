@@ -81,6 +81,8 @@ def layer_worker(warmup: int, steps: int, state_file: str) -> None:
     before = json.loads(json.dumps(getattr(comm, "traffic", {})))
     parts = dict.fromkeys(("pressure", "solid_volumes", "exchange", "contact_substeps"), 0.0)
     substeps = 0
+    split = solver.solids._split
+    contacts_before = dict(split.seconds) if split is not None else {}
     started = time.perf_counter()
     for _ in range(steps):
         report = solver.step()
@@ -91,6 +93,10 @@ def layer_worker(warmup: int, steps: int, state_file: str) -> None:
         substeps += report.solid_substeps
     comm.barrier()
     wall = time.perf_counter() - started
+    split = solver.solids._split
+    if split is not None:
+        parts.update({f"contacts: {name}": value - contacts_before[name]
+                      for name, value in split.seconds.items()})
     fluid = solver.fluid
     state = fluid.state_arrays() if comm.size == 1 else fluid.gather_whole(fluid.state_arrays())
     names = ("fraction", "u", "v", "w", "pressure")

@@ -11,14 +11,17 @@ far dearer than a rubble mound's point and edge contacts: it is printed, not use
     NUMBA_NUM_THREADS=1 python bench/substep_parts.py
 
 Last line: ``METRIC substep_repeated_per_body <microseconds> us`` (the largest lattice's broad
-phase + integration + sums, per body and sub-step).
+phase + integration + sums, per body and sub-step: what one process does for each body). Before
+it, ``METRIC substep_split_every_body``: what each process of a run split by the bodies' places
+(``riprap/solid/bodies_over_processes.py``) still does for every body.
 """
 import time
 
 import numpy as np
 
 from riprap.geometry import shapes
-from riprap.solid.kernels import integrate, interactions, stepper
+from riprap.solid.bodies_over_processes import BodiesOverProcesses
+from riprap.solid.kernels import integrate, interactions, owned_step, stepper
 from riprap.solid.materials import Material
 from riprap.solid.shape import RigidShape
 from riprap.solid.solver import SolidSolver
@@ -75,7 +78,49 @@ def parts(solids: SolidSolver) -> dict:
     sums = seconds(lambda: stepper.forces_of_contacts(system, motion, settings, body_pairs,
                                                       wall_pairs, results, stride), repeat)
     return {"bodies": n, "candidates": len(body_pairs), "broad": broad / n,
-            "integration": kicks / n, "sums": sums / n, "pairs": pairs / n}
+            "integration": kicks / n, "sums": sums / n, "pairs": pairs / n,
+            **split_parts(solids, repeat)}
+
+
+class _Slabs:
+    """Stands for ``size`` processes, seen from one in the middle (no messages are sent)."""
+    size = 8
+    rank = 3
+
+
+def split_parts(solids: SolidSolver, repeat: int) -> dict:
+    """The bodies split by the place of their centre over ``_Slabs.size`` processes
+    (``riprap/solid/bodies_over_processes.py``), seen from a process in the middle: the work it
+    does for every body (the half kicks and the drift, the owners, the angular velocities, the
+    joined forces put back), per body, and the work for its own bodies and their near ones (the
+    broad phase among the bodies near its slab, the sums of its own bodies' forces), per body it
+    owns."""
+    split = BodiesOverProcesses(_Slabs())
+    split.cuts = split.balanced_cuts(solids)
+    lower, upper = split.slab_of(_Slabs.rank)
+    system, motion, history, settings = solids._kernel_state(0.0)
+    n = solids.n_bodies
+    owners = owned_step.owners_of(solids.positions, split.cuts)
+    omegas = solids._omegas
+    forces, torques = solids.forces.copy(), solids.torques.copy()
+
+    def every_body():
+        owned_step.first_half(system, motion, omegas, settings)
+        owned_step.owners_of(solids.positions, split.cuts)
+        integrate.angular_velocities(solids.quaternions, solids.angular_momenta,
+                                     solids.inverse_principal_inertia)
+        owned_step.second_half(system, motion, omegas, settings, forces, torques)
+
+    repeated = seconds(every_body, repeat)     # zero-length steps: the state stays put
+    body_pairs, wall_pairs, _, stride = owned_step.local_candidates(
+        system, motion, settings, owners, _Slabs.rank, lower, upper)
+    broad = seconds(lambda: owned_step.local_candidates(system, motion, settings, owners,
+                                                        _Slabs.rank, lower, upper), repeat)
+    results = np.zeros((len(body_pairs) + len(wall_pairs), interactions.C_SIZE))
+    sums = seconds(lambda: stepper.forces_of_contacts(system, motion, settings, body_pairs,
+                                                      wall_pairs, results, stride), repeat)
+    own = max(int((owners == _Slabs.rank).sum()), 1)
+    return {"split_every_body": repeated / n, "split_own": (broad + sums) / own}
 
 
 def main():
@@ -88,6 +133,10 @@ def main():
         print(f"{row['bodies']:6d}  {row['candidates']:10d}  {row['broad'] * 1e6:27.2f}  "
               f"{row['integration'] * 1e6:11.2f}  {row['sums'] * 1e6:4.2f}  | {repeated * 1e6:8.2f} "
               f"| {row['pairs'] * 1e6:.0f}", flush=True)
+        print(f"        split over {_Slabs.size}, process {_Slabs.rank}: every body "
+              f"{row['split_every_body'] * 1e6:.2f} us a body | its own bodies' broad phase and "
+              f"sums {row['split_own'] * 1e6:.2f} us a body it owns", flush=True)
+    print(f"METRIC substep_split_every_body {row['split_every_body'] * 1e6:.2f} us")
     print(f"METRIC substep_repeated_per_body "
           f"{(row['broad'] + row['integration'] + row['sums']) * 1e6:.2f} us")
 

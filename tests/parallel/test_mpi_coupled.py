@@ -12,14 +12,16 @@ zero), 2e-12 on the crossing spheres.
 """
 import json
 import re
+import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from riprap.io.checkpoint import load_checkpoint
 from riprap.io.vti import read_pvti, read_vti
 
-from .test_mpi_runs import ROOT, riprap
+from .test_mpi_runs import ROOT, launch, riprap
 
 HERE = Path(__file__).parent
 RELATIVE = 1e-8
@@ -159,11 +161,21 @@ def test_body_crossing_and_contact_across_the_cut(tmp_path):
     assert len(list((tmp_path / "3_then_2" / "checkpoint_pieces").iterdir())) == 2
 
 
+@pytest.mark.parametrize("processes", [2, 3])
+def test_bodies_owned_by_the_slab_of_their_centre_are_one_process_s(processes):
+    """tests/parallel/bodies_split_check.py: rocks sliding past each other across the cuts, each
+    owned by the process of its centre (owners changing inside a batch of steps, contacts across
+    a cut), against one process stepping the same rocks: positions, velocities, forces, springs
+    and contact records equal in every bit on every process."""
+    result = launch(processes, sys.executable, str(HERE / "bodies_split_check.py"))
+    assert result.stdout.count("bit for bit") == processes, result.stdout
+
+
 def test_rigid_bodies_alone_over_two_and_three_processes(tmp_path):
-    """examples/01 (rocks dropped on a floor, no fluid): the contact pairs shared among 2 and 3
-    processes, each pair's rows joined in the broad phase's order, so the bodies' frames and
-    checkpoint are one process's, byte for byte (no tolerance: nothing is summed in another
-    order)."""
+    """examples/01 (rocks dropped on a floor, no fluid): the rocks owned by the process of their
+    centre on 2 and 3 processes, each body's forces added by its owner in one process's order,
+    so the bodies' frames and checkpoint are one process's, byte for byte (no tolerance: nothing
+    is summed in another order)."""
     case = ROOT / "examples" / "01_rock_drop" / "case.toml"
     one = tmp_path / "one"
     riprap(1, "run", str(case), "--out", str(one))

@@ -1,7 +1,8 @@
 """Bodies in a flow split over processes: the coupling (``riprap/coupling/coupled.py``) on one
 process's block of the fluid (``riprap/fluid/slab_solver.py``).
 
-How: every process holds every body and steps it alike (the contact sub-steps are deterministic
+How: every process holds every body and integrates it alike (the contact sub-steps are split by
+the bodies' places, ``riprap/solid/bodies_over_processes.py``, with every body's forces joined,
 and take the same loads on every process, so the bodies stay the same to the bit everywhere).
 Each process clips the bodies that reach its block against the *whole* grid and cuts the blocks
 of cells to its own planes, so every cell's solid volume is the one process's number, bit for
@@ -41,8 +42,8 @@ BODY_CELL_COST = 1.2
 
 def coupled_plane_costs(whole: CoupledSolver) -> np.ndarray:
     """The work of each x-plane of ``whole``'s grid for ``cut_slabs``: its cells, and its cells
-    that hold bodies once more by ``BODY_CELL_COST`` (the contact pairs, shared among all the
-    processes, do not enter)."""
+    that hold bodies once more by ``BODY_CELL_COST`` (the contact pairs, which have their own cut,
+    ``riprap/solid/bodies_over_processes.py``, do not enter)."""
     nx, ny, nz = (int(n) for n in whole.fluid.grid.cells)
     return ny * nz + BODY_CELL_COST * whole.body_cells_per_x_plane()
 
@@ -71,10 +72,10 @@ class SlabCoupledSolver(CoupledSolver):
         self._summed = None
         self._start_coupling(block, whole)
         self.substep_ceiling = whole.substep_ceiling
-        # each contact pair evaluated by one process, every process adding all (rigid bodies;
-        # deformable ones are stepped whole on every process)
-        if hasattr(self.solids, "split_contacts_over"):
-            self.solids.split_contacts_over(self.comm)
+        # rigid bodies split by the place of their centre for their contacts (deformable ones
+        # are stepped whole on every process)
+        if hasattr(self.solids, "split_bodies_over"):
+            self.solids.split_bodies_over(self.comm)
 
     def _start_coupling(self, block, whole) -> None:
         CoupledSolver.__init__(self, block, whole.solids, solid_time_step=whole.solid_time_step,

@@ -60,7 +60,12 @@ class _CoupledOverProcesses(OverProcesses):
         grid = self.whole.fluid.grid
         centres = self.solver.solids.positions
         planes = np.floor((centres[:, 0] - grid.lower[0]) / grid.cell_size)
-        return block.cut.describe(grid.cells[1] * grid.cells[2], planes.astype(int))
+        lines = block.cut.describe(grid.cells[1] * grid.cells[2], planes.astype(int))
+        if hasattr(self.solver.solids, "bodies_split_lines"):
+            # the contacts' own slabs (``riprap/solid/bodies_over_processes.py``)
+            lines += [line.replace("process", "  contacts of process", 1)
+                      for line in self.solver.solids.bodies_split_lines()]
+        return lines
 
     def body_fraction(self):
         return self.whole.body_fraction()

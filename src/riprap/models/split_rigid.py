@@ -1,13 +1,8 @@
-"""Rigid bodies without a fluid over several processes: every process steps every body, each
-evaluates the contact pairs it owns and all join their rows after every force evaluation
-(``SolidSolver.split_contacts_over``), so every process holds the one process's bodies, bit for
-bit; process 0 writes the files.
-
-Why the bodies are not cut by space: the contacts are the work (a Core-Loc pair's narrow phase
-costs thousands of times a body's integration), and sharing them out by pair needs no migration
-of bodies or springs when units move, keeps the cut balanced as a pack settles, and keeps the
-results those of one process; every process integrating every body costs microseconds a step
-for thousands of bodies.
+"""Rigid bodies without a fluid over several processes: each process owns the bodies whose
+centre lies in its slab of x, finds and evaluates their contact pairs and adds up their forces;
+all join the forces and every process integrates every body (``SolidSolver.
+split_bodies_over``, ``riprap/solid/bodies_over_processes.py``), so every process holds the
+one process's bodies, bit for bit; process 0 writes the files.
 """
 from __future__ import annotations
 
@@ -22,7 +17,7 @@ class SplitRigidModel(RigidModel):
     def __init__(self, solver, *, processes, **options):
         super().__init__(solver, **options)
         self.processes = processes
-        solver.split_contacts_over(processes)
+        solver.split_bodies_over(processes)
 
     @property
     def writes_files(self) -> bool:
@@ -35,10 +30,9 @@ class SplitRigidModel(RigidModel):
         self._chunk = self.processes.broadcast(self._chunk)
 
     def split_lines(self) -> list[str]:
-        return [f"process {rank}: every body, the contact pairs whose key falls to it"
-                for rank in range(self.processes.size)]
+        return self.solver.bodies_split_lines()
 
     def summary_fields(self, wall_time: float, steps: int) -> dict:
         fields = super().summary_fields(wall_time, steps)
-        fields["processes"] = {"count": self.processes.size, "split": "contact pairs"}
+        fields["processes"] = {"count": self.processes.size, "split": "bodies by the x of their centre"}
         return fields

@@ -77,6 +77,9 @@ class SingleProcess:
     def join_rows(self, rows: np.ndarray, counts) -> np.ndarray:
         return np.array(rows, dtype=np.float64)
 
+    def exchange_rows(self, rows: np.ndarray, send_counts, receive_counts) -> np.ndarray:
+        return np.array(rows, dtype=np.float64)
+
     def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:
         return None
 
@@ -200,6 +203,22 @@ class MpiProcesses:
         displacements = np.concatenate([[0], np.cumsum(counts)[:-1]])
         self.comm.Allgatherv(rows, [out, counts, displacements, self._mpi.DOUBLE])
         self._count("reduction", started, rows.nbytes)
+        return out
+
+    def exchange_rows(self, rows: np.ndarray, send_counts, receive_counts) -> np.ndarray:
+        """Rows to each process and from each (``rows`` grouped by destination in rank order,
+        ``send_counts[p]`` of them for process p; ``receive_counts[p]`` come from process p):
+        the rows received, grouped by source in rank order."""
+        started = time.perf_counter()
+        rows = np.ascontiguousarray(rows, dtype=np.float64)
+        per_row = int(np.prod(rows.shape[1:], dtype=np.int64))
+        sent = np.asarray(send_counts, dtype=np.int64) * per_row
+        taken = np.asarray(receive_counts, dtype=np.int64) * per_row
+        out = np.empty((int(taken.sum()) // max(per_row, 1),) + rows.shape[1:])
+        self.comm.Alltoallv(
+            [rows, sent, np.concatenate([[0], np.cumsum(sent)[:-1]]), self._mpi.DOUBLE],
+            [out, taken, np.concatenate([[0], np.cumsum(taken)[:-1]]), self._mpi.DOUBLE])
+        self._count("exchange", started, rows.nbytes)
         return out
 
     def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:

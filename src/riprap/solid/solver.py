@@ -14,6 +14,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, KernelOverflowError, OverlapError
 from riprap.schema import default_of
+from riprap.solid.bodies_over_processes import BodiesOverProcesses
 from riprap.solid.kernels import integrate, interactions, stepper
 from riprap.solid.kernels.bundles import (Bodies, History, Motion, PairLaws, RigidSystem,
                                           StepSettings, Walls)
@@ -65,9 +66,8 @@ class SolidSolver:
         never the forces. None: a tenth of the smallest median boundary sub-tet height; 0: no reuse.
         """
         self.gravity = np.asarray(gravity, dtype=np.float64)
-        #: The processes the contact pairs are shared among (``split_contacts_over``); None: all
-        #: evaluated here.
-        self._processes = None
+        #: The bodies' split over processes (``split_bodies_over``); None: one process.
+        self._split = None
         if not 0.0 <= local_damping < 1.0:
             raise CaseFileError(f"local_damping = {local_damping!r} must be in [0, 1)")
         if contact_skin is not None and not contact_skin >= 0.0:
@@ -370,14 +370,29 @@ class SolidSolver:
             "contact candidate buffer overflowed: a shape has too many tets per lookup cell; "
             "re-mesh it more uniformly or report this as a bug")
 
-    def split_contacts_over(self, processes) -> None:
-        """Share the contact pairs among ``processes`` (``riprap.parallel.communicator``): every
-        process steps every body, evaluates the pairs it owns (``stepper.owner_of_pair``, each
-        pair on one process for its whole life, with its spring) and adds its sums to the
-        rest after every force evaluation (``stepper.first_half_step``): the forces, the
-        springs, the contact records and the bodies are then those of one process, bit for bit,
-        on every process."""
-        self._processes = processes if processes.size > 1 else None
+    def split_bodies_over(self, processes) -> None:
+        """Split the bodies over ``processes`` (``riprap.parallel.communicator``) by the place of
+        their centre (``riprap/solid/bodies_over_processes.py``): each process finds and
+        evaluates the contact pairs of its own bodies and adds up their forces; every process
+        integrates every body with the joined forces. The forces, the springs, the contact
+        records and the bodies are those of one process, bit for bit, on every process."""
+        self._split = BodiesOverProcesses(processes) if processes.size > 1 else None
+
+    def bodies_split_lines(self) -> list[str]:
+        """A line per process: the slab of x whose bodies it owns now (re-cut at each
+        ``advance``) and how many."""
+        self.finalize()
+        split = self._split
+        if split is None:
+            return [f"process 0: all {len(self.positions)} bodies"]
+        split.cuts = split.balanced_cuts(self)
+        counts = split.owned_counts(self)
+        lines = []
+        for rank, count in enumerate(counts):
+            lower, upper = split.slab_of(rank)
+            lines.append(f"process {rank}: the {count} bodies with centre x in [{lower:.4g}, "
+                         f"{upper:.4g}) m (the cuts follow the bodies to share the contact pairs)")
+        return lines
 
     def advance(self, n_steps: int) -> None:
         """Advance ``n_steps`` time steps in compiled code.
@@ -388,7 +403,7 @@ class SolidSolver:
         self.finalize()
         if n_steps <= 0:
             return
-        if self._processes is not None:
+        if self._split is not None:
             self._advance_split(n_steps)
             return
         system, motion, history, settings = self._kernel_state(self.time_step)
@@ -405,38 +420,11 @@ class SolidSolver:
             self.check_finite()
 
     def _advance_split(self, n_steps: int) -> None:
-        """``advance`` with the contact pairs shared among the processes: each step's halves in
-        compiled code (``stepper.first_half_step``, ``second_half_step``), every process's
-        rows of contact results joined between them."""
-        processes = self._processes
-        system, motion, history, settings = self._kernel_state(self.time_step)
-        status, done = stepper.STATUS_OK, 0
-        omegas, cache = self._omegas, self._piece_cache
-        results = body_pairs = wall_pairs = None
-        for step in range(n_steps):
-            (body_pairs, wall_pairs, owners, own_rows, omegas, cache,
-             key_stride) = stepper.first_half_step(system, motion, omegas, history, settings,
-                                                   cache, processes.rank, processes.size)
-            # every process's rows, in rank order, put back in the broad phase's order
-            order = np.argsort(owners, kind="stable")
-            joined = processes.join_rows(own_rows, np.bincount(owners, minlength=processes.size))
-            results = np.empty((len(owners), interactions.C_SIZE))
-            results[order] = joined
-            history, overflow, finite = stepper.second_half_step(
-                system, motion, omegas, settings, body_pairs, wall_pairs, results, key_stride)
-            done = step + 1
-            if overflow:
-                status = stepper.STATUS_OVERFLOW
-                break
-            if not finite:
-                status = stepper.STATUS_NOT_FINITE
-                break
-        self._omegas, self._piece_cache = omegas, cache
-        self.history_keys, self.history_springs = history
+        """``advance`` with the bodies split over the processes by the place of their centre."""
+        done, status = self._split.advance(self, n_steps)
         self.step_count += int(done)
         self.time = (self.step_count * self.time_step if self._time_origin is None else
                      self._time_origin + (self.step_count - self._step_origin) * self.time_step)
-        self._store_results(results, body_pairs, wall_pairs)
         if status == stepper.STATUS_OVERFLOW:
             self._raise_overflow()
         if status == stepper.STATUS_NOT_FINITE:

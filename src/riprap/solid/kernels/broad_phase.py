@@ -83,6 +83,21 @@ def overlapping_pairs(lo, hi, fixed, positions, radii):
 
 
 @kernel
+def in_key_order(pairs):
+    """Body pairs (i < j) sorted by (i, j). Why: each body's contact forces are added in the
+    pairs' order, and this order is the one that bodies split over processes by the place of
+    their centre (``riprap/solid/bodies_over_processes.py``) can also produce, each process
+    finding only the pairs of its own bodies; the sweep's order depends on every body."""
+    if pairs.shape[0] < 2:
+        return pairs
+    keys = np.empty(pairs.shape[0], dtype=np.int64)
+    stride = pairs[:, 1].max() + 1
+    for k in range(pairs.shape[0]):
+        keys[k] = pairs[k, 0] * stride + pairs[k, 1]
+    return pairs[np.argsort(keys)].copy()
+
+
+@kernel
 def near_wall_pairs(positions, shape_index, bounding_radius, fixed, wall_points, wall_normals, margin):
     """(body, wall) pairs whose bounding sphere reaches into the wall half-space. (k, 2) int64."""
     n = positions.shape[0]

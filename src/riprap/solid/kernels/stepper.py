@@ -27,7 +27,8 @@ def candidate_pairs(system, motion, settings):
     radii = np.empty(n)
     for b in range(n):
         radii[b] = bounding_radius[shape_index[b]] + margin
-    body_pairs = broad_phase.overlapping_pairs(lo, hi, fixed, positions, radii)
+    body_pairs = broad_phase.in_key_order(broad_phase.overlapping_pairs(lo, hi, fixed, positions,
+                                                                        radii))
     wall_pairs = broad_phase.near_wall_pairs(positions, shape_index, bounding_radius, fixed,
                                              wall_points, wall_normals, margin)
     omegas = integrate.angular_velocities(quaternions, angular_momenta, inverse_principal_inertia)
@@ -123,65 +124,3 @@ def advance(n_steps, system, motion, omegas, history, settings, piece_cache):
             if not finite:
                 return s + 1, STATUS_NOT_FINITE, history, results, body_pairs, wall_pairs, omegas, piece_cache
     return n_steps, STATUS_OK, history, results, body_pairs, wall_pairs, omegas, piece_cache
-
-
-# ---------------------------------------------------------------------- over several processes
-# One velocity-Verlet step of ``advance`` in two halves, with the contact pairs shared among the
-# processes between them (``SolidSolver._advance_split``): every process steps every body; each
-# evaluates the pairs it owns (``pair_owners``); the rows of all are joined in the broad phase's
-# order, and every process adds them all in that order, so the forces, the springs and the
-# bodies are those of one process, bit for bit.
-@kernel
-def pair_owners(body_pairs, wall_pairs, key_stride, processes):
-    """The process that evaluates each candidate (body pairs, then body-wall pairs): by the
-    pair's key, so the same for the pair's whole life (its pieces stay cached there)."""
-    owners = np.empty(body_pairs.shape[0] + wall_pairs.shape[0], dtype=np.int64)
-    for k in range(body_pairs.shape[0]):
-        owners[k] = (body_pairs[k, 0] * key_stride + body_pairs[k, 1]) % processes
-    for w in range(wall_pairs.shape[0]):
-        key = wall_pairs[w, 0] * key_stride + (key_stride - 1 - wall_pairs[w, 1])
-        owners[body_pairs.shape[0] + w] = key % processes
-    return owners
-
-
-@kernel
-def first_half_step(system, motion, omegas, history, settings, piece_cache, rank, processes):
-    """Half kick, drift, the broad phase, and the candidates of process ``rank``. Returns (body
-    pairs, wall pairs, each candidate's owner, this process's rows of results, angular
-    velocities, piece cache, key stride)."""
-    positions, quaternions, velocities, angular_momenta, forces, torques = motion
-    _, inverse_masses, inverse_principal_inertia, _, _, _ = system.bodies
-    _, _, _, step, local_damping, _ = settings
-    integrate.kick(velocities, angular_momenta, omegas, forces, torques, inverse_masses,
-                   0.5 * step, local_damping)
-    integrate.drift(positions, quaternions, velocities, angular_momenta, inverse_masses,
-                    inverse_principal_inertia, step)
-    body_pairs, wall_pairs, omegas, key_stride = candidate_pairs(system, motion, settings)
-    owners = pair_owners(body_pairs, wall_pairs, key_stride, processes)
-    mine = owners == rank
-    n_body_pairs = body_pairs.shape[0]
-    results, piece_cache = interactions.evaluate_candidates(
-        body_pairs[mine[:n_body_pairs]], wall_pairs[mine[n_body_pairs:]], system, motion, omegas,
-        history, settings, piece_cache)
-    return body_pairs, wall_pairs, owners, results, omegas, piece_cache, key_stride
-
-
-@kernel
-def second_half_step(system, motion, omegas, settings, body_pairs, wall_pairs, results,
-                     key_stride):
-    """The forces of every candidate's ``results`` (all processes' rows, in order), the second
-    half kick. Returns (history, overflow, whether every body's state is finite)."""
-    positions, _, velocities, angular_momenta, forces, torques = motion
-    _, inverse_masses, _, _, _, _ = system.bodies
-    _, _, _, step, local_damping, _ = settings
-    history, overflow = forces_of_contacts(system, motion, settings, body_pairs, wall_pairs,
-                                           results, key_stride)
-    integrate.kick(velocities, angular_momenta, omegas, forces, torques, inverse_masses,
-                   0.5 * step, local_damping)
-    finite = True
-    for b in range(positions.shape[0]):
-        for c in range(3):
-            if not (np.isfinite(positions[b, c]) and np.isfinite(velocities[b, c])
-                    and np.isfinite(angular_momenta[b, c])):
-                finite = False
-    return history, overflow, finite
