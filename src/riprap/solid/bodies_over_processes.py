@@ -29,6 +29,8 @@ from riprap.solid.kernels import interactions, owned_step, stepper
 
 __all__ = ["BodiesOverProcesses"]
 
+#: the cuts are kept while no process has more than this times the mean work
+_KEEP_CUTS_WITHIN = 1.03
 _BODY_ROW = 0.0
 _WALL_ROW = 1.0
 
@@ -47,25 +49,52 @@ class BodiesOverProcesses:
         #: the sums of the forces
         self.seconds = dict.fromkeys(("integration", "broad_phase", "pairs", "messages", "sums"),
                                      0.0)
+        #: each process's seconds per unit of bodies' weight, relative (``balanced_cuts``)
+        self.pace = np.ones(processes.size)
+        self._weights = np.zeros(0)
 
     # ------------------------------------------------------------------ the slabs
     def balanced_cuts(self, solver) -> np.ndarray:
-        """Cuts in x that give each process about the same weight of bodies, a body's weight one
-        plus the candidate pairs it was first in at the last force evaluation."""
+        """Cuts in x that give each process about the same work: a body weighs one plus the
+        candidate pairs it was first in at the last force evaluation, times the seconds a unit
+        of weight took on the process that owned it over the last ``advance`` (``pace``: pairs
+        differ in cost, a Core-Loc pair's narrow phase against a rock's, a touching pair's
+        against a near one's). The cut changes no result, only who does the work."""
         size = self.processes.size
         _, body_pairs, wall_pairs = solver._last
         n = len(solver.positions)
-        weights = 1.0 + np.bincount(body_pairs[:, 0], minlength=n) \
-            + np.bincount(wall_pairs[:, 0], minlength=n)
+        weights = 1.0 + np.bincount(np.concatenate([body_pairs[:, 0], wall_pairs[:, 0]]),
+                                    minlength=n)
         x = solver.positions[:, 0]
+        self._weights = weights
+        if len(self.cuts) == size - 1:
+            owners = owned_step.owners_of(solver.positions, self.cuts)
+            weights = weights * self.pace[owners]
+            loads = np.bincount(owners, weights=weights, minlength=size)
+            if loads.max() <= _KEEP_CUTS_WITHIN * loads.mean():
+                # a cut that moves hands pairs to another process, whose surface pieces it
+                # must list afresh: keep the cuts while they stay balanced
+                return self.cuts
         order = np.argsort(x, kind="stable")
         x, running = x[order], np.cumsum(weights[order])
-        cuts = np.empty(size - 1)
-        for p in range(1, size):
-            k = int(np.searchsorted(running, running[-1] * p / size))
-            k = min(max(k, 1), n - 1) if n > 1 else 0
-            cuts[p - 1] = 0.5 * (x[k - 1] + x[k]) if n > 1 else np.inf
+        cuts = np.full(size - 1, np.inf)
+        if n > 1:
+            for p in range(1, size):
+                k = int(np.searchsorted(running, running[-1] * p / size))
+                k = min(max(k, 1), n - 1)
+                cuts[p - 1] = 0.5 * (x[k - 1] + x[k])
         return np.maximum.accumulate(cuts)
+
+    def _measure_pace(self, owners, pair_seconds: float) -> None:
+        """``pace`` from this ``advance``: each process's seconds in its pairs over the weight of
+        the bodies it owned (one message), blended half and half with the last."""
+        mine = float(self._weights[owners == self.processes.rank].sum())
+        every = np.array(self.processes.all_values((pair_seconds, mine)), dtype=np.float64)
+        seconds, weight = every[:, 0], every[:, 1]
+        if (seconds > 0.0).all() and (weight > 0.0).all():
+            pace = seconds / weight
+            pace /= pace.mean()
+            self.pace = 0.5 * self.pace + 0.5 * pace
 
     def slab_of(self, rank: int) -> tuple[float, float]:
         lower = -np.inf if rank == 0 else float(self.cuts[rank - 1])
@@ -97,6 +126,7 @@ class BodiesOverProcesses:
         mine = np.zeros(0, bool)
         own_rows = np.zeros((0, interactions.C_SIZE))
         clock = self.seconds
+        pairs_before = clock["pairs"]
         for step in range(n_steps):
             started = time.perf_counter()
             owned_step.first_half(system, motion, omegas, settings)
@@ -140,6 +170,7 @@ class BodiesOverProcesses:
                 status = stepper.STATUS_NOT_FINITE
                 break
         if owners is not None:
+            self._measure_pace(owners, clock["pairs"] - pairs_before)
             history = self._joined_history(history, owners, key_stride)
             solver._store_results(*self._joined_results(own_rows, body_pairs[mine], wall_pairs,
                                                         key_stride, len(solver.wall_points)))
