@@ -12,17 +12,23 @@ with c the one-thread seconds per cell-step, s the pressure's share, r the share
 work on the gathered levels (both measured on one process), m_x, m_r, m_g the messages per step
 measured on two processes.
 
-With B bodies (``--bodies``; every process holds every body, the contact pairs shared out):
+With B bodies (``--bodies``; each owned by the process whose slab holds its centre, every
+process holding a copy of every body: riprap/solid/bodies_over_processes.py):
   coupling work      = k_c (cells holding bodies) (n + 2H) / nx   clipping, face set, sums
-  contact sub-steps  = S (a B / P + b B + [P > 1] (f + latency log2(P) + rows / bandwidth))
-with b the work every process repeats per body and sub-step (broad phase, integration, the sums
-of the contact rows: 2.6 us at 3,888 bodies, bench/substep_parts.py; 1.1 us at 192), f the
-fixed cost of a split sub-step (its two compiled halves entered from Python, the join's
-bookkeeping; one process runs its sub-steps in one compiled call), a the pair work per body and
-sub-step, S the sub-steps per fluid step. a and f are fitted to bench/parallel.py's placed layer
-(161 bodies, 69 sub-steps a step: 3.3 ms a sub-step on one process = a B + b B, 2.2 ms on two =
-a B / 2 + b B + f, b = 1.1 us). The cells holding bodies: 850 per body (137,000 for the layer's
-161 at 11 cells across a unit).
+  contact sub-steps  = S (a B / P + o B / P + e B
+                          + [P > 1] (f + 3 latency log2(P) + (48 B + rows) / bandwidth))
+with a the pair work per body and sub-step, o the broad phase among the bodies near a slab and
+the sums of its own bodies' forces, per body owned (measured at P = 8 on 3,888 cubes,
+bench/substep_parts.py), e the work every process still does for every body (the half kicks
+and the drift, the owners, the joined forces put back; bench/substep_parts.py), f the fixed cost
+of a split sub-step (its compiled parts entered from Python, the messages' bookkeeping, the
+waiting of a sub-step's imbalance), S the sub-steps per fluid step. Each sub-step sends two
+messages (the pairs' rows to the other owners, the forces joined: 48 bytes a body) and, when a
+body crossed a cut, a third (the springs). a and f are fitted to bench/parallel.py's placed
+layer (161 bodies, 69 sub-steps a step: 2.19 ms a sub-step on one process = a B + b B with b
+the one process's broad phase, integration and sums, 1.1 us a body at 192 bodies; 1.50 ms on
+two = a B / 2 + o B / 2 + e B + f). The cells holding bodies: 850 per body (137,000 for the
+layer's 161 at 11 cells across a unit).
 
     python bench/parallel_model.py [--cells 1000 200 100] [--bodies 3678]
 """
@@ -40,12 +46,18 @@ REDUCTIONS = 49
 GATHERS = 16
 BODY_CELL_SECONDS = 0.15 / 137_000   # the coupling's seconds per cell holding bodies, a step
 BODY_CELLS = 850                      # cells holding a body, per body (11 cells across a unit)
-REPEATED_SECONDS = 2.6e-6             # per body and sub-step, repeated on every process
-LAYER_REPEATED = 1.1e-6 * 161         # the same for the layer's 161 bodies (192 measured)
-PAIR_SECONDS = (3.3e-3 - LAYER_REPEATED) / 161          # pair work per body and sub-step
-SPLIT_SUBSTEP_SECONDS = 2.2e-3 - PAIR_SECONDS * 161 / 2 - LAYER_REPEATED   # f, per sub-step
+ONE_PROCESS_BODY_SECONDS = 2.6e-6     # broad phase, integration, sums per body, one process
+                                      # (3,888 measured; the broad phase's sort grows with B)
+LAYER_ONE_PROCESS_BODY = 1.1e-6       # the same at 192 bodies, for the layer's fit
+EVERY_BODY_SECONDS = EVERY_BODY_MEASURED      # e, per body and sub-step on every process
+OWN_BODY_SECONDS = OWN_BODY_MEASURED          # o, per body owned and sub-step
+LAYER_BODIES = 161
+PAIR_SECONDS = 2.19e-3 / LAYER_BODIES - LAYER_ONE_PROCESS_BODY         # a
+SPLIT_SUBSTEP_SECONDS = (1.50e-3 - (PAIR_SECONDS + OWN_BODY_SECONDS) * LAYER_BODIES / 2
+                         - EVERY_BODY_SECONDS * LAYER_BODIES)           # f, per sub-step
 SUBSTEPS = 69                         # contact sub-steps per fluid step (the layer, adaptive)
-ROW_BYTES = 6 * 28 * 8                # the contact rows of a body's pairs (about 6), joined
+ROW_BYTES = 28 * 8                    # a pair's row of results, sent when its bodies' owners differ
+CROSSING_ROWS = 0.1                   # rows sent per body and sub-step (pairs across a cut)
 NETWORKS = {"shared memory (one node)": (0.5e-6, 10e9),
             "InfiniBand HDR": (2e-6, 12.5e9),
             "10 Gb Ethernet": (25e-6, 1.2e9)}
@@ -60,10 +72,13 @@ def body_time(cells, bodies, processes, latency, bandwidth):
     n = nx / processes
     planes = n + (2 * HALO if processes > 1 else 0)
     coupling = BODY_CELL_SECONDS * BODY_CELLS * bodies * min(planes, nx) / nx
-    substep = PAIR_SECONDS * bodies / processes + REPEATED_SECONDS * bodies
-    if processes > 1:
-        substep += (SPLIT_SUBSTEP_SECONDS + latency * math.log2(processes)
-                    + ROW_BYTES * bodies / bandwidth)
+    if processes == 1:
+        substep = (PAIR_SECONDS + ONE_PROCESS_BODY_SECONDS) * bodies
+    else:
+        substep = ((PAIR_SECONDS + OWN_BODY_SECONDS) * bodies / processes
+                   + EVERY_BODY_SECONDS * bodies + SPLIT_SUBSTEP_SECONDS
+                   + 3 * latency * math.log2(processes)
+                   + (48 * bodies + ROW_BYTES * CROSSING_ROWS * bodies / processes) / bandwidth)
     return coupling + SUBSTEPS * substep
 
 

@@ -25,6 +25,7 @@ import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.kernels.plane_sums import plane_sums
+from riprap.fluid.pressure_window import PressureWindow, fits
 from riprap.fluid.slab_pressure import DISTRIBUTED_LEVELS, SlabPressureSolver
 from riprap.fluid.solver import FluidSolver, boundary_inflow_planes
 from riprap.parallel.slabs import cut_slabs
@@ -42,9 +43,12 @@ PLANE_ARRAYS = tuple(name for name, _ in _STATE) + ("solid",)
 
 class _BlockPressure:
     """The pressure solve of a block: its slab's cells with one ghost plane each side, solved
-    over all the processes (``SlabPressureSolver``), the block's other planes kept."""
+    over all the processes (``SlabPressureSolver``), the block's other planes kept. Given a
+    ``window`` (``riprap/fluid/pressure_window.py``), the solve runs on the pressure's own slabs
+    and the planes between the two cuts move before and after it."""
 
-    def __init__(self, slab_solver: SlabPressureSolver, low: int, owned: int, high: int):
+    def __init__(self, slab_solver: SlabPressureSolver, low: int, owned: int, high: int,
+                 window: PressureWindow | None = None):
         self.slab = slab_solver
         ghost_low = 1 if low else 0
         ghost_high = 1 if high else 0
@@ -53,9 +57,13 @@ class _BlockPressure:
         self.faces = slice(self.first, low + owned + ghost_high + 1)
         self.low, self.owned = low, owned
         self.tolerance = slab_solver.tolerance
+        self.window = window
 
     def solve(self, beta_x, beta_y, beta_z, rhs, p_initial=None, listed_cells=None,
               time_step=None):
+        if self.window is not None:
+            return self._solve_in_window(beta_x, beta_y, beta_z, rhs, p_initial, listed_cells,
+                                         time_step)
         cells = self.cells
         listed = None
         if listed_cells is not None:
@@ -75,6 +83,18 @@ class _BlockPressure:
         window_shape = (self.cells.stop - self.cells.start,) + tuple(shape[1:])
         return np.ravel_multi_index((i[own] - self.first, j[own], k[own]), window_shape)
 
+    def _solve_in_window(self, beta_x, beta_y, beta_z, rhs, p_initial, listed_cells, time_step):
+        move = self.window
+        listed = (None if listed_cells is None
+                  else move.listed(np.asarray(listed_cells, dtype=np.int64), rhs.shape))
+        guess = np.zeros(rhs.shape) if p_initial is None else p_initial
+        solved, report = self.slab.solve(
+            move.window(beta_x, faces=True), move.window(beta_y), move.window(beta_z),
+            move.window(rhs), p_initial=None if p_initial is None else move.window(guess),
+            listed_cells=listed, time_step=time_step)
+        pressure = np.array(guess, copy=True)
+        move.to_block(solved, pressure)
+        return pressure, report
 
 class SlabFluidSolver(FluidSolver):
     """A ``FluidSolver`` on one process's block of a grid split over processes (module docstring).
@@ -239,11 +259,21 @@ def split_fluid(whole: FluidSolver, comm, *, halo: int = HALO_PLANES, plane_cost
     block.whole_cells = (nx, ny, nz)
     block.first, block.stop, block.low, block.high = first, stop, low, high
     block.owned = stop - first
-    slab = SlabPressureSolver((nx, ny, nz), h, cut, comm,
+    # the pressure on slabs of equal planes where the fluid's are not (bodies' work weighed in)
+    # and the planes between the cuts can move between neighbours (pressure_window.py)
+    pressure_cut = cut_slabs(nx, comm.size, alignment=cut.alignment,
+                             thinnest=max(halo, cut.alignment))
+    window = None
+    if pressure_cut.starts != cut.starts and fits(cut, pressure_cut):
+        window = PressureWindow(cut, pressure_cut, comm, low)
+    else:
+        pressure_cut = cut
+    slab = SlabPressureSolver((nx, ny, nz), h, pressure_cut, comm,
                               tolerance=whole.pressure_solver.tolerance,
                               max_iterations=whole.pressure_solver.max_iterations,
                               volume_tolerance=whole.pressure_solver.volume_tolerance)
-    block.pressure_solver = _BlockPressure(slab, low, stop - first, high)
+    block.pressure_solver = _BlockPressure(slab, low, stop - first, high, window)
+    block.pressure_cut = pressure_cut
     block.obstacle_boxes = list(whole.obstacle_boxes)
     if add_parts is not None:
         add_parts(block, whole)

@@ -72,6 +72,7 @@ class OverProcesses:
         fields = super().summary_fields(wall_time, steps)
         block = self.block
         fields["processes"] = {"count": block.comm.size, "slabs": list(block.cut.starts),
+                               "pressure_slabs": list(block.pressure_cut.starts),
                                "halo_planes": block.halo}
         return fields
 

@@ -27,6 +27,9 @@ __all__ = ["SingleProcess", "MpiProcesses", "world", "launched_processes", "Para
 # The variables a launcher sets to the number of processes it started: MPICH and Intel MPI
 # (PMI_SIZE), Open MPI (OMPI_COMM_WORLD_SIZE), PMIx launchers (PMIX_SIZE is not standard; Open
 # MPI 5 sets OMPI_COMM_WORLD_SIZE too), Slurm's srun with --mpi (PMI_SIZE).
+#: Seconds an aborting process waits for the launcher to read what it wrote (``abort``).
+_ABORT_GRACE_SECONDS = 0.5
+
 _LAUNCHER_SIZE_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS")
 
 
@@ -79,6 +82,9 @@ class SingleProcess:
 
     def exchange_rows(self, rows: np.ndarray, send_counts, receive_counts) -> np.ndarray:
         return np.array(rows, dtype=np.float64)
+
+    def swap_planes(self, to_low, to_high, n_from_low: int, n_from_high: int):
+        return None, None
 
     def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:
         return None
@@ -221,6 +227,28 @@ class MpiProcesses:
         self._count("exchange", started, rows.nbytes)
         return out
 
+    def swap_planes(self, to_low: np.ndarray, to_high: np.ndarray, n_from_low: int,
+                    n_from_high: int):
+        """Planes (along axis 0) to the neighbouring slabs and from them: ``to_high`` to the
+        next process, ``to_low`` to the previous; ``n_from_low`` planes of the same shape come
+        from the previous, ``n_from_high`` from the next. Returns (from the previous, from the
+        next), None where there is no neighbour."""
+        mpi = self._mpi
+        started = time.perf_counter()
+        plane = to_low.shape[1:]
+        from_low = np.empty((n_from_low,) + plane) if self._low != mpi.PROC_NULL else None
+        from_high = np.empty((n_from_high,) + plane) if self._high != mpi.PROC_NULL else None
+        self.comm.Sendrecv(np.ascontiguousarray(to_high, dtype=np.float64), dest=self._high,
+                           sendtag=3, recvbuf=from_low if from_low is not None else np.empty(0),
+                           source=self._low, recvtag=3)
+        self.comm.Sendrecv(np.ascontiguousarray(to_low, dtype=np.float64), dest=self._low,
+                           sendtag=4, recvbuf=from_high if from_high is not None else np.empty(0),
+                           source=self._high, recvtag=4)
+        sent = to_high.nbytes * (self._high != mpi.PROC_NULL) \
+            + to_low.nbytes * (self._low != mpi.PROC_NULL)
+        self._count("exchange", started, sent, 2)
+        return from_low, from_high
+
     def exchange(self, array: np.ndarray, send_low, receive_low, send_high, receive_high) -> None:
         """Planes of ``array`` along axis 0 to and from the neighbouring slabs: ``send_high``
         (a slice) goes to the next process's ``receive_low``, ``send_low`` to the previous
@@ -258,6 +286,17 @@ class MpiProcesses:
         self.comm.Barrier()
 
     def abort(self, code: int = 1) -> None:
+        """End every process of the run. The launcher forwards each process's output as it
+        reads it, and an abort tears the pipes down at once: a message written just before could
+        be lost (seen: a refusal that every process met, each aborting, and none of its lines
+        reached the terminal). So the output is flushed and given a moment to be read first."""
+        import sys
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        time.sleep(_ABORT_GRACE_SECONDS)
         self.comm.Abort(code)
 
 
