@@ -26,8 +26,10 @@ waiting of a sub-step's imbalance), S the sub-steps per fluid step. Each sub-ste
 messages (the pairs' rows to the other owners, the forces joined: 48 bytes a body) and, when a
 body crossed a cut, a third (the springs). a and f are fitted to bench/parallel.py's placed
 layer (161 bodies, 69 sub-steps a step: 2.19 ms a sub-step on one process = a B + b B with b
-the one process's broad phase, integration and sums, 1.1 us a body at 192 bodies; 1.50 ms on
-two = a B / 2 + o B / 2 + e B + f). The cells holding bodies: 850 per body (137,000 for the
+the one process's broad phase, integration and sums, 0.8 us a body at 192 bodies; 1.50 ms on
+two = a B / 2 + o B / 2 + e B + f). Taken as it is measured at P = 8, o grows as slabs thin
+(the near bodies beside a slab's own grow to several times them when a slab is a few bodies
+wide): the model is optimistic there. The cells holding bodies: 850 per body (137,000 for the
 layer's 161 at 11 cells across a unit).
 
     python bench/parallel_model.py [--cells 1000 200 100] [--bodies 3678]
@@ -46,11 +48,13 @@ REDUCTIONS = 49
 GATHERS = 16
 BODY_CELL_SECONDS = 0.15 / 137_000   # the coupling's seconds per cell holding bodies, a step
 BODY_CELLS = 850                      # cells holding a body, per body (11 cells across a unit)
-ONE_PROCESS_BODY_SECONDS = 2.6e-6     # broad phase, integration, sums per body, one process
-                                      # (3,888 measured; the broad phase's sort grows with B)
-LAYER_ONE_PROCESS_BODY = 1.1e-6       # the same at 192 bodies, for the layer's fit
-EVERY_BODY_SECONDS = EVERY_BODY_MEASURED      # e, per body and sub-step on every process
-OWN_BODY_SECONDS = OWN_BODY_MEASURED          # o, per body owned and sub-step
+# bench/substep_parts.py, 2026-11-29 (one thread):
+ONE_PROCESS_BODY_SECONDS = 1.6e-6     # broad phase, integration, sums per body, one process
+                                      # (3,888 cubes; the broad phase's sort grows with B)
+LAYER_ONE_PROCESS_BODY = 0.8e-6       # the same at 192 bodies, for the layer's fit
+EVERY_BODY_SECONDS = 0.16e-6          # e, per body and sub-step on every process (3,888)
+OWN_BODY_SECONDS = 1.6e-6             # o, per body owned and sub-step (3,888 over 8: the
+                                      # near bodies about twice the owned)
 LAYER_BODIES = 161
 PAIR_SECONDS = 2.19e-3 / LAYER_BODIES - LAYER_ONE_PROCESS_BODY         # a
 SPLIT_SUBSTEP_SECONDS = (1.50e-3 - (PAIR_SECONDS + OWN_BODY_SECONDS) * LAYER_BODIES / 2

@@ -1,6 +1,9 @@
 """Run under ``mpiexec -n N``: a fluid case's steps on N processes against one process's; exits 1
 if any array of the whole grid (or a gauge's record) differs in any bit, compared every EVERY
-steps and after the last. Usage: slab_fluid_check.py CASE STEPS [HALO [EVERY]]"""
+steps and after the last. Usage: slab_fluid_check.py CASE STEPS [HALO [EVERY [skewed]]]
+
+``skewed``: the fluid's cut made unequal (the upper half's planes cost three times the lower's),
+so that the pressure solve runs on slabs of its own (``riprap/fluid/pressure_window.py``)."""
 import sys
 
 import numpy as np
@@ -16,10 +19,17 @@ def main():
     case_path, steps = sys.argv[1], int(sys.argv[2])
     halo = int(sys.argv[3]) if len(sys.argv) > 3 else HALO_PLANES
     every = int(sys.argv[4]) if len(sys.argv) > 4 else 1
+    skewed = len(sys.argv) > 5 and sys.argv[5] == "skewed"
     comm = world()
     case = load_case(case_path)
     serial = build_fluid_solver(case)
-    split = split_fluid(build_fluid_solver(case), comm, halo=halo, add_parts=add_parts_to_block)
+    nx = serial.grid.cells[0]
+    costs = np.where(np.arange(nx) >= nx // 2, 3.0, 1.0) if skewed else None
+    split = split_fluid(build_fluid_solver(case), comm, halo=halo, add_parts=add_parts_to_block,
+                        plane_costs=costs)
+    if skewed and split.pressure_cut.starts == split.cut.starts:
+        print(f"the pressure's cut {split.pressure_cut.starts} is the fluid's: nothing checked")
+        sys.exit(1)
     worst = 0
     for step in range(steps):
         serial.step()
@@ -44,8 +54,8 @@ def main():
             worst = 1
             break
     if comm.rank == 0 and not worst:
-        print(f"{steps} steps on {comm.size} processes (halo {halo}, slabs {split.cut.starts}): "
-              "bit for bit", flush=True)
+        print(f"{steps} steps on {comm.size} processes (halo {halo}, slabs {split.cut.starts}, "
+              f"pressure slabs {split.pressure_cut.starts}): bit for bit", flush=True)
     sys.exit(worst)
 
 

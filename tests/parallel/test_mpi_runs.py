@@ -65,6 +65,19 @@ def test_slab_pressure_solve_is_bit_for_bit(processes):
     assert result.stdout.count("bit for bit") == 4, result.stdout
 
 
+@pytest.mark.parametrize("processes", [2, 3])
+def test_pressure_on_slabs_of_its_own_is_bit_for_bit(processes):
+    """The fluid's cut made unequal (its upper planes weighed three times), the pressure solved on
+    equal slabs of its own (riprap/fluid/pressure_window.py): the planes moved between the cuts
+    are the owners' (pressure_window_check.py: halos hold NaN), and 600 dam-break steps give one
+    process's state in every bit."""
+    result = launch(processes, sys.executable, str(HERE / "pressure_window_check.py"))
+    assert result.stdout.count("bit for bit") == processes, result.stdout
+    result = launch(processes, sys.executable, str(HERE / "slab_fluid_check.py"), str(DAM_BREAK),
+                    "600", "8", "100", "skewed")
+    assert "bit for bit" in result.stdout, result.stdout
+
+
 def test_dam_break_over_two_processes_and_restarts(tmp_path):
     """Martin & Moyce's dam break (examples/02, the front crosses the cut at x-plane 64 near
     t = 0.06 s): the frames, solver log and checkpoint of ``mpiexec -n 2 riprap run`` are those
