@@ -37,8 +37,12 @@ def mpiexec() -> str:
 
 def launch(processes, *arguments, timeout=600, check=True):
     command = [mpiexec(), "-n", str(processes), *arguments] if processes > 1 else list(arguments)
+    # the machine's cores shared among the processes (docs/parallel.md): more threads than cores
+    # made the split runs several times slower here (2 cores, 3 processes of 2 threads each)
+    threads = str(max(1, (os.cpu_count() or 1) // processes))
     result = subprocess.run(command, capture_output=True, text=True, timeout=timeout,
-                            cwd=ROOT, env=dict(os.environ, RIPRAP_SMOKE="0"))
+                            cwd=ROOT, env=dict(os.environ, RIPRAP_SMOKE="0",
+                                               NUMBA_NUM_THREADS=threads))
     if check:
         assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     return result
