@@ -114,9 +114,9 @@ def test_settling_sphere_over_two_processes_and_restarts(tmp_path):
 
 
 def test_placed_layer_in_dam_break_wave_over_two_processes(tmp_path):
-    """examples/06 (25 units on 135 fixed rocks and a fixed core, cut at x-plane 36 of 70,
-    x = 0.6 m, through the layer) for 0.3 s: units resting across the cut and their contacts
-    across it, as on one process."""
+    """examples/06 (25 units on 135 fixed rocks and a fixed core, the fluid cut at x-plane 40 of
+    70, x = 1.0 m, through the layer; the pressure solved on its own slabs, cut at 36) for 0.3 s:
+    units resting across the cut and their contacts across it, as on one process."""
     case = shortened(ROOT / "examples" / "06_layer_in_wave" / "case.toml", tmp_path, 0.3, "short")
     try:
         one, two = tmp_path / "one", tmp_path / "two"
@@ -126,6 +126,7 @@ def test_placed_layer_in_dam_break_wave_over_two_processes(tmp_path):
         case.unlink()
     summary = json.loads((two / "summary.json").read_text())
     cut = -3.0 + summary["processes"]["slabs"][1] * 0.1
+    assert summary["processes"]["pressure_slabs"] != summary["processes"]["slabs"]
     positions = np.load(two / "checkpoint.npz")["bodies_positions"]
     assert (positions[:, 0] < cut).any() and (positions[:, 0] > cut).any()
     assert summary["contacts"] > 50
