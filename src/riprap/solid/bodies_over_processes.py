@@ -107,11 +107,11 @@ class BodiesOverProcesses:
         return np.bincount(owners, minlength=self.processes.size).tolist()
 
     # ------------------------------------------------------------------ the step
-    def advance(self, solver, n_steps: int) -> int:
-        """``n_steps`` velocity-Verlet steps of ``solver`` (a ``SolidSolver``); returns the
-        status of ``stepper`` (the state is left at the failing step, as on one process)."""
-        processes = self.processes
-        rank, size = processes.rank, processes.size
+    def advance(self, solver, n_steps: int) -> tuple[int, int]:
+        """``n_steps`` velocity-Verlet steps of ``solver`` (a ``SolidSolver``); returns (the
+        steps done, the status of ``stepper``: the state is left at the failing step, as on one
+        process)."""
+        rank = self.processes.rank
         self.cuts = self.balanced_cuts(solver)
         lower, upper = self.slab_of(rank)
         system, motion, history, settings = solver._kernel_state(solver.time_step)
