@@ -79,33 +79,15 @@ class PressureWindow:
         extra = 1 if faces else 0
         out = np.empty((self.end - self.start + extra,) + array.shape[1:])
         # own planes: cells [first, stop), faces [first, stop] (both ends computed here)
-        self._copy_from_block(out, self.start, array, self.first, self.stop + extra)
+        own = (max(self.first, self.start), min(self.stop + extra, self.end + extra))
+        _put(out, self.start, own, _planes(array, self.block_start, own))
         (below_in, above_in), (below_out, above_out) = self.cells_in, self.cells_out
-        from_below, from_above = self._swap(
-            array, (below_out[0] + extra, below_out[1] + extra), above_out,
-            _length(below_in), _length(above_in))
-        if from_below is not None and len(from_below):
-            out[below_in[0] - self.start:below_in[1] - self.start] = from_below
-        if from_above is not None and len(from_above):
-            out[above_in[0] + extra - self.start:above_in[1] + extra - self.start] = from_above
+        from_below, from_above = self.comm.swap_planes(
+            _planes(array, self.block_start, (below_out[0] + extra, below_out[1] + extra)),
+            _planes(array, self.block_start, above_out), _length(below_in), _length(above_in))
+        _put(out, self.start, below_in, from_below)
+        _put(out, self.start, (above_in[0] + extra, above_in[1] + extra), from_above)
         return out
-
-    def _copy_from_block(self, out, out_start, array, start, stop) -> None:
-        lo = max(start, out_start)
-        hi = min(stop, out_start + len(out))
-        if hi > lo:
-            out[lo - out_start:hi - out_start] = array[lo - self.block_start:hi - self.block_start]
-
-    def _swap(self, array, to_below, to_above, n_from_below, n_from_above):
-        """Send the block's planes ``to_below`` / ``to_above`` (global ranges) to the
-        neighbours and take ``n_from_below`` / ``n_from_above`` planes from them."""
-        def planes(span):
-            lo, hi = span
-            if hi <= lo:
-                return np.empty((0,) + array.shape[1:])
-            return array[lo - self.block_start:hi - self.block_start]
-        return self.comm.swap_planes(planes(to_below), planes(to_above), n_from_below,
-                                     n_from_above)
 
     def listed(self, listed_block_cells: np.ndarray, block_shape) -> np.ndarray:
         """The listed cells of the whole grid that fall in the window's own planes (its
@@ -128,25 +110,31 @@ class PressureWindow:
     def to_block(self, window_pressure: np.ndarray, block_pressure: np.ndarray) -> None:
         """The solved pressure into the block's slab and its ghost planes, those outside the
         window from the neighbours' windows."""
-        lo = max(self.want[0], self.start)
-        hi = min(self.want[1], self.end)
-        block_pressure[lo - self.block_start:hi - self.block_start] = \
-            window_pressure[lo - self.start:hi - self.start]
+        mine = (max(self.want[0], self.start), min(self.want[1], self.end))
+        _put(block_pressure, self.block_start, mine, _planes(window_pressure, self.start, mine))
         (below_in, above_in), (below_out, above_out) = self.pressure_in, self.pressure_out
-
-        def planes(span):
-            a, b = span
-            if b <= a:
-                return np.empty((0,) + window_pressure.shape[1:])
-            return window_pressure[a - self.start:b - self.start]
         from_below, from_above = self.comm.swap_planes(
-            planes(below_out), planes(above_out), _length(below_in), _length(above_in))
-        if from_below is not None and len(from_below):
-            block_pressure[below_in[0] - self.block_start:below_in[1] - self.block_start] = \
-                from_below
-        if from_above is not None and len(from_above):
-            block_pressure[above_in[0] - self.block_start:above_in[1] - self.block_start] = \
-                from_above
+            _planes(window_pressure, self.start, below_out),
+            _planes(window_pressure, self.start, above_out), _length(below_in),
+            _length(above_in))
+        _put(block_pressure, self.block_start, below_in, from_below)
+        _put(block_pressure, self.block_start, above_in, from_above)
+
+
+def _planes(array: np.ndarray, origin: int, span) -> np.ndarray:
+    """The planes [span) of ``array``, whose plane 0 is global plane ``origin`` (none when the
+    span is empty)."""
+    lo, hi = span
+    if hi <= lo:
+        return np.empty((0,) + array.shape[1:])
+    return array[lo - origin:hi - origin]
+
+
+def _put(target: np.ndarray, origin: int, span, planes) -> None:
+    """``planes`` into [span) of ``target``, whose plane 0 is global plane ``origin``."""
+    lo, hi = span
+    if planes is not None and hi > lo:
+        target[lo - origin:hi - origin] = planes
 
 
 def _length(span) -> int:
