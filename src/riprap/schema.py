@@ -718,9 +718,19 @@ KEYS: tuple[Key, ...] = (
         variant="surface"),
     Key("gauges", "position", "vector", "m", "The point read.", variant="velocity"),
     Key("gauges", "position", "vector", "m",
-        "A point of the plane x = const at the crest level z: only the water crossing above it "
-        "(from the cell row holding it up) counts, not the flow through a core under the crest "
-        "(y unused).", variant="overtopping"),
+        "A point of the plane x = const (the crest's landward edge) at the crest level z (y "
+        "unused). The water crossing the plane above the crest's surface there counts: the top "
+        "of the obstacles and porous zones beside the plane, found from the geometry, not z; "
+        "the flow through a porous crest under its surface does not. z is where the count "
+        "starts only where the plane has no obstacle or porous zone, and gives the freeboard Rc "
+        "= z - still_water_level of the EurOtop comparison (docs/waves.md).",
+        variant="overtopping"),
+    Key("gauges", "crest_width", "number", "m",
+        "Width G_c of the crest in front of the plane, for EurOtop's crest-width factor C_r = "
+        "min(1, 3.06 exp(-1.5 G_c/Hm0)) in a series' comparison; 0: from the top of the placed "
+        "layer's face ([slope] of the pack) to the plane, or no factor (C_r = 1) without a "
+        "slope. A width under 0.75 Hm0 gives C_r = 1.", default=0.0, variant="overtopping",
+        valid_range=_NON_NEGATIVE),
     Key("gauges", "position", "vector", "m",
         "Where the run-up is looked for from (x; y picks the cell row; z unused).",
         variant="run_up"),
@@ -912,6 +922,8 @@ PLAUSIBLE: dict[tuple[str, str], Range] = {
     ("series_steps", "duration"): _between(1.0, 1.0e6),
     ("series_steps", "wave_steepness"): _between(1.0e-3, 0.142),
     ("series", "displacement_threshold"): _between(1.0e-3, 10.0),
+    # crest widths: a narrow laboratory crest (a few cm) to a prototype berm (a hundred m)
+    ("gauges", "crest_width"): _between(1.0e-3, 1000.0),
     ("series", "settle_time"): _between(0.0, 1.0e5),
     # elastic material: gels (1e3 Pa) to diamond (1.2e12); concrete about 3e10
     ("deformable", "young_modulus"): _between(1.0e3, 1.0e13),
