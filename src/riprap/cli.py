@@ -228,6 +228,10 @@ def _check(path: Path, out: str | None, restart: str | None = None) -> int:
     print(f"  checked: {'; '.join(report.checked)}")
     for item in report.not_checked:
         print(f"  not checked (only a run can tell): {item}")
+    if report.friction:
+        print("  friction of the pairs of materials that meet:")
+        for pair in report.friction:
+            print(f"    {'-'.join(pair.materials)}: {pair.friction_coefficient:g} ({pair.source})")
     return 0
 
 

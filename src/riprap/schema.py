@@ -82,6 +82,7 @@ KINDS = {
     ),
     "direction": "3 numbers [x, y, z], not all zero (normalised on load)",
     "string_list": "a non-empty list of strings",
+    "name_pair": "2 strings [a, b]",
     "body_selection": '"all", or a non-empty list of body indices (integers from 0, in the order '
                       'the case creates its bodies)',
     "path": "a file path (string)",
@@ -266,6 +267,13 @@ TABLES: tuple[Table, ...] = (
     Table("simulation", False, 1, None, "Clock, time step, gravity, damping and stopping rules."),
     Table("materials", True, 1, None,
           "Contact materials; bodies and walls refer to them by name."),
+    Table("friction", True, 0, None,
+          "Coulomb friction coefficient of the contacts between two named materials (a material "
+          "with itself too), for rigid bodies and walls; each pair once, in either order. A pair "
+          "not listed takes the smaller of its two materials' own friction_coefficient. Walls "
+          "have materials too (a placement's face_material and side_wall_material). Not for the "
+          "materials of deformable bodies (their contact takes the smaller of the two). A case "
+          "with `pack` may name the pack's materials; a pack keeps its pairs."),
     Table("shapes", True, 1, "type",
           "Body shapes, meshed into tetrahedra; bodies and grids refer to them by name."),
     Table("bodies", True, 0, None, "Single bodies, each placed by its centroid."),
@@ -384,6 +392,14 @@ KEYS: tuple[Key, ...] = (
     Key("materials", "tangential_stiffness_ratio", "number", "-",
         "Tangential over normal contact stiffness (2/7 by default).",
         default=2.0 / 7.0, valid_range=_POSITIVE),
+    # [[friction]]
+    Key("friction", "materials", "name_pair", "-",
+        "The two materials in contact (the same name twice: a material on itself).",
+        references="materials"),
+    # 2 = tan 63 degrees, above any dry contact of concrete, rock, steel or glass (0.2-1.2)
+    Key("friction", "friction_coefficient", "number", "-",
+        "Coulomb friction coefficient of their contacts (tan of the friction angle).",
+        valid_range=Range(minimum=0.0, maximum=2.0)),
     # [[shapes]], keys of every type
     Key("shapes", "name", "string", "-", "Name that bodies and grids use to refer to it.",
         unique=True),
@@ -1038,7 +1054,8 @@ def describe_expected(entry: Key) -> str:
     if entry.greater_than is not None:
         text += f", each component > {entry.greater_than}"
     if entry.references is not None:
-        text += f", the name of a [[{entry.references}]] entry"
+        each = "each " if entry.kind in ("string_list", "name_pair") else ""
+        text += f", {each}the name of a [[{entry.references}]] entry"
     return text
 
 
@@ -1114,8 +1131,9 @@ def render_markdown() -> str:
         "body, except in a placement case (one with `[placement]`, run by `riprap place`), which "
         "makes its own shapes and bodies from `[slope]`, `[underlayer]`, `[armour]` and "
         "`[placement]`.",
-        "- `name` is unique among `[[materials]]` and among `[[shapes]]`; `shape`, `shapes` and "
-        "`material` must name an entry that exists.",
+        "- `name` is unique among `[[materials]]` and among `[[shapes]]`; `shape`, `shapes`, "
+        "`material` and `[[friction]]` `materials` must name an entry that exists; a pair of "
+        "materials appears in `[[friction]]` at most once, in either order.",
         "- Keys listed under a `type` exist only for that type: giving one for another type is an "
         "error, and a required one must be given.",
         "- Relative file paths are relative to the folder of the case file.",

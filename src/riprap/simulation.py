@@ -263,6 +263,7 @@ class Simulation:
     deformable_accepted_depths = _OfScene()
 
     add_material = _of_scene(Scene.add_material)
+    add_friction_pair = _of_scene(Scene.add_friction_pair)
     add_shape = _of_scene(Scene.add_shape)
     shape = _of_scene(Scene.shape)
     add_body = _of_scene(Scene.add_body)

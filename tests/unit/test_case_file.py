@@ -97,6 +97,10 @@ max = [1, 1, 2]
 
 [output]
 directory = "out-test"
+
+[[friction]]
+materials = ["rock", "concrete"]
+friction_coefficient = 0.8
 """
 
 
@@ -223,6 +227,28 @@ ERROR_CASES = {
                               "walls[1].max", "[1.0, -1.0, 2.0]", "must exceed min"),
     "zero normal": ("normal = [0, 0, 2]", "normal = [0, 0, 0]", "normal", "walls[0].normal",
                     "[0, 0, 0]", "not all zero"),
+    # [[friction]]: a pair of unknown materials, of the wrong size, twice, or beyond 0-2
+    "friction pair of an unknown material": (
+        'materials = ["rock", "concrete"]', 'materials = ["rock", "concrte"]', "concrte",
+        "friction[0].materials[1]", '"concrte"', "did you mean 'concrete'?"),
+    "friction pair of three names": (
+        'materials = ["rock", "concrete"]', 'materials = ["rock", "concrete", "rock"]',
+        '"concrete", "rock"]', "friction[0].materials", '["rock", "concrete", "rock"]',
+        "expected 2 strings [a, b], each the name of a [[materials]] entry, got a list of 3 names"),
+    "friction pair of one name": (
+        'materials = ["rock", "concrete"]', 'materials = ["rock"]', 'materials = ["rock"]',
+        "friction[0].materials", '["rock"]', "got a list of 1 name"),
+    "friction pair listed twice": (
+        "friction_coefficient = 0.8", 'friction_coefficient = 0.8\n[[friction]]\n'
+        'materials = ["concrete", "rock"]  # again\nfriction_coefficient = 0.5', "# again",
+        "friction[1].materials", '["concrete", "rock"]',
+        "the pair concrete-rock is listed twice; friction[0] (line"),
+    "friction coefficient above 2": (
+        "friction_coefficient = 0.8", "friction_coefficient = 2.5", "= 2.5",
+        "friction[0].friction_coefficient", "2.5", "out of range; expected a number, [0, 2]"),
+    "friction coefficient below 0": (
+        "friction_coefficient = 0.8", "friction_coefficient = -0.1", "= -0.1",
+        "friction[0].friction_coefficient", "-0.1", "[0, 2]"),
     "unknown table": ("[output]", "[outputs]", "[outputs]", "outputs",
                       '{ directory = "out-test" }', "did you mean 'output'?"),
 }

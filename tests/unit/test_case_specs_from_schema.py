@@ -9,6 +9,7 @@ from riprap.case import specs
 from riprap.case.load import Case
 
 SPECS = {"simulation": specs.SimulationSettings, "materials": specs.MaterialSpec,
+         "friction": specs.FrictionSpec,
          "shapes": specs.ShapeSpec, "bodies": specs.BodySpec, "body_grids": specs.BodyGridSpec,
          "walls": specs.WallSpec, "slope": specs.SlopeSpec, "underlayer": specs.UnderlayerSpec,
          "armour": specs.ArmourSpec, "placement": specs.PlacementSpec, "fluid": specs.FluidSpec,

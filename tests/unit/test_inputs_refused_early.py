@@ -1,8 +1,9 @@
 """Work refused before it starts (issue 35), and ``riprap check`` agreeing with ``riprap run`` and
 ``riprap place``: check passes every shipped example; schedules that cannot advance, absurd body
 counts, integers beyond 64 bits, bodies needing billions of steps, keys far outside any physical
-range and placement cases that place would refuse later are all refused by both commands, with
-exit status 2, one line naming the file / key / body, no traceback and nothing written.
+range, placement cases that place would refuse later and bad [[friction]] pairs are all refused
+by both commands, with exit status 2, one line naming the file / key / body, no traceback and
+nothing written.
 """
 from pathlib import Path
 
@@ -46,6 +47,7 @@ _TINY_IN_WATER = (_edit(FLUID, "end_time = 0.01", "end_time = 1.0e4\noutput_inte
                     'side = 2e-4\n[[bodies]]\nshape = "c"\nmaterial = "rock"\n'
                     'position = [0.1, 0.01, 0.08]\n')
 _BIG_CORELOC = (EXAMPLES / "coreloc_small.toml").read_text()
+_PAIR = "[[friction]]\nmaterials = [{}]\nfriction_coefficient = {}\n"
 
 # name -> (case text, the command that would run it, phrases the error must contain)
 BROKEN_CASES = {
@@ -140,6 +142,28 @@ BROKEN_CASES = {
                                           ("Dn / Dn50 = 1.11", "own size")),
     "deformable_in_a_placement_case": (PLACEMENT + "[deformable]\n", "place",
                                        ("deformable:", "ignore [deformable]")),
+    # [[friction]] pairs (issue 51): unknown materials, a coefficient outside 0-2, a pair twice or
+    # of one name, a pair of a deformable body's material, in runs and placements
+    "friction_pair_of_an_unknown_material": (
+        RIGID + _PAIR.format('"rock", "concrete"', 0.7), "run",
+        ('friction[0].materials[1] = "concrete"', "no [[materials]] entry has this name")),
+    "friction_coefficient_of_3": (RIGID + _PAIR.format('"rock", "rock"', 3.0), "run",
+                                  ("friction[0].friction_coefficient = 3.0", "[0, 2]")),
+    "friction_pair_listed_twice": (
+        RIGID + _PAIR.format('"rock", "rock"', 0.7) + _PAIR.format('"rock", "rock"', 0.5), "run",
+        ('.toml:23: friction[1].materials = ["rock", "rock"]', "listed twice",
+         "friction[0] (line 20)")),
+    "friction_pair_of_one_name": (RIGID + _PAIR.format('"rock"', 0.7), "run",
+                                  ('friction[0].materials = ["rock"]', "2 strings [a, b]")),
+    "friction_pair_of_a_deformable_body": (
+        RIGID + _PAIR.format('"rock", "rock"', 0.7) + "[deformable]\n", "run",
+        ('[[friction]] materials = ["rock", "rock"]', "deformable body", "rigid contacts only")),
+    "friction_pair_of_an_unknown_material_in_a_placement": (
+        PLACEMENT + _PAIR.format('"concrete", "glass"', 0.3), "place",
+        ('friction[0].materials[1] = "glass"', "defined names")),
+    "friction_coefficient_negative_in_a_placement": (
+        PLACEMENT + _PAIR.format('"concrete", "rock"', -0.5), "place",
+        ("friction[0].friction_coefficient = -0.5", "[0, 2]")),
     "grid_file_with_a_repeated_row": (
         _edit(PLACEMENT, "rows = 3\nunits_per_row = 3", 'grid_file = "repeated.csv"'), "place",
         ("repeated.csv:4", "repeats line 2")),

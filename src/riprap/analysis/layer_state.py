@@ -21,6 +21,7 @@ from riprap.errors import CaseFileError
 from riprap.geometry.mass_properties import mass_properties
 from riprap.placement.slope import Slope
 from riprap.solid.contact_statistics import pair_friction
+from riprap.solid.materials import friction_table
 
 __all__ = ["LayerDescription", "LayerState", "state_from_simulation"]
 
@@ -156,6 +157,9 @@ class LayerState:
     rotation_history : (frames, n) float or None
         Each body's rotation (degrees) from its reference pose in every frame up to this state's
         (a run's frames 0..frame), for counting rocking; None without frames.
+    friction_pairs : tuple of riprap.solid.materials.FrictionPair
+        Friction coefficients of named pairs of materials (the case's ``[[friction]]``); other
+        pairs take the smaller of the two materials'.
     """
 
     positions: np.ndarray
@@ -181,6 +185,7 @@ class LayerState:
     reference_note: str = ""
     contacts_recorded: bool = True
     rotation_history: np.ndarray | None = None
+    friction_pairs: tuple = ()
     _faces: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -207,8 +212,9 @@ class LayerState:
         return volumes[self.shape_of_body] * density[self.material_of_body]
 
     def contact_friction(self) -> np.ndarray:
-        """Friction coefficient of each contact row (the smaller of the two materials')."""
-        return pair_friction(self.contacts, [m.friction_coefficient for m in self.materials],
+        """Friction coefficient of each contact row, as the run gave it (the pair's
+        ``[[friction]]`` entry, else the smaller of the two materials')."""
+        return pair_friction(self.contacts, friction_table(self.materials, self.friction_pairs),
                              self.material_of_body, self.wall_materials)
 
 
@@ -232,4 +238,5 @@ def state_from_simulation(sim, layer: LayerDescription, *, source: str = "simula
         wall_normals=np.array([w.normal for w in walls], dtype=float).reshape(-1, 3),
         wall_materials=np.array([material_index[w.material] for w in walls], dtype=np.int64),
         contacts=solver.contacts, gravity=np.asarray(solver.gravity, dtype=float).copy(),
-        time=float(solver.time), layer=layer, source=source)
+        time=float(solver.time), layer=layer, source=source,
+        friction_pairs=tuple(solver.friction_pairs))

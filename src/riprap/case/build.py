@@ -23,15 +23,22 @@ from riprap.geometry.meshing import check_body_length
 from riprap.geometry.tetmesh import TetMesh
 from riprap.io.contact_history import ContactHistory, read_contact_history
 from riprap.io.mesh_files import read_mesh
-from riprap.schema import default_of
+from riprap.schema import default_of, format_toml_value
 from riprap.simulation import Simulation
 from riprap.solid import walls as wall_builders
-from riprap.solid.materials import Material
+from riprap.solid.materials import FrictionPair, Material, pair_naming
 
 
 def build_material(spec) -> Material:
     """The :class:`Material` of a ``[[materials]]`` entry."""
     return Material(**keywords_for(Material, spec))
+
+
+def build_friction_pairs(case) -> tuple[FrictionPair, ...]:
+    """The :class:`FrictionPair` of each ``[[friction]]`` entry of ``case`` (a pack's first)."""
+    return tuple(FrictionPair(materials=spec.materials,
+                              friction_coefficient=spec.friction_coefficient)
+                 for spec in case.friction)
 
 
 def build_shape(spec) -> TetMesh:
@@ -93,6 +100,8 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
     sim.run_definition = RunDefinition.of(case)
     for m in case.materials:
         sim.add_material(build_material(m))
+    for pair in build_friction_pairs(case):
+        sim.add_friction_pair(pair)
     radii = {}
     for spec in case.shapes:
         try:
@@ -157,6 +166,14 @@ class _BodyPlacer:
     def _elastic_material(self, name: str):
         if name not in self._materials:
             spec = self.spec
+            pair = pair_naming(self.case.friction, name)
+            if pair is not None:
+                raise RiprapError(
+                    f"{self.case.source}: [[friction]] materials = "
+                    f"{format_toml_value(list(pair.materials))}: names '{name}', the material of "
+                    "a deformable body ([deformable] bodies); a [[friction]] pair reaches the "
+                    "rigid contacts only (a deformable body's contact takes the smaller of the two "
+                    "coefficients): remove the entry or keep those bodies rigid")
             source = next(m for m in self.case.materials if m.name == name)
             self._materials[name] = ElasticMaterial(
                 name=name, density=source.density, friction_coefficient=source.friction_coefficient,

@@ -26,9 +26,9 @@ from riprap.case.cross_rules import check_cross_rules
 # The specs are generated from the schema in riprap.case.specs; named here too, where the loaded
 # case's parts have always been imported from.
 from riprap.case.specs import (ArmourSpec, BodyGridSpec, BodySpec, Case, DeformableSpec,
-                               FluidSpec, GaugeSpec, MaterialSpec, OutputSettings, PlacementSpec,
-                               PorousZoneSpec, RegionSpec, SeriesSpec, SeriesStepSpec,
-                               ShapeSpec, SimulationSettings,
+                               FluidSpec, FrictionSpec, GaugeSpec, MaterialSpec,
+                               OutputSettings, PlacementSpec, PorousZoneSpec, RegionSpec,
+                               SeriesSpec, SeriesStepSpec, ShapeSpec, SimulationSettings,
                                SlopeSpec, UnderlayerSpec, WallSpec, WavesSpec)
 from riprap.errors import CaseFileError
 from riprap.io.case_text import PACK_HEADER, read_case_text
@@ -452,11 +452,13 @@ class _Validator:
             if len(set(value)) != len(value):
                 return _INVALID, "a body listed twice"
             return tuple(value), ""
-        if kind == "string_list":
+        if kind in ("string_list", "name_pair"):
             if not isinstance(value, list):
                 return _INVALID, _type_name(value)
             if not value:
                 return _INVALID, "an empty list"
+            if kind == "name_pair" and len(value) != 2:
+                return _INVALID, f"a list of {len(value)} name{'' if len(value) == 1 else 's'}"
             for number, item in enumerate(value):
                 if not isinstance(item, str) or not item.strip():
                     return _INVALID, f"{_type_name(item)} at item {number}"
@@ -695,14 +697,14 @@ class _Validator:
                 else:
                     first_use[value] = number
 
-    def _check_references(self, tables: dict) -> None:
+    def _check_references(self, tables: dict, *, deferred: tuple = ()) -> None:
+        """Names that refer to nothing; those of the tables ``deferred`` (which may name a
+        pack's entries) are checked once the pack is joined (:meth:`_check_friction_of_pack`)."""
         for entry in schema.KEYS:
-            if entry.references is None:
+            if entry.references is None or entry.table in deferred:
                 continue
             defined = [values["name"] for values in tables[entry.references]
                        if values is not None and values.get("name", _INVALID) is not _INVALID]
-            listing = ", ".join(format_toml_value(name) for name in dict.fromkeys(defined))
-            listing = listing or "none"
             table_values = tables[entry.table]
             if schema.table(entry.table).is_array:
                 located = [((entry.table, number, entry.name), values)
@@ -718,12 +720,47 @@ class _Validator:
                     if name in defined:
                         continue
                     item_path = path + (item_number,) if isinstance(value, tuple) else path
-                    self._problems.add(
-                        item_path,
-                        f"no [[{entry.references}]] entry has this name; "
-                        f"{_suggestion(name, defined)}defined names: {listing}",
-                        name,
-                    )
+                    self._add_unknown_name(item_path, name, entry.references, defined)
+
+    def _add_unknown_name(self, path: tuple, name: str, references: str, defined: list) -> None:
+        listing = ", ".join(format_toml_value(known) for known in dict.fromkeys(defined)) or "none"
+        self._problems.add(path, f"no [[{references}]] entry has this name; "
+                                 f"{_suggestion(name, defined)}defined names: {listing}", name)
+
+    def _check_friction_pairs(self, entries: list) -> None:
+        """Each pair of materials once in [[friction]], in either order."""
+        first: dict = {}
+        for number, values in enumerate(entries):
+            names = None if values is None else values.get("materials", _INVALID)
+            if names is None or names is _INVALID:
+                continue
+            pair = tuple(sorted(names))
+            if pair in first:
+                earlier = first[pair]
+                line = self._problems.line_of(("friction", earlier, "materials"))
+                self._problems.add(("friction", number, "materials"),
+                                   f"the pair {pair[0]}-{pair[1]} is listed twice; friction[{earlier}] "
+                                   f"(line {line}) already gives it; list each pair once", names)
+            else:
+                first[pair] = number
+
+    def _check_friction_of_pack(self, own: tuple, case: Case, pack_path) -> None:
+        """This file's [[friction]] pairs beside an included pack's: each name one of the
+        materials of the two, and no pair the pack gives already."""
+        defined = [material.name for material in case.materials]
+        pack_pairs = {tuple(sorted(spec.materials)): spec
+                      for spec in case.friction[:len(case.friction) - len(own)]}
+        for number, spec in enumerate(own):
+            path = ("friction", number, "materials")
+            for item_number, name in enumerate(spec.materials):
+                if name not in defined:
+                    self._add_unknown_name(path + (item_number,), name, "materials", defined)
+            pair = tuple(sorted(spec.materials))
+            if pair in pack_pairs:
+                self._problems.add(path, f"the pack {pack_path} gives the pair {pair[0]}-{pair[1]} "
+                                   f"already (friction_coefficient = "
+                                   f"{pack_pairs[pair].friction_coefficient:g}); a pack keeps its "
+                                   "pairs: remove this entry", spec.materials)
 
     def _check_body_count(self, tables: dict, top: dict | None = None) -> None:
         total, named = len(tables["bodies"]), False
@@ -762,7 +799,9 @@ class _Validator:
                 tables[part.name] = (self._array(part, data) if part.is_array
                                      else self._single(part, data))
         self._check_unique(tables)
-        self._check_references(tables)
+        pack_given = bool(top) and top.get("pack") not in (None, "", _INVALID)
+        self._check_references(tables, deferred=("friction",) if pack_given else ())
+        self._check_friction_pairs(tables["friction"])
         self._check_body_count(tables, top)
         check_cross_rules(tables, self._problems.add, _INVALID)
         if self._problems:
@@ -773,6 +812,7 @@ class _Validator:
             base_dir=self._base_dir,
             simulation=SimulationSettings(**tables["simulation"]),
             materials=tuple(MaterialSpec(**values) for values in tables["materials"]),
+            friction=tuple(FrictionSpec(**values) for values in tables["friction"]),
             shapes=tuple(_with_parameters(ShapeSpec, "shapes", values)
                          for values in tables["shapes"]),
             bodies=tuple(BodySpec(**values) for values in tables["bodies"]),
@@ -799,7 +839,9 @@ class _Validator:
             series_steps=tuple(SeriesStepSpec(**values) for values in tables["series_steps"]),
         )
         if top.get("pack"):
+            own = case.friction
             case = _with_pack(case, top["pack"])
+            self._check_friction_of_pack(own, case, top["pack"])
         return case
 
 
@@ -809,9 +851,9 @@ _PACKS_BEING_INCLUDED: list[Path] = []
 
 
 def _with_pack(case: Case, pack_path) -> Case:
-    """``case`` with the pack's materials, shapes, bodies and walls first, and its contact history
-    unless the case names one (the history's body and wall numbers are the pack's, which stay
-    first)."""
+    """``case`` with the pack's materials, friction pairs, shapes, bodies and walls first, and its
+    contact history unless the case names one (the history's body and wall numbers are the
+    pack's, which stay first)."""
     import dataclasses
 
     including = Path(case.source).resolve()
@@ -848,6 +890,7 @@ def _with_pack(case: Case, pack_path) -> Case:
                                          contact_history=pack.simulation.contact_history)
     return dataclasses.replace(case, simulation=simulation,
                                materials=pack.materials + case.materials,
+                               friction=pack.friction + case.friction,
                                shapes=pack.shapes + case.shapes, bodies=pack.bodies + case.bodies,
                                body_grids=pack.body_grids + case.body_grids,
                                walls=pack.walls + case.walls)

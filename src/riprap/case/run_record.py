@@ -33,6 +33,9 @@ RESTART_MAY_CHANGE = (("simulation", "end_time"), ("simulation", "output_interva
 
 # Fields of Case that are not keys of the case file.
 _NOT_KEYS = ("format_version", "source", "base_dir")
+# Tables recorded only when the case has entries, so that a checkpoint written before they
+# existed restarts (its record has no count of them).
+_RECORDED_WHEN_GIVEN = ("friction",)
 # Above this many entries, a [[table]] keeps one fingerprint per entry.
 _LISTED_ENTRIES = 100
 
@@ -89,6 +92,8 @@ def case_record(case) -> dict[str, str]:
         if value is None:
             continue
         if isinstance(value, tuple):
+            if not value and table in _RECORDED_WHEN_GIVEN:
+                continue
             entries = [_entry_fields(_plain(item)) for item in value]
             record[f"[[{table}]] count"] = _text(len(entries))
             for number, fields in enumerate(entries, start=1):

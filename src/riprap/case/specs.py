@@ -17,6 +17,7 @@ __all__ = [
     "Case",
     "SimulationSettings",
     "MaterialSpec",
+    "FrictionSpec",
     "ShapeSpec",
     "BodySpec",
     "BodyGridSpec",
@@ -51,6 +52,7 @@ _TYPES = {
     "quaternion": tuple[float, float, float, float],
     "direction": Vector,
     "string_list": tuple[str, ...],
+    "name_pair": tuple[str, str],
     "body_selection": object,       # "all" or a tuple of body indices
     "path": Path | str,
     "polygon_xz": tuple,
@@ -125,6 +127,7 @@ def _cracks(self, index: int) -> bool:
 
 SimulationSettings = spec_class("SimulationSettings", "simulation")
 MaterialSpec = spec_class("MaterialSpec", "materials")
+FrictionSpec = spec_class("FrictionSpec", "friction")
 ShapeSpec = spec_class("ShapeSpec", "shapes")
 BodySpec = spec_class("BodySpec", "bodies")
 BodyGridSpec = spec_class("BodyGridSpec", "body_grids",
@@ -169,6 +172,7 @@ class Case:
     simulation: SimulationSettings
     materials: tuple[MaterialSpec, ...]
     shapes: tuple[ShapeSpec, ...]
+    friction: tuple[FrictionSpec, ...] = ()
     bodies: tuple[BodySpec, ...] = ()
     body_grids: tuple[BodyGridSpec, ...] = ()
     walls: tuple[WallSpec, ...] = ()

@@ -3,8 +3,8 @@
 A pack is a folder::
 
     pack/
-      pack.toml          format_version = 1 case file: [simulation], [[materials]], [[shapes]],
-                         [[bodies]], [[walls]], [output]
+      pack.toml          format_version = 1 case file: [simulation], [[materials]], [[friction]],
+                         [[shapes]], [[bodies]], [[walls]], [output]
       shapes/<name>.vtu  one tetrahedral mesh per shape (meshio, float64 coordinates)
 
 so ``riprap run pack/pack.toml`` starts a run from it, and ``riprap.case.load.load_case`` reads
@@ -184,9 +184,15 @@ def _file_stems(names) -> dict[str, str]:
 
 
 def _check_references(shapes: Mapping, materials: Sequence, bodies: Sequence,
-                      walls: Sequence) -> None:
+                      walls: Sequence, friction_pairs: Sequence = ()) -> None:
     problems = []
     material_names = [material.name for material in materials]
+    for number, pair in enumerate(friction_pairs):
+        for name in pair.materials:
+            if name not in material_names:
+                problems.append(f"friction_pairs[{number}] names material '{name}': no such "
+                                f"material; {_suggestion(name, material_names)}materials: "
+                                f"{', '.join(material_names)}")
     duplicates = sorted({name for name in material_names if material_names.count(name) > 1})
     if duplicates:
         problems.append(f"materials: names used twice: {', '.join(duplicates)}")
@@ -269,7 +275,7 @@ def _write_atomically(path: Path, text: str) -> None:
 def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
                materials: Sequence, bodies: Sequence[PackBody], walls: Sequence = (),
                simulation: Mapping | None = None, output: Mapping | None = None,
-               comment: str = "", contact_history=None) -> Path:
+               comment: str = "", contact_history=None, friction_pairs: Sequence = ()) -> Path:
     """Save bodies, their shapes and materials, and plane walls as a pack folder.
 
     Parameters
@@ -299,6 +305,9 @@ def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
         The contacts the bodies rest in (spring state and overlap depths); written as
         ``contact_history.csv`` and named by ``[simulation] contact_history``, so that a run from
         the pack starts from them (:mod:`riprap.io.contact_history`).
+    friction_pairs : sequence of riprap.solid.materials.FrictionPair
+        Friction coefficients of named pairs of materials, written as ``[[friction]]`` entries
+        so that a run from the pack keeps them.
 
     Returns
     -------
@@ -317,7 +326,8 @@ def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
     materials = list(materials)
     bodies = list(bodies)
     walls = list(walls)
-    _check_references(shapes, materials, bodies, walls)
+    friction_pairs = list(friction_pairs)
+    _check_references(shapes, materials, bodies, walls, friction_pairs)
     simulation_values = _table_keys("simulation", simulation, DEFAULT_PACK_SIMULATION)
     output_values = _table_keys("output", output, DEFAULT_PACK_OUTPUT)
 
@@ -332,6 +342,9 @@ def write_pack(directory: str | os.PathLike, *, shapes: Mapping[str, TetMesh],
     lines += _key_lines(simulation_values)
     for material in materials:
         lines += ["", "[[materials]]"] + _key_lines(_material_values(material))
+    for pair in friction_pairs:
+        lines += ["", "[[friction]]"] + _key_lines({
+            "materials": list(pair.materials), "friction_coefficient": pair.friction_coefficient})
     for name, mesh in shapes.items():
         relative = f"{SHAPES_FOLDER}/{stems[name]}.vtu"
         write_volume_mesh(folder / relative, mesh)

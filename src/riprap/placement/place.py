@@ -50,12 +50,14 @@ UNIT_SHAPE_NAME = "armour_unit"
 
 @dataclass(frozen=True)
 class PlacementMaterials:
-    """Contact materials of the four kinds of surfaces."""
+    """Contact materials of the four kinds of surfaces, and the friction coefficients of named
+    pairs of them (``[[friction]]``: unit on rock, unit on the glass side walls, ...)."""
 
     unit: Material
     rock: Material
     face: Material          # the slope face and the bed (the core's surface)
     side_wall: Material
+    friction_pairs: tuple = ()      # riprap.solid.materials.FrictionPair
 
     def all(self) -> list[Material]:
         """Each material once (two roles may share one)."""
@@ -63,6 +65,22 @@ class PlacementMaterials:
         for m in (self.unit, self.rock, self.face, self.side_wall):
             unique.setdefault(m.name, m)
         return list(unique.values())
+
+    def add_to(self, sim: Simulation) -> None:
+        """Add every material and friction pair to a placement run."""
+        for m in self.all():
+            sim.add_material(m)
+        for pair in self.friction_pairs:
+            sim.add_friction_pair(pair)
+
+    def in_contact(self) -> list[tuple[str, str]]:
+        """The pairs of materials that meet in the placement runs: rocks settling on the face,
+        between the side walls and on each other, then units on the rocks, the face, the side
+        walls and each other."""
+        pairs = []
+        for moving in (self.rock, self.unit):
+            pairs += [(moving.name, other.name) for other in (self.rock, self.face, self.side_wall)]
+        return pairs + [(self.unit.name, self.unit.name)]
 
 
 @dataclass
@@ -118,8 +136,7 @@ def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range,
     probability /= probability.sum()
     points = rock_lattice(slope, shapes, s_range, layers)
     sim = Simulation(**_run_settings(run))
-    for m in materials.all():
-        sim.add_material(m)
+    materials.add_to(sim)
     for s in shapes:
         sim.add_shape(s.name, s)
     sim.add_walls(slope.walls(face_material=materials.face.name,
@@ -187,8 +204,7 @@ def free_body_time_step(shapes, materials: PlacementMaterials, material: str,
     held fixed do not count), found without running, for the work estimate before the runs;
     with a function naming the shape that sets it."""
     sim = Simulation(**_run_settings(run))
-    for m in materials.all():
-        sim.add_material(m)
+    materials.add_to(sim)
     for k, shape in enumerate(shapes):
         sim.add_shape(shape.name, shape)
         # far apart: only the masses and stiffness count, not where the bodies are
@@ -441,8 +457,7 @@ def _combined_runs(results: list[dict]) -> dict:
 def _placement_simulation(slope, unit_shape, underlayer, state, members, materials,
                           run) -> Simulation:
     sim = Simulation(**_run_settings(run))
-    for m in materials.all():
-        sim.add_material(m)
+    materials.add_to(sim)
     for s in underlayer.shapes:
         sim.add_shape(s.name, s)
     sim.add_shape(unit_shape.name, unit_shape)

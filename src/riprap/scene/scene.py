@@ -19,7 +19,7 @@ from riprap.geometry.tetmesh import TetMesh
 from riprap.io.contact_history import ContactHistory
 from riprap.schema import default_of
 from riprap.solid.kernels.pair_rule import pair_friction
-from riprap.solid.materials import Material
+from riprap.solid.materials import FrictionPair, Material, pair_naming
 from riprap.solid.shape import RigidShape
 from riprap.solid.solver import SolidSolver
 from riprap.solid.walls import Wall
@@ -89,6 +89,13 @@ class Scene:
     # ------------------------------------------------------------------ building
     def add_material(self, material: Material) -> None:
         self.solver.add_material(material)
+
+    def add_friction_pair(self, pair: FrictionPair) -> None:
+        """Give the contacts of two named materials their own friction coefficient (a
+        :class:`riprap.solid.materials.FrictionPair`) instead of the smaller of the two; rigid
+        bodies and walls only (:meth:`deformable_system` refuses a pair naming a deformable
+        body's material)."""
+        self.solver.add_friction_pair(pair)
 
     def add_shape(self, name: str, mesh: TetMesh | RigidShape) -> None:
         """Add a shape by name: a tetrahedral mesh, or a prepared :class:`RigidShape` (whose frame
@@ -191,6 +198,13 @@ class Scene:
         already) as surfaces they touch, its walls, and ``extra_walls`` not already among them
         (with the deformable bodies' smallest friction coefficient)."""
         solver = self.solver
+        for body in self.deformable_bodies:
+            pair = pair_naming(solver.friction_pairs, body.material.name)
+            if pair is not None:
+                raise CaseFileError(f"friction pair {pair.materials[0]}-{pair.materials[1]} names "
+                                    f"'{body.material.name}', the material of deformable body "
+                                    f"'{body.name}': pairs reach the rigid contacts only (a "
+                                    "deformable body's contact takes the smaller of the two)")
         rigid_surfaces = []
         for b in range(solver.n_bodies):
             shape = solver.shapes[int(solver.shape_index[b])]

@@ -12,8 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from riprap.solid.kernels.pair_rule import pair_friction as pair_friction_rule
-
 
 @dataclass(frozen=True)
 class UnitContacts:
@@ -58,11 +56,12 @@ def unit_contacts(n_bodies: int, contacts, group=None) -> UnitContacts:
                         total_contact_force=total)
 
 
-def pair_friction(contacts, friction_of_material, material_of_body, material_of_wall) -> np.ndarray:
-    """Friction coefficient of each contact row: the smaller of the two materials' (the solver's
-    rule for a pair). ``friction_of_material`` (n_materials,), ``material_of_body`` (n_bodies,),
-    ``material_of_wall`` (n_walls,) material indices."""
-    mu = np.asarray(friction_of_material, dtype=float)
+def pair_friction(contacts, friction_table, material_of_body, material_of_wall) -> np.ndarray:
+    """Friction coefficient of each contact row, as the solver gives it: ``friction_table``
+    (n_materials, n_materials) of :func:`riprap.solid.materials.friction_table` (a
+    ``[[friction]]`` pair's own, else the smaller of the two materials'); ``material_of_body``
+    (n_bodies,), ``material_of_wall`` (n_walls,) material indices."""
+    table = np.asarray(friction_table, dtype=float)
     material_of_body = np.asarray(material_of_body, dtype=np.int64)
     material_of_wall = np.asarray(material_of_wall, dtype=np.int64)
     body_i = np.asarray(contacts.body_i, dtype=np.int64)
@@ -71,7 +70,7 @@ def pair_friction(contacts, friction_of_material, material_of_body, material_of_
     walls = np.where(is_wall, -1 - body_j, 0)
     other = np.where(is_wall, material_of_wall[walls] if len(material_of_wall) else 0,
                      material_of_body[np.maximum(body_j, 0)])
-    return pair_friction_rule.py_func(mu[material_of_body[body_i]], mu[other])
+    return table[material_of_body[body_i], other]
 
 
 def sliding_factor_of_safety(n_bodies: int, contacts, friction_coefficient) -> np.ndarray:
@@ -106,8 +105,8 @@ def solver_contact_statistics(solver) -> dict:
     ``bodies.pvd`` records them, dry or in water."""
     contacts = solver.contacts
     stats = unit_contacts(solver.n_bodies, contacts)
-    friction = pair_friction(contacts, [m.friction_coefficient for m in solver.materials],
-                             solver.material_index_of_body, solver.wall_materials)
+    friction = pair_friction(contacts, solver.friction_table, solver.material_index_of_body,
+                             solver.wall_materials)
     return {"coordination_number": stats.coordination_number,
             "max_contact_force": stats.max_contact_force,
             "factor_of_safety_sliding": sliding_factor_of_safety(solver.n_bodies, contacts,

@@ -10,7 +10,7 @@ import numpy as np
 from scipy import optimize
 
 from riprap.errors import CaseFileError
-from riprap.schema import default_of
+from riprap.schema import default_of, key as schema_key
 from riprap.solid.kernels import pair_rule
 
 
@@ -120,20 +120,128 @@ def damping_ratio_for_restitution(restitution: float) -> float:
     return 0.5 * (low + high)
 
 
-def pair_tables(materials) -> dict[str, np.ndarray]:
+#: Where a pair's friction coefficient came from (:func:`friction_by_pair`).
+FROM_FRICTION_TABLE = "[[friction]] table"
+FROM_PAIR_RULE = "smaller-of-two rule"
+#: The case file's key of a pair's coefficient: its range is checked here too.
+_PAIR_COEFFICIENT = schema_key("friction", "friction_coefficient")
+
+
+@dataclass(frozen=True)
+class FrictionPair:
+    """The Coulomb friction coefficient of contacts between two named materials (a case's
+    ``[[friction]]`` entry), in place of the pair rule's smaller of the two materials' own
+    coefficients: concrete on concrete, on quarry rock and on glass differ. The two names may be
+    the same (a material on itself); the order does not matter.
+
+    Parameters
+    ----------
+    materials : (str, str)
+        Names of the two materials (walls have materials too).
+    friction_coefficient : float
+        Coulomb friction coefficient (-) of their contacts, in [0, 2] (tan 63 degrees; the
+        case file's range).
+    """
+
+    materials: tuple
+    friction_coefficient: float
+
+    def __post_init__(self):
+        names = tuple(self.materials) if isinstance(self.materials, (list, tuple)) else ()
+        if len(names) != 2 or not all(isinstance(name, str) and name for name in names):
+            raise CaseFileError(f"friction pair {self.materials!r}: materials must be exactly two "
+                                "material names")
+        object.__setattr__(self, "materials", names)
+        if not _PAIR_COEFFICIENT.allows(self.friction_coefficient):
+            raise CaseFileError(f"friction pair {names[0]}-{names[1]}: friction_coefficient = "
+                                f"{self.friction_coefficient!r} must be "
+                                f"{_PAIR_COEFFICIENT.stated_range()}")
+
+    @property
+    def key(self) -> tuple[str, str]:
+        """The two names in alphabetical order: the same for (a, b) and (b, a)."""
+        return tuple(sorted(self.materials))
+
+
+def check_friction_pairs(materials, friction_pairs) -> None:
+    """Refuse a pair that names a material not among ``materials``, or a pair listed twice."""
+    names = [m.name for m in materials]
+    seen = {}
+    for number, pair in enumerate(friction_pairs):
+        for name in pair.materials:
+            if name not in names:
+                raise CaseFileError(f"friction pair {pair.materials[0]}-{pair.materials[1]} names "
+                                    f"material '{name}', which is not defined (materials: "
+                                    f"{', '.join(names) or 'none'})")
+        if pair.key in seen:
+            raise CaseFileError(f"friction pair {pair.key[0]}-{pair.key[1]} given twice (pairs "
+                                f"{seen[pair.key]} and {number}); give each pair once")
+        seen[pair.key] = number
+
+
+def pair_naming(friction_pairs, name: str):
+    """The first of ``friction_pairs`` that names the material ``name``, or None."""
+    return next((pair for pair in friction_pairs if name in pair.materials), None)
+
+
+def friction_table(materials, friction_pairs=()) -> np.ndarray:
+    """(n, n) Coulomb friction coefficient of contacts between materials i and j: the pair's
+    ``friction_pairs`` entry (:class:`FrictionPair`) where there is one, else the pair rule
+    (``solid/kernels/pair_rule.py``: the smaller of the two)."""
+    check_friction_pairs(materials, friction_pairs)
+    mu = np.array([m.friction_coefficient for m in materials], dtype=float)
+    table = pair_rule.pair_friction.py_func(mu[:, None], mu[None, :])
+    index = {m.name: k for k, m in enumerate(materials)}
+    for pair in friction_pairs:
+        i, j = (index[name] for name in pair.materials)
+        table[i, j] = table[j, i] = pair.friction_coefficient
+    return table
+
+
+@dataclass(frozen=True)
+class PairFriction:
+    """The friction coefficient a pair of materials in contact gets, and where it came from:
+    :data:`FROM_FRICTION_TABLE`, or :data:`FROM_PAIR_RULE` with the two coefficients."""
+
+    materials: tuple
+    friction_coefficient: float
+    source: str
+
+
+def friction_by_pair(materials, friction_pairs, pairs) -> list[PairFriction]:
+    """The friction of each pair of material names in ``pairs`` (each unordered pair once, in
+    the order first met)."""
+    table = friction_table(materials, friction_pairs)
+    index = {m.name: k for k, m in enumerate(materials)}
+    listed = {pair.key for pair in friction_pairs}
+    out = {}
+    for a, b in pairs:
+        key = tuple(sorted((a, b)))
+        if key in out:
+            continue
+        source = FROM_FRICTION_TABLE
+        if key not in listed:
+            own = ", ".join(f"{name} {materials[index[name]].friction_coefficient:g}"
+                            for name in dict.fromkeys(key))
+            source = f"{FROM_PAIR_RULE}: {own}"
+        out[key] = PairFriction(key, float(table[index[a], index[b]]), source)
+    return list(out.values())
+
+
+def pair_tables(materials, friction_pairs=()) -> dict[str, np.ndarray]:
     """Contact parameters of every material pair.
 
     Combination rule (``solid/kernels/pair_rule.py``, printed in the run log): the smaller friction
-    coefficient, the smaller restitution and the smaller penalty of the two (as in Y3D for the
-    penalty); the mean of the tangential stiffness ratios.
+    coefficient (unless ``friction_pairs``, :class:`FrictionPair` entries, give the pair's own),
+    the smaller restitution and the smaller penalty of the two (as in Y3D for the penalty); the
+    mean of the tangential stiffness ratios.
     """
     n = len(materials)
-    tables = {k: np.zeros((n, n)) for k in ("penalty", "friction", "damping_ratio", "tangential_ratio")}
+    tables = {k: np.zeros((n, n)) for k in ("penalty", "damping_ratio", "tangential_ratio")}
+    tables["friction"] = friction_table(materials, friction_pairs)
     for i, a in enumerate(materials):
         for j, b in enumerate(materials):
             tables["penalty"][i, j] = pair_rule.pair_penalty.py_func(a.contact_penalty, b.contact_penalty)
-            tables["friction"][i, j] = pair_rule.pair_friction.py_func(a.friction_coefficient,
-                                                                       b.friction_coefficient)
             restitution = pair_rule.pair_restitution.py_func(a.restitution, b.restitution)
             tables["damping_ratio"][i, j] = damping_ratio_for_restitution(float(restitution))
             tables["tangential_ratio"][i, j] = 0.5 * (a.tangential_stiffness_ratio + b.tangential_stiffness_ratio)

@@ -19,7 +19,7 @@ from riprap.solid.kernels import integrate, interactions, stepper
 from riprap.solid.kernels.bundles import (Bodies, History, Motion, PairLaws, RigidSystem,
                                           StepSettings, Walls)
 from riprap.solid.kernels.geometry_ops import rotation_matrices, rotation_matrix
-from riprap.solid.materials import Material, pair_tables
+from riprap.solid.materials import FrictionPair, Material, friction_table, pair_tables
 from riprap.solid.shape import RigidShape, ShapeTable
 from riprap.solid.walls import Wall
 
@@ -76,6 +76,9 @@ class SolidSolver:
         self.local_damping = float(local_damping)
         self.shapes: list[RigidShape] = []
         self.materials: list[Material] = []
+        #: Friction coefficients of named pairs of materials (``[[friction]]``), in place of the
+        #: pair rule's smaller of the two.
+        self.friction_pairs: list[FrictionPair] = []
         self.walls: list[Wall] = []
         self._body_rows: list[tuple] = []
         self.time = 0.0
@@ -101,6 +104,20 @@ class SolidSolver:
         self.materials.append(material)
         self._ready = False
         return len(self.materials) - 1
+
+    def add_friction_pair(self, pair: FrictionPair) -> None:
+        """Give contacts between ``pair.materials`` their own friction coefficient (the
+        materials may be added before or after; both must exist when the solver is built)."""
+        if any(known.key == pair.key for known in self.friction_pairs):
+            raise CaseFileError(f"friction pair {pair.key[0]}-{pair.key[1]} given twice; give "
+                                "each pair once")
+        self.friction_pairs.append(pair)
+        self._ready = False
+
+    @property
+    def friction_table(self) -> np.ndarray:
+        """(n_materials, n_materials) friction coefficient of each pair of materials in contact."""
+        return friction_table(self.materials, self.friction_pairs)
 
     def material_index(self, name: str) -> int:
         for i, m in enumerate(self.materials):
@@ -249,7 +266,7 @@ class SolidSolver:
         self.table = ShapeTable.build(self.shapes)
         self._shapes = self.table.kernel_arrays()
         self.bounding_radius = self._shapes.lookup.bounding_radius
-        tables = pair_tables(self.materials)
+        tables = pair_tables(self.materials, self.friction_pairs)
         self._pair_laws = PairLaws(tables["penalty"], tables["friction"], tables["damping_ratio"],
                                    tables["tangential_ratio"])
         self.wall_points = np.array([w.point for w in self.walls], dtype=np.float64).reshape(-1, 3)

@@ -8,15 +8,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from riprap.case.build import build_simulation
+from riprap.case.build import build_friction_pairs, build_material, build_simulation
 from riprap.case.build_fluid import build_fluid_run
 from riprap.workflows.series import check_series
 from riprap.case.load import Case
 from riprap.errors import CaseFileError
 from riprap.io.output_folder import check_output_folder
-from riprap.workflows.place import PLACEMENT_NOT_CHECKED, prepare_placement
+from riprap.solid.materials import PairFriction, friction_by_pair
+from riprap.workflows.place import PLACEMENT_NOT_CHECKED, placement_materials, prepare_placement
 
-__all__ = ["CheckReport", "check_case"]
+__all__ = ["CheckReport", "check_case", "friction_in_use"]
 
 
 @dataclass
@@ -27,6 +28,9 @@ class CheckReport:
     description: str
     checked: list[str] = field(default_factory=list)
     not_checked: list[str] = field(default_factory=list)
+    #: The friction coefficient of each pair of materials that can meet, and where it came from
+    #: (riprap.solid.materials.PairFriction).
+    friction: list = field(default_factory=list)
 
 
 def check_case(case: Case, *, output_directory=None, restart=None) -> CheckReport:
@@ -93,7 +97,24 @@ def check_case(case: Case, *, output_directory=None, restart=None) -> CheckRepor
         report.checked.append(f"restart from {restart}: a checkpoint of this case (only what may "
                               "change on a restart has changed)")
     report.checked.append(check_output_folder(out))
+    report.friction = friction_in_use(case)
     return report
+
+
+def friction_in_use(case: Case) -> list[PairFriction]:
+    """The friction coefficient of each pair of materials that can meet in the runs of ``case``
+    (a free body with any body or wall; a placement's rocks and units with what they settle on),
+    from its ``[[friction]]`` entry or the smaller of the two materials' own."""
+    if case.is_placement:
+        materials = placement_materials(case)
+        return friction_by_pair(materials.all(), materials.friction_pairs, materials.in_contact())
+    moving = [b.material for b in case.bodies if not b.fixed] + [g.material for g in case.body_grids]
+    still = [b.material for b in case.bodies if b.fixed] + [w.material for w in case.walls]
+    if case.obstacles and case.body_count:
+        still.append(case.materials[0].name)        # obstacles meet bodies with the first material
+    pairs = [(a, b) for a in dict.fromkeys(moving) for b in dict.fromkeys(moving + still)]
+    return friction_by_pair([build_material(spec) for spec in case.materials],
+                            build_friction_pairs(case), pairs)
 
 
 def _bodies_step(sim) -> str:

@@ -19,7 +19,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from riprap.analysis.layer_state import LayerDescription, LayerState
-from riprap.case.build import build_material, build_shape
+from riprap.case.build import build_friction_pairs, build_material, build_shape
 from riprap.case.load import load_case
 from riprap.errors import CaseFileError
 from riprap.geometry.mass_properties import mass_properties
@@ -101,7 +101,8 @@ def _read_pack(pack_file: Path) -> dict:
     _check_layer_against_case(layer, case, shape_names, pack_file)
     material_names = [m.name for m in materials]
     return {"case": case, "shape_names": shape_names, "meshes": meshes, "centroids": centroids,
-            "materials": materials, "walls": walls, "layer": layer,
+            "materials": materials, "friction_pairs": build_friction_pairs(case),
+            "walls": walls, "layer": layer,
             "shape_of_body": np.array([shape_names.index(b.shape) for b in case.bodies],
                                       dtype=np.int64),
             "material_of_body": np.array([material_names.index(b.material) for b in case.bodies],
@@ -120,7 +121,8 @@ def _layer_state(pack: dict, *, positions, rotations, contacts, time: float, sou
         fixed=np.array([b.fixed for b in case.bodies], dtype=bool),
         wall_points=walls[0], wall_normals=walls[1], wall_materials=walls[2],
         contacts=contacts, gravity=np.asarray(case.simulation.gravity, dtype=float),
-        time=float(time), layer=pack["layer"], source=source, **reference)
+        time=float(time), layer=pack["layer"], source=source,
+        friction_pairs=pack["friction_pairs"], **reference)
 
 
 def load_pack_state(path):

@@ -20,7 +20,7 @@ import numpy as np
 
 from riprap.analysis.layer_state import LayerDescription
 from riprap.case.body_start import check_grid_starts
-from riprap.case.build import SMOKE_END_TIME, build_material, smoke_mode
+from riprap.case.build import SMOKE_END_TIME, build_friction_pairs, build_material, smoke_mode
 from riprap.case.load import parse_case
 from riprap.errors import CaseFileError
 from riprap.geometry.armour_units import armour_unit
@@ -47,6 +47,18 @@ def _material(case, name):
         if spec.name == name:
             return build_material(spec)
     raise CaseFileError(f"{case.source}: no material named {name!r}")
+
+
+def placement_materials(case) -> PlacementMaterials:
+    """The four roles' materials and the ``[[friction]]`` pairs between them (a pair naming a
+    material no role has meets nothing in a placement)."""
+    roles = dict(unit=_material(case, case.armour.material),
+                 rock=_material(case, case.underlayer.material),
+                 face=_material(case, case.slope.face_material),
+                 side_wall=_material(case, case.slope.side_wall_material))
+    names = {material.name for material in roles.values()}
+    return PlacementMaterials(**roles, friction_pairs=tuple(
+        pair for pair in build_friction_pairs(case) if set(pair.materials) <= names))
 
 
 def _require_tables(case) -> None:
@@ -107,10 +119,7 @@ def prepare_placement(case) -> PlacementInputs:
     sl, ul, pl = case.slope, case.underlayer, case.placement
     slope = Slope(cotangent=sl.cotangent, width=sl.width, length=sl.length, toe_x=sl.toe_x,
                   toe_level=sl.toe_level, toe_stop_distance=sl.toe_stop_distance)
-    materials = PlacementMaterials(unit=_material(case, case.armour.material),
-                                   rock=_material(case, ul.material),
-                                   face=_material(case, sl.face_material),
-                                   side_wall=_material(case, sl.side_wall_material))
+    materials = placement_materials(case)
     grid = None
     if pl.grid_file:
         grid = read_grid_file(case.base_dir / pl.grid_file)
@@ -304,7 +313,8 @@ def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
                                   "time_step_safety": case.simulation.time_step_safety,
                                   "gravity": list(case.simulation.gravity)},
                       comment=f"armour layer placed by riprap place from {case.source}",
-                      contact_history=sim.contact_history())
+                      contact_history=sim.contact_history(),
+                      friction_pairs=materials.friction_pairs)
     outputs = {"pack": str(pack), "paraview": str(out / "deposition" / "bodies.pvd"),
                "layer": str(write_layer_file(out, layer)),
                "contacts": str(write_contact_table(out / CONTACTS_FILE_NAME, solver.contacts))}
@@ -339,4 +349,4 @@ def _write_layer_picture(path: Path, sim, slope, *, n_units: int) -> Path:
     return sim.write_picture(path, show_fixed=True, planes=[face], view=_LAYER_VIEW, title=title)
 
 
-__all__ = ["run_placement", "prepare_placement", "write_checked_pack"]
+__all__ = ["run_placement", "prepare_placement", "placement_materials", "write_checked_pack"]

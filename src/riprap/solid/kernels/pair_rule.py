@@ -3,7 +3,10 @@ contact tables (``solid/materials.py`` ``pair_tables``), the deformable contact 
 analysis of a layer's contacts.
 
 A pair takes the smaller friction coefficient, the smaller restitution and the smaller contact
-penalty of its two materials (the penalty as in Y3D): the weaker material governs. Each rule is
+penalty of its two materials (the penalty as in Y3D): the weaker material governs. A case's
+``[[friction]]`` table gives named pairs their own friction coefficient instead
+(``solid/materials.py`` ``friction_table``, which the rigid pair tables and the layer analysis
+read; the deformable contact takes this rule and refuses pairs naming its materials). Each rule is
 written with ``np.minimum`` so that the same function serves compiled kernels (inlined, on
 scalars) and Python (``.py_func``, on scalars or arrays of materials).
 """
@@ -12,8 +15,9 @@ import numpy as np
 from riprap._jit import inline_kernel
 
 #: The rule in words, for logs and messages.
-PAIR_RULE_TEXT = ("contact pairs combine materials by the smaller friction coefficient, the "
-                  "smaller restitution and the smaller contact_penalty")
+PAIR_RULE_TEXT = ("contact pairs combine materials by the smaller friction coefficient (unless "
+                  "[[friction]] gives the pair's), the smaller restitution and the smaller "
+                  "contact_penalty")
 
 
 @inline_kernel
