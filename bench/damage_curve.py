@@ -214,12 +214,18 @@ def main() -> None:
     results = run_series(load_case(out / "series.toml"), output_directory=out / "series",
                          progress=False)
     curve = results["curve"]
-    print("step  Hm0_m  N_s    waves  displaced  N_od    S      VdM_cubes_N_od  q_m3/s/m  EurOtop_q")
+    print("step  Hm0_m  N_s    waves  displaced  N_od    S      VdM_cubes_N_od  q_m3/s/m  EurOtop_q"
+          "  C_r")
     for k in range(len(curve["step"])):
         print(f"{curve['step'][k]:4d}  {curve['Hm0_m'][k]:.3f}  {curve['stability_number'][k]:.2f}  "
               f"{curve['waves'][k]:5d}  {curve['units_displaced'][k]:9d}  {curve['N_od'][k]:.3f}  "
               f"{curve['S'][k]:.3f}  {curve['van_der_meer_cubes_N_od'][k]:.3f}           "
-              f"{curve['q_m3_s_m'][k]:.2e}  {curve['eurotop_q_m3_s_m'][k]:.2e}")
+              f"{curve['q_m3_s_m'][k]:.2e}  {curve['eurotop_q_m3_s_m'][k]:.2e}   "
+              f"{curve['eurotop_crest_width_factor'][k]:.3f}")
+    formulas = results["formulas"]
+    if formulas.get("crest_width_m") is not None:
+        print(f"EurOtop_q includes C_r (EurOtop 2018 eq. 6.8), G_c = "
+              f"{formulas['crest_width_m']:.3f} m ({formulas['crest_width_source']})")
     first = results["first_displacement"]
     print("first displacement: " + (f"step {first['step']}, N_s = {first['stability_number']:.2f}"
                                      if first else "none")

@@ -114,6 +114,28 @@ def test_bad_flumes_are_refused_naming_the_file(change, message):
         build_fluid_run(_case(**change), progress=False)
 
 
+@pytest.mark.parametrize("value, message", [
+    ("-0.3", "flume.toml:41: gauges\\[4\\].crest_width = -0.3: out of range; expected a number "
+             "in m, >= 0"),
+    ("3e6", "gauges\\[4\\].crest_width = 3e\\+06: far outside any physical value"),
+    ('"wide"', "gauges\\[4\\].crest_width = \"wide\": expected a number in m"),
+])
+def test_a_bad_crest_width_is_refused_naming_the_line_and_key(value, message):
+    text = CASE.format(end_time=0.4, length=5.6, cells=280, kind="linear", extra="", gauge_x=1.8,
+                       above_z=0.42).replace('name = "above"\n',
+                                             f'name = "above"\ncrest_width = {value}\n')
+    with pytest.raises(CaseFileError, match=message):
+        parse_case(text, source="flume.toml")
+
+
+def test_a_crest_width_is_only_for_an_overtopping_gauge():
+    text = CASE.format(end_time=0.4, length=5.6, cells=280, kind="linear", extra="", gauge_x=1.8,
+                       above_z=0.42).replace('name = "a"\n', 'name = "a"\ncrest_width = 0.3\n')
+    with pytest.raises(CaseFileError, match="'crest_width' is a key of \\[\\[gauges\\]\\] with "
+                                            'type = "overtopping", not "surface"'):
+        parse_case(text, source="flume.toml")
+
+
 def test_waves_without_a_fluid_are_refused_at_the_line():
     text = """format_version = 1
 [simulation]

@@ -15,7 +15,10 @@ overtopping q. Beside them, per step:
 - EurOtop's (2018, eq. 5.18, mean value approach) mean overtopping discharge for the section,
   q / sqrt(g Hm0^3) = 0.09 exp(-(1.5 Rc / (Hm0 gamma_f))^1.3), with the roughness factor
   gamma_f of the unit (EurOtop 2018 table 6.2) and Rc the crest freeboard (the overtopping
-  gauge's level above still water); no crest-width reduction.
+  gauge's level above still water), times the crest-width factor C_r = 3.06 exp(-1.5 G_c / Hm0),
+  at most 1 (EurOtop 2018, section 6.3.3, eq. 6.8), G_c the width of the crest in front of the
+  overtopping gauge: the water that sinks into a wide permeable crest does not reach its rear
+  edge, where q is measured. Without a crest width C_r = 1, and the results say so.
 
 The first displacement: the lowest step's N_s at which a unit moved more than the threshold,
 against the formula's start of damage (Hudson's N_s; for cubes N_od = 0.2 by Van der Meer, and
@@ -29,8 +32,10 @@ from scipy.optimize import brentq
 
 from riprap.analysis.design_formulas import hudson_stability_number, van_der_meer_cubes_damage
 from riprap.analysis.stability_report import HUDSON_TRUNK_STABILITY
+from riprap.errors import CaseFileError
 
-__all__ = ["series_curve", "cumulative_damage", "eurotop_mean_overtopping", "ROUGHNESS_FACTORS",
+__all__ = ["series_curve", "cumulative_damage", "eurotop_mean_overtopping",
+           "eurotop_crest_width_factor", "ROUGHNESS_FACTORS",
            "SINGLE_LAYER_CUBES_START", "SINGLE_LAYER_CUBES_FAILURE"]
 
 GRAVITY = 9.81
@@ -71,17 +76,39 @@ def eurotop_mean_overtopping(hm0: float, freeboard: float, roughness: float) -> 
     return 0.09 * math.exp(-(1.5 * relative) ** 1.3) * math.sqrt(GRAVITY * hm0 ** 3)
 
 
+def eurotop_crest_width_factor(crest_width: float | None, hm0: float) -> float:
+    """C_r = min(1, 3.06 exp(-1.5 G_c / Hm0)) (-): EurOtop (2018) section 6.3.3, eq. 6.8, the
+    reduction of the mean overtopping discharge behind a crest of width G_c = ``crest_width``
+    (m) for waves of ``hm0`` (m) at the toe. 1 without a crest width (None); NaN without a wave
+    height.
+
+    >>> round(eurotop_crest_width_factor(1.0, 1.0), 3)
+    0.683
+    """
+    if crest_width is None:
+        return 1.0
+    if not (math.isfinite(crest_width) and crest_width >= 0):
+        raise CaseFileError(f"EurOtop crest-width factor: crest_width must be a length >= 0 m, "
+                            f"got {crest_width!r}")
+    if not (math.isfinite(hm0) and hm0 > 0):
+        return math.nan
+    return min(1.0, 3.06 * math.exp(-1.5 * crest_width / hm0))
+
+
 def series_curve(steps: list[dict], *, unit_kind: str, nominal_diameter: float, delta: float,
-                 slope_cot: float, freeboard: float | None) -> dict:
+                 slope_cot: float, freeboard: float | None, crest_width: float | None = None,
+                 crest_width_source: str | None = None) -> dict:
     """The damage curve of a series: ``steps`` one dict per step with ``step``, ``Hm0_m``
     (incident at the toe, NaN when not measured), ``Tm_s`` (the mean period), ``waves`` (waves
     run), ``units_displaced``, ``N_od``, ``S``, ``rocking_events``, ``q_m3_s_m``; returns
     ``{"curve": columns, "first_displacement": ..., "formulas": ...}``. ``delta``: the relative
-    density rho_armour / rho_water - 1; ``freeboard``: the crest's height above still water (m)."""
+    density rho_armour / rho_water - 1; ``freeboard``: the crest's height above still water (m);
+    ``crest_width``: G_c (m) of EurOtop's crest-width factor (None: C_r = 1), found as
+    ``crest_width_source`` says (for the results)."""
     curve = {name: [] for name in (
         "step", "Hm0_m", "Tm_s", "waves", "cumulative_waves", "stability_number",
         "units_displaced", "N_od", "S", "rocking_events", "q_m3_s_m", "hudson_stability_number",
-        "van_der_meer_cubes_N_od", "eurotop_q_m3_s_m")}
+        "van_der_meer_cubes_N_od", "eurotop_crest_width_factor", "eurotop_q_m3_s_m")}
     coefficient = HUDSON_TRUNK_STABILITY.get(unit_kind)
     hudson = (hudson_stability_number(coefficient, slope_cot) if coefficient else math.nan)
     cubes = unit_kind in ("cube", "antifer_cube")
@@ -106,9 +133,13 @@ def series_curve(steps: list[dict], *, unit_kind: str, nominal_diameter: float, 
             curve[name].append(step[name])
         curve["hudson_stability_number"].append(hudson)
         curve["van_der_meer_cubes_N_od"].append(formula_nod)
+        factor = eurotop_crest_width_factor(crest_width, hm0)
+        curve["eurotop_crest_width_factor"].append(factor)
         curve["eurotop_q_m3_s_m"].append(
-            eurotop_mean_overtopping(hm0, freeboard, roughness)
+            factor * eurotop_mean_overtopping(hm0, freeboard, roughness)
             if freeboard is not None and math.isfinite(hm0) else math.nan)
+    crest_source = ("none: no crest-width factor (C_r = 1)" if crest_width is None
+                    else crest_width_source or "given")
     first = next((k for k, count in enumerate(curve["units_displaced"]) if count > 0), None)
     start = {"hudson_stability_number": hudson if coefficient else None}
     if cubes:
@@ -124,7 +155,10 @@ def series_curve(steps: list[dict], *, unit_kind: str, nominal_diameter: float, 
                      "slope_cot": slope_cot, "unit": unit_kind, "start_of_damage": start,
                      "roughness_factor": roughness if math.isfinite(roughness) else None,
                      "freeboard_m": freeboard,
+                     "crest_width_m": crest_width,
+                     "crest_width_source": crest_source,
                      "sources": "Hudson (1959), CEM VI-5-2; Van der Meer (1988) double-layer "
                                 "cubes with cumulative equivalent waves; Van Gent (2002) single "
-                                "layer cubes; EurOtop (2018) eq. 5.18 and table 6.2"},
+                                "layer cubes; EurOtop (2018) eq. 5.18, table 6.2 and the "
+                                "crest-width factor C_r of eq. 6.8"},
     }

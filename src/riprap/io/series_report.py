@@ -64,8 +64,9 @@ def _overtopping_figure(path: Path, results: dict) -> Path:
     figure, axes = plt.subplots(figsize=(5.5, 4))
     axes.semilogy(curve["Hm0_m"], np.maximum(np.asarray(curve["q_m3_s_m"], float), 1e-12), "o-",
                   label="riprap")
+    reduced = results["formulas"].get("crest_width_m") is not None
     axes.semilogy(curve["Hm0_m"], curve["eurotop_q_m3_s_m"], "s--",
-                  label="EurOtop (2018) eq. 5.18, mean")
+                  label="EurOtop (2018) eq. 5.18, mean" + (" x C_r (eq. 6.8)" if reduced else ""))
     axes.set_xlabel("Hm0 at the toe (m)")
     axes.set_ylabel("q (m^3/s per m)")
     axes.legend(fontsize=8)
@@ -90,6 +91,22 @@ def _table(columns: dict, names: list[str]) -> str:
     rows = "".join("<tr>" + "".join(f"<td>{_cell(columns[name][k])}</td>" for name in names)
                    + "</tr>" for k in range(count))
     return f"<table><tr>{head}</tr>{rows}</table>"
+
+
+def _crest_width_note(results: dict) -> str:
+    """What the EurOtop comparison did about the crest's width, with C_r per step."""
+    formulas = results["formulas"]
+    width = formulas.get("crest_width_m")
+    if width is None:
+        return ("<p>EurOtop's q: no crest-width factor applied (C_r = 1): "
+                + html.escape(str(formulas.get("crest_width_source", "no crest width known")))
+                + "; give the overtopping gauge's crest_width.</p>")
+    curve = results["curve"]
+    factors = ", ".join(f"step {step}: {_cell(factor)}" for step, factor in
+                        zip(curve["step"], curve.get("eurotop_crest_width_factor", [])))
+    return (f"<p>EurOtop's q includes the crest-width factor C_r = min(1, 3.06 exp(-1.5 G_c / "
+            f"Hm0)) (EurOtop 2018, eq. 6.8) for G_c = {width:.4g} m "
+            f"({html.escape(str(formulas.get('crest_width_source', '')))}): {factors}.</p>")
 
 
 _STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
@@ -117,6 +134,7 @@ def write_series_report(out, results: dict) -> dict:
                       if first else "No unit was displaced in the series.")
              + "; the formulas' start of damage: "
              + ", ".join(f"{html.escape(k)} = {v:g}" for k, v in start.items() if v) + ".</p>",
+             _crest_width_note(results),
              "<img src='damage_curve.png'><img src='overtopping.png'>",
              f"<p>Sources: {html.escape(results['formulas']['sources'])}.</p>",
              "<h2>Before the series</h2><p><a href='start/report.html'>the layer as built</a> "

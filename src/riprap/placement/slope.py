@@ -92,6 +92,11 @@ class Slope:
     def crest_level(self) -> float:
         return self.toe_level + self.length * np.sin(self.angle)
 
+    @property
+    def crest_x(self) -> float:
+        """x of the face's top edge (m): where the crest begins."""
+        return self.toe_x + self.length * np.cos(self.angle)
+
     def to_world(self, s, y, h) -> np.ndarray:
         """World points (n, 3) of slope coordinates (arrays or scalars, m)."""
         s = np.asarray(s, dtype=float)[..., None]

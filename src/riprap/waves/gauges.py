@@ -6,13 +6,21 @@ elevation eta (m) above the still water level, exact for a single-valued surface
 holds a plunging jet's air pocket counts only its water). A velocity gauge reads (u, v, w) at its
 point, each component interpolated linearly between the faces that carry it.
 
-An overtopping gauge stands on a plane x = const (the crest's landward edge) at the crest level z
-of its ``position``: it reads the water volume that crossed the plane above that level in each
-step per metre of flume width (the volume-of-fluid step's own face fluxes, so exactly the water
-that went over; from the cell row that holds the crest level up, so that the flow through a
-porous core under the crest is not counted), summed into the overtopped volume per metre V
-(m^3/m), and that step's mean discharge q (m^3/s per m). A
-run-up gauge reads, between x = ``position`` x and ``to_x``, the highest level the water reaches
+An overtopping gauge stands on a plane x = const (the crest's landward edge, where EurOtop
+measures q): it reads the water volume that crossed the plane above the crest's surface there in
+each step per metre of flume width (the volume-of-fluid step's own face fluxes, so exactly the
+water that went over), summed into the overtopped volume per metre V (m^3/m), and that step's mean
+discharge q (m^3/s per m). The crest's surface is found in each cell row along y from what the
+fluid holds solid or porous in the two cell columns beside the plane (``crest_rows``): the count
+starts at the first cell row above the highest cell that is an obstacle or at least half inside a
+porous zone, so a tongue one cell thick running over the crest counts, and the flow through a
+porous crest under its surface does not (EurOtop's q is the water over the crest; the water that
+sinks into a permeable crest is what its crest-width factor takes off). Where the plane has
+neither, the count starts at the cell row holding the crest level z of the gauge's ``position``.
+Bodies (armour units, a pack's fixed rocks) are no part of that surface: the water between units
+above it counts.
+
+A run-up gauge reads, between x = ``position`` x and ``to_x``, the highest level the water reaches
 on the slope: in each cell column the top of the water resting on the column's bed (its obstacle
 cells, or the box's bottom; cells more than half water counted up from there, plus the part of
 the next), the highest over the columns, above the still water level (m). Spray above the tongue
@@ -30,7 +38,8 @@ import numpy as np
 
 from riprap.errors import CaseFileError
 
-__all__ = ["Gauge", "GaugeSet", "SURFACE", "VELOCITY", "OVERTOPPING", "RUN_UP", "KINDS"]
+__all__ = ["Gauge", "GaugeSet", "crest_rows", "SURFACE", "VELOCITY", "OVERTOPPING", "RUN_UP",
+           "KINDS"]
 
 SURFACE = "surface"
 VELOCITY = "velocity"
@@ -94,6 +103,9 @@ class GaugeSet:
         self._times = np.zeros(1024)
         self._values = np.zeros((1024, len(self.columns)))
         self._where = None
+        # per overtopping gauge (its index), the first cell row counted in each row along y: set
+        # on the first reading, from the fluid read (the crest does not move)
+        self._crest_rows = {}
 
     def check_in_grid(self, grid) -> None:
         """Refuse a gauge outside the fluid box, naming it."""
@@ -126,7 +138,8 @@ class GaugeSet:
                 where.append(column[:2])
                 continue
             if gauge.kind == OVERTOPPING:
-                # the x face nearest the plane, from the cell row holding the crest level up
+                # the x face nearest the plane, and the cell row holding the crest level (where the
+                # fluid holds no crest at the plane)
                 where.append((int(min(max(round((p[0] - lower[0]) / h), 0), cells[0])), column[2]))
                 continue
             if gauge.kind == RUN_UP:
@@ -145,6 +158,7 @@ class GaugeSet:
                 stencils.append(stencil)
             where.append(stencils)
         self._where = (where, h, float(lower[2]))
+        self._crest_rows = {}
 
     def read(self, fluid) -> np.ndarray:
         """The gauges' values now, in ``columns`` order."""
@@ -159,7 +173,10 @@ class GaugeSet:
                 continue
             if gauge.kind == OVERTOPPING:
                 column = self.columns.index(gauge.columns[0])
-                crossed = _water_crossed_per_width(fluid, place)
+                rows = self._crest_rows.get(index)
+                if rows is None:
+                    rows = self._crest_rows[index] = crest_rows(fluid, place[0], place[1])
+                crossed = _water_crossed_per_width(fluid, place[0], rows)
                 previous = self._values[self.count - 1, column + 1] if self.count else 0.0
                 step = fluid.time_step
                 values.extend((crossed / step if step > 0 else 0.0, previous + crossed))
@@ -231,17 +248,47 @@ class GaugeSet:
         return self.times.copy(), self.values[:, self.columns.index(column)].copy()
 
 
-def _water_crossed_per_width(fluid, place) -> float:
-    """Water volume per metre of width (m^3/m) that crossed the x faces of index ``place[0]``
-    from cell row ``place[1]`` up in the fluid's last step: the volume-of-fluid step's own fluxes,
-    so that it is exactly the water that left one side and reached the other. 0 before the first
-    step."""
+def crest_rows(fluid, face: int, fallback_row: int) -> np.ndarray:
+    """(ny,) for each cell row along y, the first cell row (k) whose water crossing the x faces of
+    index ``face`` is overtopping: the row above the highest cell of the two cell columns beside
+    the faces that is an obstacle (``fluid.solid``) or at least half inside the fluid's porous
+    zones (their cover, not the porosity, so that a zone's own porosity does not matter), i.e.
+    the crest's surface; ``fallback_row`` (the cell row holding the gauge's crest level) where
+    the two columns hold neither. Works on a block of a split grid too (``fluid.grid`` a
+    ``BlockGrid``): the cover is computed on the whole grid's planes the block holds."""
+    nx, ny, nz = fluid.fraction.shape
+    first, stop = max(face - 1, 0), min(face + 1, nx)
+    crest = np.asarray(fluid.solid[first:stop], dtype=bool).copy()
+    porous = getattr(fluid, "porous", None)
+    if porous is not None and porous.zones:
+        grid = fluid.grid
+        whole = grid.whole_grid
+        offset = getattr(grid, "first", 0) if grid is not whole else 0
+        columns = whole.block(offset + first, offset + stop)
+        cover = np.zeros((stop - first, ny, nz))
+        for zone in porous.zones:
+            part = zone.cover(columns)
+            cover = cover * (1.0 - part) + part          # the union of the zones' covers
+        crest |= cover >= 0.5
+    rows = np.full(ny, int(fallback_row), dtype=np.int64)
+    for j in range(ny):
+        solid_rows = np.flatnonzero(crest[:, j, :].any(axis=0))
+        if solid_rows.size:
+            rows[j] = int(solid_rows[-1]) + 1
+    return rows
+
+
+def _water_crossed_per_width(fluid, face: int, rows: np.ndarray) -> float:
+    """Water volume per metre of width (m^3/m) that crossed the x faces of index ``face`` in the
+    fluid's last step, in each cell row along y from cell row ``rows[j]`` up: the volume-of-fluid
+    step's own fluxes, so that it is exactly the water that left one side and reached the other.
+    0 before the first step."""
     fluxes = getattr(fluid, "last_water_fluxes", None)
     if fluxes is None or fluid.step_count == 0:
         return 0.0
-    face, row = place
     width = fluid.h * fluid.fraction.shape[1]
-    return float(np.sum(fluxes[0][face][:, row:])) / width
+    plane = fluxes[0][face]
+    return float(sum(np.sum(plane[j, rows[j]:]) for j in range(plane.shape[0]))) / width
 
 
 def _highest_contiguous_water(fluid, first: int, last: int, j: int, h: float, bottom: float) -> float:

@@ -107,6 +107,8 @@ def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:
         waves, analysis.layer, unit_kind=layer.unit_kind, nominal_diameter=layer.nominal_diameter,
         armour_density=float(densities[unit]), water_density=water_density,
         slope_cot=layer.slope.cotangent)
+    # where the crest begins, for the crest width of a series' EurOtop comparison
+    analysis.layer["flume_test"]["slope_crest_x_m"] = float(layer.slope.crest_x)
     gauges = read_gauges_csv(Path(path) / "gauges.csv")
     times, columns = gauges if gauges is not None else (None, {})
     contacts = read_unit_contacts_per_frame(path, bodies, until=state.time)

@@ -261,10 +261,12 @@ def _series_results(out: Path, steps: list[_Step], case) -> dict:
     over = next((g for g in case.gauges if g.type == "overtopping"), None)
     freeboard = (over.parameters["position"][2] - case.waves.still_water_level
                  if over is not None else None)
+    crest_width, crest_width_source = _crest_width(over, flume)
     results = series_curve(rows, unit_kind=str(flume.get("unit", "")),
                            nominal_diameter=float(flume.get("nominal_diameter_m", math.nan)),
                            delta=float(flume.get("relative_density", math.nan)),
-                           slope_cot=float(flume.get("slope_cot", math.nan)), freeboard=freeboard)
+                           slope_cot=float(flume.get("slope_cot", math.nan)), freeboard=freeboard,
+                           crest_width=crest_width, crest_width_source=crest_width_source)
     results["per_wave"] = per_wave
     results["case_file"] = str(Path(case.source).resolve())
     results["displacement_threshold_over_dn"] = case.series.displacement_threshold
@@ -273,6 +275,23 @@ def _series_results(out: Path, steps: list[_Step], case) -> dict:
                          "target_waves": s.sea.waves, "sea_duration_s": s.sea.duration}
                         for s in steps]
     return results
+
+
+def _crest_width(over, flume: dict) -> tuple[float | None, str | None]:
+    """G_c (m) of EurOtop's crest-width factor and where it came from: the overtopping gauge's
+    ``crest_width``; when 0, the distance from the top of the placed layer's face (the survey's
+    ``slope_crest_x_m``) to the gauge's plane; (None, None) without either (C_r = 1)."""
+    if over is None:
+        return None, None
+    given = float(over.parameters.get("crest_width", 0.0))
+    if given > 0:
+        return given, f"[[gauges]] {over.name!r} crest_width"
+    top = _number(flume.get("slope_crest_x_m"))
+    if not math.isfinite(top):
+        return None, None
+    x = float(over.parameters["position"][0])
+    return max(x - top, 0.0), (f"from the top of the placed layer's face (x = {top:.4g} m) to the "
+                               f"overtopping gauge {over.name!r} (x = {x:.4g} m)")
 
 
 def _number(value) -> float:
