@@ -81,7 +81,8 @@ class SlabCoupledSolver(CoupledSolver):
         CoupledSolver.__init__(self, block, whole.solids, solid_time_step=whole.solid_time_step,
                                wall_material=None, check_momentum=whole.check_momentum,
                                obstacle_bodies=whole.obstacle_bodies,
-                               adaptive_substep=whole.adaptive_substep)
+                               adaptive_substep=whole.adaptive_substep,
+                               cut_faces=whole.cut_faces)
 
     # ------------------------------------------------------------------ set up from the whole
     def _check_bodies_in_grid(self) -> None:
@@ -186,11 +187,12 @@ class SlabCoupledSolver(CoupledSolver):
         """The carrying field's values on the halo faces from the neighbours that own them."""
         axis, index, values = self._carried
         block = self.fluid
-        fields = (block.u.copy(), block.v.copy(), block.w.copy())
-        rigid_coupling.scatter(axis, index, values, *fields)
-        for along, field in enumerate(fields):
-            block.exchange_planes(field, on_x_faces=along == 0)
-        rigid_coupling.gather(axis, index, *fields, values)
+        for carried in (values, self._excess[1]):
+            fields = (block.u.copy(), block.v.copy(), block.w.copy())
+            rigid_coupling.scatter(axis, index, carried, *fields)
+            for along, field in enumerate(fields):
+                block.exchange_planes(field, on_x_faces=along == 0)
+            rigid_coupling.gather(axis, index, *fields, carried)
 
     # ------------------------------------------------------------------ the whole run's state
     def state_piece(self, state: dict) -> dict:
@@ -209,7 +211,8 @@ class SlabCoupledSolver(CoupledSolver):
         mine = self._owned(axis, index[:, 0])
         index[:, 0] += self._begin
         return {"coupling_carried_axis": axis[mine], "coupling_carried_index": index[mine],
-                "coupling_carried_values": values[mine]}
+                "coupling_carried_values": values[mine],
+                "coupling_carried_excess": state["coupling_carried_excess"][mine]}
 
     def load_state_arrays(self, arrays: dict) -> None:
         """A block's state, or a whole grid's (a checkpoint of a run on any number of
@@ -227,6 +230,9 @@ class SlabCoupledSolver(CoupledSolver):
             arrays["coupling_carried_axis"] = axis[inside]
             arrays["coupling_carried_index"] = index[inside]
             arrays["coupling_carried_values"] = np.asarray(arrays["coupling_carried_values"])[inside]
+            if "coupling_carried_excess" in arrays:
+                arrays["coupling_carried_excess"] = np.asarray(
+                    arrays["coupling_carried_excess"])[inside]
         super().load_state_arrays(arrays)
         self._summed = None
 

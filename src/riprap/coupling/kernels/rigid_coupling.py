@@ -233,11 +233,12 @@ BodyFaces = namedtuple("BodyFaces", ["entry_start", "entry_face", "entry_half", 
 
 
 @kernel
-def accumulate_rigid(faces, centres, motions, phi, out):
-    """out[f] += sum over bodies of phi_b' (J x_b) on the set's faces (``faces``:
-    :class:`BodyFaces`), phi_b' the body's share scaled by 1 / max(1, phi): the rigid part of a
-    blended velocity. A body at rest (x_b = 0: a fixed one after the projection) adds nothing and
-    is skipped."""
+def accumulate_rigid(faces, centres, motions, phi, weights, out):
+    """out[f] += sum over bodies of weights[f] phi_b' (J x_b) on the set's faces (``faces``:
+    :class:`BodyFaces`), phi_b' the body's share scaled by 1 / max(1, phi): with weights 1 the
+    rigid part of a blended velocity; with the faces' grip (``cut_face_grip``) the part of the
+    fluid's share that moves with the bodies after the step. A body at rest (x_b = 0: a fixed one
+    after the projection) adds nothing and is skipped."""
     entry_start, entry_face, entry_half, face_axis, face_index, lower, h = faces
     jac = np.empty(6)
     for b in range(entry_start.shape[0] - 1):
@@ -254,7 +255,7 @@ def accumulate_rigid(faces, centres, motions, phi, out):
             value = 0.0
             for m in range(6):
                 value += jac[m] * motions[b, m]
-            out[f] += value * share
+            out[f] += value * share * weights[f]
 
 
 @parallel_kernel
@@ -265,7 +266,9 @@ def own_momentum_rhs(faces, centres, motions, densities, phi, fluid_density, pre
     the pressure's velocity change on the face, and its part (phi_b' / phi) of the fluid share's
 
         r = sum_f J_f^T (phi_b' rho_b (J_f x_b + dv_f) + phi_b' / phi F_f) h^3,
-        F_f = (1 - phi) rho_fluid (u_fluid + dv_f - (1 - phi) u_projected).
+        F_f = (1 - phi) (rho_fluid (u_fluid - (1 - alpha) u_projected) + dv_f / beta_f),
+
+    (alpha the face's grip fraction, ``cut_face_grip``; F_f is formed by the caller).
 
     Summed over the bodies of a face this is the momentum_systems right-hand side (w u - C): for a
     face of one body it is the same; where two bodies share a face, neither takes the other's
@@ -309,12 +312,16 @@ def accumulate_density(entry_start, entry_face, entry_half, densities, phi, flui
 
 
 @parallel_kernel
-def momentum_systems(faces, centres, densities, phi, fluid_density, velocities, unaccounted,
+def momentum_systems(faces, centres, densities, phi, grip, fluid_density, velocities, unaccounted,
                      with_matrices, chosen, matrices, body_matrices, rhs):
     """For every body the 6 x 6 system M x = r of its rigid motion after the projection:
 
         M = sum_f w_f J_f^T J_f,  r = sum_f J_f^T (w_f u_f - C_f phi_b' / phi),
-        w_f = phi_b' ((1 - phi) rho_fluid + rho_b),
+        w_f = phi_b' ((1 - phi) rho_fluid g_f + rho_b),
+
+    g_f = alpha_f / phi the face's grip (``cut_face_grip``): the fluid's share of a cut face ends
+    the step a fraction alpha_f of the way to the bodies' motion, so that part of it moves with
+    them.
 
     which makes the momentum and angular momentum of fluid and body together (the fluid's share
     of every face at the blended velocity, the body's at its rigid one) equal those before the
@@ -351,7 +358,7 @@ def momentum_systems(faces, centres, densities, phi, fluid_density, velocities, 
             share = entry_half[e] / max(1.0, phi_f)
             capped = min(phi_f, 1.0)
             own = rho_f if densities[b] < 0.0 else densities[b]
-            weight = share * ((1.0 - capped) * rho_f + own) * volume
+            weight = share * ((1.0 - capped) * rho_f * grip[f] + own) * volume
             own_weight = share * own * volume
             _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac)
             for r in range(n_rhs):
@@ -366,3 +373,94 @@ def momentum_systems(faces, centres, densities, phi, fluid_density, velocities, 
                     for n in range(6):
                         matrices[b, m, n] += weight * jac[m] * jac[n]
                         body_matrices[b, m, n] += own_weight * jac[m] * jac[n]
+
+
+@parallel_kernel
+def cut_face_grip(phi, fluid_velocity, body_velocity, fluid_density, water_density,
+                  water_viscosity, air_density, air_viscosity, h, dt, out):
+    """The fraction alpha of the way from its own velocity to the bodies' motion that the fluid's
+    share of each cut face goes over a step of ``dt``, divided by the face's solid fraction phi
+    (the grip g = alpha / phi that ``momentum_systems`` and ``accumulate_rigid`` take).
+
+    The fluid beside a body meets it at a rate, not once per step (``docs/coupling.md``, Cut faces):
+    the fluid of a face's control volume is renewed by the flow through it, at the relative speed
+    over a cell |u - U| / h, and by viscous diffusion across a cell, 2 nu / h^2; each renewal takes
+    it the fraction phi of the way to the body, so that
+
+        alpha = 1 - (1 - phi)^(dt (|u - U| / h + 2 nu / h^2)),
+
+    the same as one relaxation by phi per renewal, whatever the step. A face inside a body
+    (phi = 1) moves with it. ``body_velocity``: the bodies' blended rigid velocity on the face
+    (sum phi_b' J x_b) over phi; the face's kinematic viscosity from its fluid density (water and
+    air mixed by volume)."""
+    for f in prange(phi.shape[0]):
+        capped = min(phi[f], 1.0)
+        if capped <= 0.0:
+            out[f] = 0.0
+            continue
+        if capped >= 1.0:
+            out[f] = 1.0
+            continue
+        water = 1.0
+        if water_density != air_density:     # (one fluid in both phases: a single-liquid tank)
+            water = (fluid_density[f] - air_density) / (water_density - air_density)
+            water = min(max(water, 0.0), 1.0)
+        viscosity = water * water_viscosity + (1.0 - water) * air_viscosity
+        nu = viscosity / max(fluid_density[f], 1e-300)
+        opening = (1.0 - capped) * h
+        rate = abs(fluid_velocity[f] - body_velocity[f]) / opening + 2.0 * nu / (opening * opening)
+        out[f] = (1.0 - (1.0 - capped) ** (rate * dt)) / capped
+
+
+@kernel
+def body_velocity_vectors(faces, centres, motions, phi, out):
+    """out[f] (F, 3) = the bodies' rigid velocity U + omega x rho at face f, each body weighted
+    by its share phi_b' over phi (0 on faces of no body)."""
+    entry_start, entry_face, entry_half, face_axis, face_index, lower, h = faces
+    for f in range(out.shape[0]):
+        for c in range(3):
+            out[f, c] = 0.0
+    for b in range(entry_start.shape[0] - 1):
+        for e in range(entry_start[b], entry_start[b + 1]):
+            f = entry_face[e]
+            weight = entry_half[e] / max(1.0, phi[f]) / max(min(phi[f], 1.0), 1e-300)
+            axis = face_axis[f]
+            i, j, k = face_index[f, 0], face_index[f, 1], face_index[f, 2]
+            rx = lower[0] + (i + (0.0 if axis == 0 else 0.5)) * h - centres[b, 0]
+            ry = lower[1] + (j + (0.0 if axis == 1 else 0.5)) * h - centres[b, 1]
+            rz = lower[2] + (k + (0.0 if axis == 2 else 0.5)) * h - centres[b, 2]
+            wx, wy, wz = motions[b, 3], motions[b, 4], motions[b, 5]
+            out[f, 0] += weight * (motions[b, 0] + wy * rz - wz * ry)
+            out[f, 1] += weight * (motions[b, 1] + wz * rx - wx * rz)
+            out[f, 2] += weight * (motions[b, 2] + wx * ry - wy * rx)
+
+
+@parallel_kernel
+def moving_pattern(face_axis, face_index, velocity, on_x, on_y, on_z, h, dt, out):
+    """out[f] = dt (V . grad) u_a at face f of axis a, the upwind differences of the face array
+    of its own axis along V (``velocity`` (F, 3)): the change a field that moves rigidly with V
+    shows at a fixed face over dt, which the grid-frame predictor puts on a moving body's faces."""
+    for f in prange(face_axis.shape[0]):
+        axis = face_axis[f]
+        field = on_x if axis == 0 else (on_y if axis == 1 else on_z)
+        i, j, k = face_index[f, 0], face_index[f, 1], face_index[f, 2]
+        total = 0.0
+        for c in range(3):
+            speed = velocity[f, c]
+            if speed == 0.0:
+                continue
+            di = 1 if c == 0 else 0
+            dj = 1 if c == 1 else 0
+            dk = 1 if c == 2 else 0
+            here = field[i, j, k]
+            if speed > 0.0:
+                ii, jj, kk = i - di, j - dj, k - dk
+                if ii < 0 or jj < 0 or kk < 0:
+                    continue
+                total += speed * (here - field[ii, jj, kk])
+            else:
+                ii, jj, kk = i + di, j + dj, k + dk
+                if ii >= field.shape[0] or jj >= field.shape[1] or kk >= field.shape[2]:
+                    continue
+                total += speed * (field[ii, jj, kk] - here)
+        out[f] = total * dt / h

@@ -1,0 +1,85 @@
+"""The fluid's load on a unit against a known drag, and its dependence on the time step.
+
+A towing tank: a cube of side D carried face-on at a constant speed U through water at rest (no
+gravity, free-slip walls), the way a laboratory tows a model; by Galileo the same as a cube held in
+a uniform current of U. Its drag coefficient C_D = F_x / (rho U^2 D^2 / 2), averaged while it
+travels from 4 to 10 D (the wake formed), against the bluff-body value of about 1.05 for a cube
+face-on (Hoerner, Fluid-Dynamic Drag, 1965, ch. 3; Re = U D / nu of 2e4 here). The tank is 16 D
+long and 6 D square (blockage 2.8 % of the section, not corrected).
+
+Each run carries the cube at a fixed step of ``COURANT`` h / U (0.2) (scaled by ``--dt-scale``): the load
+of a method whose load is a property of the flow does not change with it. Both cut-face
+treatments of ``riprap.coupling.coupled`` (``CUT_FACE_TREATMENTS``) are measured.
+
+Prints, last, ``METRIC cube_drag_coefficient_<cells> <value> ratio`` per resolution (the default
+treatment at the reference step), ``METRIC load_change_dt_5_to_1_25ms`` (here: the relative
+change of the drag between the reference step and a quarter of it, the same factor of 4 as
+5 ms to 1.25 ms) and ``METRIC load_change_4_5_to_6_cells`` (the relative change of the drag from
+4.5 to 6 cells per D). The flume part of the issue (a cube held on examples/09's slope) is not
+measured here yet.
+
+    python bench/unit_loads.py [--cells 3 4.5 6] [--treatment mixture own_velocity]
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from riprap.benchmarks.towing_tank import tow, towing_tank
+from riprap.coupling.coupled import CUT_FACE_TREATMENTS
+
+SIDE = 0.05            # m, the cube's side (the damage curve's units are 4.6 cm)
+SPEED = 0.4            # m/s: Re = 2e4 in water at 20 degrees C
+FROM, TO = 4.0, 10.0   # in D of travel: the window of the average
+COURANT = 0.2          # the reference step: 0.2 h / U (the flow beside the cube reaches 1.7 U)
+REFERENCE_DRAG = 1.05  # Hoerner (1965), a cube face-on
+
+
+def towed_cube_drag(cells_per_side: float, *, dt_scale: float = 1.0,
+                    cut_faces: str = "mixture") -> dict:
+    """C_D of the towed cube, with the steps and wall time."""
+    coupled = towing_tank(SIDE, SPEED, cells_per_side, cut_faces=cut_faces)
+    fluid = coupled.fluid
+    dt = COURANT * fluid.h / SPEED * dt_scale
+    started = time.perf_counter()
+    travel, drag = tow(coupled, SIDE, SPEED, dt, TO)
+    window = (travel > FROM) & (travel < TO)
+    dynamic = 0.5 * fluid.water.density * SPEED ** 2 * SIDE ** 2
+    return {"cells_per_side": cells_per_side, "dt_scale": dt_scale, "cut_faces": cut_faces,
+            "time_step_s": dt, "steps": len(drag), "cells": int(np.prod(fluid.grid.cells)),
+            "drag_coefficient": float(drag[window].mean() / dynamic),
+            "drag_coefficient_rms_over_mean": float(drag[window].std() / drag[window].mean()),
+            "wall_s": time.perf_counter() - started}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cells", type=float, nargs="+", default=[3.0, 4.5, 6.0])
+    parser.add_argument("--treatment", nargs="+", default=list(CUT_FACE_TREATMENTS),
+                        choices=CUT_FACE_TREATMENTS)
+    args = parser.parse_args()
+    results = {}
+    for treatment in args.treatment:
+        for cells in args.cells:
+            for scale in (1.0, 0.25):
+                row = towed_cube_drag(cells, dt_scale=scale, cut_faces=treatment)
+                results[(treatment, cells, scale)] = row
+                print(f"{treatment:13s} {cells:4.1f} cells per D, dt {row['time_step_s']:.2e} s: "
+                      f"C_D {row['drag_coefficient']:.3f} (reference {REFERENCE_DRAG}), "
+                      f"{row['steps']} steps, {row['wall_s']:.0f} s", flush=True)
+    default = args.treatment[0]
+    for cells in args.cells:
+        print(f"METRIC cube_drag_coefficient_{cells:g} "
+              f"{results[(default, cells, 1.0)]['drag_coefficient']:.3f} ratio")
+    change = max(abs(results[(default, c, 0.25)]["drag_coefficient"]
+                     / results[(default, c, 1.0)]["drag_coefficient"] - 1.0) for c in args.cells)
+    print(f"METRIC load_change_dt_5_to_1_25ms {change:.3f} ratio")
+    if 4.5 in args.cells and 6.0 in args.cells:
+        fine, coarse = (results[(default, c, 1.0)]["drag_coefficient"] for c in (6.0, 4.5))
+        print(f"METRIC load_change_4_5_to_6_cells {abs(fine / coarse - 1.0):.3f} ratio")
+
+
+if __name__ == "__main__":
+    main()
