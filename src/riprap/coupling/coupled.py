@@ -84,6 +84,10 @@ SUBSTEP_MAX_OVER_ESTIMATE = 30.0
 #: cells per diameter and 4 % at 6 (the cut faces' fluid slips where a resolved boundary layer
 #: would hold it), so it is not yet the default.
 CUT_FACE_TREATMENTS = ("mixture", "own_velocity")
+#: With "own_velocity": the viscous renewal rate of the fluid in a cut face is this times
+#: nu / d^2, d = (1 - phi) h the face's open width: the wall shear mu u / (d / 2) on a film of
+#: thickness d at its mean velocity u gives 2 nu / d^2 (``rigid_coupling.cut_face_grip``).
+VISCOUS_RENEWAL = 2.0
 #: A moving body must span at least this many cells (by its nominal diameter, V^(1/3)): at 3
 #: the ten Cate sphere (4 cells across its diameter, nominal diameter 3.2 cells) still settles
 #: within 9 % of the experiment; below that its forces are noise.
@@ -875,7 +879,7 @@ class CoupledSolver:
         rigid_coupling.cut_face_grip(faces.phi, fluid_part, body_velocity, rho_fluid,
                                      fluid.water.density, fluid.water.dynamic_viscosity,
                                      fluid.air.density, fluid.air.dynamic_viscosity, fluid.h, dt,
-                                     grip)
+                                     VISCOUS_RENEWAL, grip)
         return grip
 
     def _body_faces(self, faces) -> rigid_coupling.BodyFaces:

@@ -377,17 +377,18 @@ def momentum_systems(faces, centres, densities, phi, grip, fluid_density, veloci
 
 @parallel_kernel
 def cut_face_grip(phi, fluid_velocity, body_velocity, fluid_density, water_density,
-                  water_viscosity, air_density, air_viscosity, h, dt, out):
+                  water_viscosity, air_density, air_viscosity, h, dt, viscous_renewal, out):
     """The fraction alpha of the way from its own velocity to the bodies' motion that the fluid's
     share of each cut face goes over a step of ``dt``, divided by the face's solid fraction phi
     (the grip g = alpha / phi that ``momentum_systems`` and ``accumulate_rigid`` take).
 
     The fluid beside a body meets it at a rate, not once per step (``docs/coupling.md``, Cut faces):
-    the fluid of a face's control volume is renewed by the flow through it, at the relative speed
-    over a cell |u - U| / h, and by viscous diffusion across a cell, 2 nu / h^2; each renewal takes
-    it the fraction phi of the way to the body, so that
+    the fluid of a face's control volume is renewed by the flow through its opening (1 - phi) h
+    at the relative speed, |u - U| / ((1 - phi) h), and by viscous
+    diffusion across it, ``viscous_renewal`` nu / ((1 - phi) h)^2; each renewal takes it the
+    fraction phi of the way to the body, so that
 
-        alpha = 1 - (1 - phi)^(dt (|u - U| / h + 2 nu / h^2)),
+        alpha = 1 - (1 - phi)^(dt (|u - U| / d + c nu / d^2)),  d = (1 - phi) h,
 
     the same as one relaxation by phi per renewal, whatever the step. A face inside a body
     (phi = 1) moves with it. ``body_velocity``: the bodies' blended rigid velocity on the face
@@ -408,7 +409,8 @@ def cut_face_grip(phi, fluid_velocity, body_velocity, fluid_density, water_densi
         viscosity = water * water_viscosity + (1.0 - water) * air_viscosity
         nu = viscosity / max(fluid_density[f], 1e-300)
         opening = (1.0 - capped) * h
-        rate = abs(fluid_velocity[f] - body_velocity[f]) / opening + 2.0 * nu / (opening * opening)
+        rate = (abs(fluid_velocity[f] - body_velocity[f]) / opening
+                + viscous_renewal * nu / (opening * opening))
         out[f] = (1.0 - (1.0 - capped) ** (rate * dt)) / capped
 
 
