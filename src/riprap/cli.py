@@ -66,6 +66,7 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
         print(f"riprap: fluid case {path}: {grid.cells[0]} x {grid.cells[1]} x {grid.cells[2]} "
               f"cells of {grid.cell_size:.4g} m ({'2D' if grid.two_dimensional else '3D'}), water "
               f"{water:.4g} m^3{bodies}")
+        _say_filter_layer(sim.filter_layer)
     else:
         print(f"riprap: case {path}: {case.body_count} bodies, {len(case.shapes)} shapes, "
               f"{len(case.walls)} wall entries")
@@ -222,12 +223,21 @@ def _say_flume_test(flume: dict | None) -> None:
         print(f"riprap: flume test: caution: {item}")
 
 
+def _say_filter_layer(layer, prefix: str = "riprap: ") -> None:
+    """The contact-only bodies and the filter zones the flow sees in their place, if any."""
+    if layer is None:
+        return
+    for line in layer.lines():
+        print(f"{prefix}filter layer: {line}")
+
+
 def _check(path: Path, out: str | None, restart: str | None = None) -> int:
     report = check_case(load_case(path), output_directory=out, restart=restart)
     print(f"{path}: valid ({report.description})")
     print(f"  checked: {'; '.join(report.checked)}")
     for item in report.not_checked:
         print(f"  not checked (only a run can tell): {item}")
+    _say_filter_layer(report.filter_layer, prefix="  ")
     if report.friction:
         print("  friction of the pairs of materials that meet:")
         for pair in report.friction:

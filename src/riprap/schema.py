@@ -656,6 +656,16 @@ KEYS: tuple[Key, ...] = (
         "over the step (|div u| dt, the divergence the solve leaves; Basilisk's TOLERANCE); 0 "
         "leaves that test out.", default=0.0,
         valid_range=Range(minimum=0.0, maximum=1.0e-2, maximum_inclusive=False)),
+    # The default 0 is "not given" (off); a value given must be > 0 (valid_range).
+    Key("fluid", "contact_only_below_cells", "number", "-",
+        "Fixed bodies whose nominal diameter V^(1/3) spans fewer cells than this (underlayer "
+        "rocks too small for the grid) are contact-only: the free bodies meet them, the flow "
+        "does not (not clipped into it, fluid force 0) but sees a porous filter zone in their "
+        "place: the case's [[porous_zones]] that hold them, else one riprap fits to them "
+        "(porosity 0.4, their Dn50, the default friction; `riprap check` prints it; "
+        "docs/waves.md, Filter layers). Between the rocks' size and the free bodies'. Not given "
+        "(0): every body is in the flow, and riprap warns of fixed bodies under 4 cells.",
+        default=0.0, valid_range=_POSITIVE),
     # [[water_regions]]
     Key("water_regions", "type", "string", "-", "Kind of region; selects the keys below.",
         choices=("box", "level")),

@@ -235,6 +235,9 @@ class Simulation:
         #: What the progress display calls the run (default the model's name): a test series
         #: names its step there.
         self.progress_label = None
+        #: The contact-only bodies and the filter zones the flow sees in their place
+        #: (``riprap.coupling.filter_layer.FilterLayer``, set by the case builder), or None.
+        self.filter_layer = None
         self._model = None
         if isinstance(scene, Model):
             self._model, scene = scene, None
@@ -261,6 +264,7 @@ class Simulation:
     deformable_mass_damping = _OfScene()
     deformable_case_index = _OfScene()
     deformable_accepted_depths = _OfScene()
+    contact_only_bodies = _OfScene()
 
     add_material = _of_scene(Scene.add_material)
     add_friction_pair = _of_scene(Scene.add_friction_pair)

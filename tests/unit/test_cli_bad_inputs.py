@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from riprap.cli import main
+from test_filter_layer import ZONE_OVER_THE_ROCKS, bed_case
 from test_placement_case import MINIMAL
 
 RIGID = """format_version = 1
@@ -86,6 +87,20 @@ BROKEN_CASES = {
     "obstacle_over_all_the_water": (
         FLUID + '[[obstacles]]\ntype = "box"\nlower = [0.0, 0.0, 0.0]\nupper = [0.2, 0.02, 0.06]\n',
         "run", "no water"),
+    # contact-only bodies (issue 51, item 4): a bed of small fixed rocks under a free ball
+    "filter_zone_over_the_units": (
+        bed_case(extra=ZONE_OVER_THE_ROCKS.replace("0.018]", "0.2]")), "run",
+        "[[porous_zones]] entry 1: this porous filter zone holds 1.00 of free body 0"),
+    "contact_only_threshold_above_every_free_body": (
+        bed_case(threshold=5.0), "run", "[fluid] contact_only_below_cells = 5: every free body"),
+    "contact_only_threshold_over_every_body": (
+        _edit(bed_case(threshold=5.0), "position = [0.1, 0.1, 0.1]",
+              "position = [0.1, 0.1, 0.1]\nfixed = true"), "run",
+        "[fluid] contact_only_below_cells = 5: every one of the 82 bodies"),
+    "contact_only_threshold_zero": (bed_case(threshold=0), "run",
+                                    "fluid.contact_only_below_cells = 0: out of range"),
+    "contact_only_threshold_negative": (bed_case(threshold=-2.0), "run",
+                                        "fluid.contact_only_below_cells = -2.0: out of range"),
     "placement_beside_fluid": (PLACEMENT + "\n" + FLUID.split("[simulation]\nend_time = 0.01\n")[1],
                                "place", "not both"),
     "rows_beside_grid_file": (_edit(PLACEMENT, "rows = 3\nunits_per_row = 3",

@@ -10,6 +10,8 @@ from riprap.case.build_waves import build_waves
 from riprap.case.run_record import RunDefinition
 from riprap.case.specs import keywords_for
 from riprap.coupling.coupled import MINIMUM_DENSITY_RATIO
+from riprap.coupling.filter_layer import (UNRESOLVED_BELOW_CELLS, choose_filter_layer,
+                                          nominal_cells, unresolved_fixed_bodies)
 from riprap.errors import CaseFileError
 from riprap.fluid.grid import SIDES, FluidGrid
 from riprap.fluid.phases import Phase
@@ -123,9 +125,16 @@ def build_fluid_run(case, *, output_directory=None, progress: bool = True):
         _check_bodies_not_too_light(case)
         simulation = build_simulation(case, output_directory=output_directory, progress=progress)
         simulation.add_fluid(fluid)
+        _choose_contact_only_bodies(case, simulation, fluid)
         simulation.prepare()
         _warn_if_too_short_to_analyse(case, simulation)
         return simulation
+    if case.fluid.contact_only_below_cells > 0:
+        import warnings
+
+        warnings.warn(f"{case.source} [fluid] contact_only_below_cells = "
+                      f"{case.fluid.contact_only_below_cells:g}: the case has no bodies, so "
+                      "nothing is contact-only; leave the key out", RiprapWarning, stacklevel=2)
     settings = case.simulation
     source = Path(case.source)
     simulation = Simulation(
@@ -138,6 +147,50 @@ def build_fluid_run(case, *, output_directory=None, progress: bool = True):
     simulation.run_definition = RunDefinition.of(case)
     _warn_if_too_short_to_analyse(case, simulation)
     return simulation
+
+
+def _choose_contact_only_bodies(case, simulation, fluid) -> None:
+    """Make the fixed bodies under ``[fluid] contact_only_below_cells`` contact-only, with the
+    porous filter zone the flow sees in their place (``riprap.coupling.filter_layer``); without
+    the key, warn of fixed bodies too small for the grid. ``simulation.filter_layer`` keeps the
+    choice for the run's log and ``riprap check``."""
+    import warnings
+
+    threshold = case.fluid.contact_only_below_cells
+    solver, h = simulation.solver, fluid.grid.cell_size
+    simulation.filter_layer = None
+    if threshold <= 0.0:
+        small = unresolved_fixed_bodies(solver, h)
+        if len(small):
+            cells = nominal_cells(solver, h)
+            fixed = solver.body_poses()[4]
+            free = cells[~fixed]
+            between = (f"; e.g. {0.5 * (cells[small].max() + free.min()):.2g}, between them and "
+                       f"the free bodies' {free.min():.2f}" if len(free)
+                       and free.min() > cells[small].max() else "")
+            warnings.warn(
+                f"{case.source}: {len(small)} fixed bodies span fewer than "
+                f"{UNRESOLVED_BELOW_CELLS:g} cells of the fluid grid ({cells[small].min():.2f}-"
+                f"{cells[small].max():.2f}): clipped into the flow, their cut faces hold the water "
+                "with a drag that depends on the time step, not a filter's; give [fluid] "
+                "contact_only_below_cells to make them contact-only under a porous filter zone"
+                f"{between} (docs/waves.md, Filter layers)", RiprapWarning, stacklevel=3)
+        return
+    where = f"{case.source}"
+    if simulation.deformable_bodies:
+        raise CaseFileError(f"{where} [fluid] contact_only_below_cells: not for runs with "
+                            "deformable bodies (their coupling keeps every rigid body in the "
+                            "flow); leave the key out")
+    zones = fluid.porous.zones if fluid.porous is not None else []
+    layer = choose_filter_layer(solver, zones, cell_size=h, contact_only_below_cells=threshold,
+                                where=where)
+    if layer.fitted:
+        # the case's own zones come after the fitted ones: where they overlap, the case's win
+        fluid.add_porous_zones(layer.fitted + list(zones))
+    simulation.contact_only_bodies = [int(body) for body in layer.bodies]
+    simulation.filter_layer = layer
+    if not len(layer.bodies):
+        warnings.warn(f"{where}: {layer.lines()[0]}", RiprapWarning, stacklevel=3)
 
 
 def _warn_if_too_short_to_analyse(case, simulation) -> None:

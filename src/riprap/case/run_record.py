@@ -36,6 +36,9 @@ _NOT_KEYS = ("format_version", "source", "base_dir")
 # Tables recorded only when the case has entries, so that a checkpoint written before they
 # existed restarts (its record has no count of them).
 _RECORDED_WHEN_GIVEN = ("friction",)
+# Keys recorded only when given (not at their default, "off"), so that a checkpoint written
+# before they existed restarts.
+_KEYS_RECORDED_WHEN_GIVEN = {("fluid", "contact_only_below_cells"): 0.0}
 # Above this many entries, a [[table]] keeps one fingerprint per entry.
 _LISTED_ENTRIES = 100
 
@@ -110,6 +113,8 @@ def case_record(case) -> dict[str, str]:
         if table == "waves":
             fields = _effective_waves(case, fields)
         for key, item in fields.items():
+            if _KEYS_RECORDED_WHEN_GIVEN.get((table, key), ()) == item:
+                continue
             if not _may_change(table, key):
                 record[f"[{table}] {key}"] = _text(item)
     return record

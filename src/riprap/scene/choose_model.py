@@ -97,7 +97,10 @@ def _coupled_model(scene: Scene, settings: ModelSettings, restarted: bool) -> Co
                        restarted=restarted)
     except OverlapError as error:
         raise name_obstacles_in_overlap(error, obstacle_bodies, boxes) from None
-    return CoupledModel(CoupledSolver(scene.fluid, scene.solver, obstacle_bodies=obstacle_bodies,
+    # Contact-only bodies are left out of the exchange as the obstacles are: the flow holds
+    # nothing of them (riprap.coupling.filter_layer: a porous zone stands for them).
+    left_out = obstacle_bodies + list(scene.contact_only_bodies)
+    return CoupledModel(CoupledSolver(scene.fluid, scene.solver, obstacle_bodies=left_out,
                                       adaptive_substep=settings.adaptive_time_step))
 
 
@@ -137,6 +140,10 @@ def _deformable_coupled_model(scene: Scene, settings: ModelSettings,
     the case's walls bound them."""
     _refuse_adaptive_step(settings)
     solver, fluid = scene.solver, scene.fluid
+    if scene.contact_only_bodies:
+        raise CaseFileError("contact-only bodies (fixed bodies the flow does not see) are not for "
+                            "runs with deformable bodies: their coupling keeps every rigid body "
+                            "in the flow")
     if "coupled solver" in scene.holds():
         raise CaseFileError("deformable bodies cannot join a CoupledSolver built by the caller: "
                             "give the Simulation a FluidSolver")

@@ -62,6 +62,9 @@ class Scene:
         #: resting overlaps (m) of a pack's contacts that involve deformable bodies.
         self.deformable_case_index: list[int] = []
         self.deformable_accepted_depths: dict[tuple[int, int], float] = {}
+        #: Fixed bodies the flow does not see (``riprap.coupling.filter_layer``): left out of the
+        #: fluid exchange (``CoupledSolver(obstacle_bodies=...)``), met by the other bodies.
+        self.contact_only_bodies: list[int] = []
 
     # ------------------------------------------------------------------ what it holds
     def holds(self) -> frozenset[str]:

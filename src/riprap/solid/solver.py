@@ -174,6 +174,21 @@ class SolidSolver:
             return [self.shapes[s] for s, fixed in zip(self.shape_index, self.fixed) if not fixed]
         return [self.shapes[row[0]] for row in self._body_rows if not row[6]]
 
+    def body_poses(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Every body's shape index (n,), material index (n,), centroid (n, 3) m, orientation of
+        its principal frame (n, 4) (w, x, y, z) and whether it is fixed (n,), before or after
+        :meth:`finalize` (after it: where the bodies are now)."""
+        if self._ready:
+            return (self.shape_index.copy(), self.material_index_of_body.copy(),
+                    self.positions.copy(), self.quaternions.copy(), self.fixed.copy())
+        rows = self._body_rows
+        n = len(rows)
+        return (np.array([r[0] for r in rows], dtype=np.int64),
+                np.array([r[1] for r in rows], dtype=np.int64),
+                np.array([r[2] for r in rows], dtype=np.float64).reshape(n, 3),
+                np.array([r[3] for r in rows], dtype=np.float64).reshape(n, 4),
+                np.array([r[6] for r in rows], dtype=np.bool_))
+
     def restore_state(self, arrays: dict, time_step: float) -> None:
         """Continue from a checkpoint's state arrays at ``time_step`` (s): the arrays built and
         the state loaded, without evaluating forces again."""

@@ -31,6 +31,9 @@ class CheckReport:
     #: The friction coefficient of each pair of materials that can meet, and where it came from
     #: (riprap.solid.materials.PairFriction).
     friction: list = field(default_factory=list)
+    #: The contact-only bodies and the filter zones the flow sees in their place
+    #: (riprap.coupling.filter_layer.FilterLayer), or None.
+    filter_layer: object = None
 
 
 def check_case(case: Case, *, output_directory=None, restart=None) -> CheckReport:
@@ -78,6 +81,10 @@ def check_case(case: Case, *, output_directory=None, restart=None) -> CheckRepor
         if run.coupled:
             report.checked.append("bodies: meshes, overlaps, inside the fluid box, cells across")
             report.checked.append(_bodies_step(run))
+            report.filter_layer = run.filter_layer
+            if run.filter_layer is not None and len(run.filter_layer.bodies):
+                report.checked.append("contact-only bodies and their filter zones: covered, "
+                                      "clear of the free bodies")
     else:
         sim = build_simulation(case, output_directory=out, progress=False)
         sim.prepare()

@@ -139,12 +139,15 @@ def check_series(case, output_directory=None, seed_offset: int = 0) -> list[str]
     first step, the output folder's series record); returns what was checked, in words."""
     out = Path(output_directory or case.output.directory)
     steps = _steps(case, out, seed_offset)
-    build_fluid_run(steps[0].case, output_directory=steps[0].folder, progress=False)
+    first = build_fluid_run(steps[0].case, output_directory=steps[0].folder, progress=False)
     if out.is_dir():
         _claim_folder(out, _record(case, steps, seed_offset), write=False)
+    layer = first.filter_layer
     return [f"{len(steps)} steps: each step's sea in the flume (as [waves]), Hm0 "
             + ", ".join(f"{s.sea.significant_height:g}" for s in steps) + " m",
             f"bodies of the first step ({case.body_count})",
+            *([] if layer is None
+              else [f"filter layer: {line}" for line in layer.lines(entries=False)]),
             f"the series folder {out} (a series of this case and riprap version, or none)"]
 
 
