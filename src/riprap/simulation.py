@@ -265,6 +265,7 @@ class Simulation:
     deformable_case_index = _OfScene()
     deformable_accepted_depths = _OfScene()
     contact_only_bodies = _OfScene()
+    cut_faces = _OfScene()
 
     add_material = _of_scene(Scene.add_material)
     add_friction_pair = _of_scene(Scene.add_friction_pair)

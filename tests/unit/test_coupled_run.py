@@ -145,3 +145,41 @@ def test_an_adaptive_substep_restarts_bit_for_bit(tmp_path):
     for name in ("u", "w", "fraction", "pressure", "bodies_positions", "bodies_velocities",
                  "coupling_substep"):
         assert np.array_equal(a[name], b[name]), name
+
+
+def _own_velocity_case(tmp_path, end_time, treatment='"own_velocity"'):
+    path = tmp_path / f"own_{end_time}.toml"
+    path.write_text(CASE.format(end_time=end_time).replace(
+        "surface_tension = 0.0\n", f"surface_tension = 0.0\ncut_faces = {treatment}\n"))
+    return path
+
+
+def test_own_velocity_cut_faces_run_from_a_case_and_restart_bit_for_bit(tmp_path):
+    """[fluid] cut_faces = "own_velocity" reaches the coupling, and the fluid's excess on the
+    cut faces rides in the checkpoint: a restart continues to the bit (docs/coupling.md)."""
+    unbroken, pieces = tmp_path / "unbroken", tmp_path / "pieces"
+    assert main(["run", str(_own_velocity_case(tmp_path, 0.1)), "--out", str(unbroken),
+                 "--quiet"]) == 0
+    assert main(["run", str(_own_velocity_case(tmp_path, 0.05)), "--out", str(pieces),
+                 "--quiet"]) == 0
+    assert main(["run", str(_own_velocity_case(tmp_path, 0.1)), "--out", str(pieces), "--quiet",
+                 "--restart", str(pieces / "checkpoint.npz")]) == 0
+    a, _ = load_checkpoint(unbroken / "checkpoint.npz")
+    b, _ = load_checkpoint(pieces / "checkpoint.npz")
+    assert np.any(a["coupling_carried_excess"] != 0.0), "the water in the cut faces keeps its own"
+    for name in ("u", "v", "w", "fraction", "bodies_positions", "bodies_velocities",
+                 "bodies_fluid_loads", "coupling_carried_excess"):
+        assert np.array_equal(a[name], b[name]), name
+    mixture = tmp_path / "mixture"
+    assert main(["run", str(_case(tmp_path, 0.1)), "--out", str(mixture), "--quiet"]) == 0
+    m, _ = load_checkpoint(mixture / "checkpoint.npz")
+    assert not np.array_equal(a["bodies_velocities"], m["bodies_velocities"]), \
+        "the treatment changes the run"
+
+
+def test_an_unknown_cut_face_treatment_in_a_case_is_refused(tmp_path, capsys):
+    path = _own_velocity_case(tmp_path, 0.1, treatment='"sharp"')
+    assert main(["run", str(path), "--out", str(tmp_path / "run"), "--quiet"]) == 2
+    error = capsys.readouterr().err
+    assert "cut_faces" in error and "own_velocity" in error
+    assert not (tmp_path / "run").exists()

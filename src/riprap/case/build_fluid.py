@@ -126,6 +126,7 @@ def build_fluid_run(case, *, output_directory=None, progress: bool = True):
         simulation = build_simulation(case, output_directory=output_directory, progress=progress)
         simulation.add_fluid(fluid)
         _choose_contact_only_bodies(case, simulation, fluid)
+        simulation.cut_faces = case.fluid.cut_faces
         simulation.prepare()
         _warn_if_too_short_to_analyse(case, simulation)
         return simulation

@@ -38,7 +38,8 @@ _NOT_KEYS = ("format_version", "source", "base_dir")
 _RECORDED_WHEN_GIVEN = ("friction",)
 # Keys recorded only when given (not at their default, "off"), so that a checkpoint written
 # before they existed restarts.
-_KEYS_RECORDED_WHEN_GIVEN = {("fluid", "contact_only_below_cells"): 0.0}
+_KEYS_RECORDED_WHEN_GIVEN = {("fluid", "contact_only_below_cells"): 0.0,
+                             ("fluid", "cut_faces"): "mixture"}
 # Above this many entries, a [[table]] keeps one fingerprint per entry.
 _LISTED_ENTRIES = 100
 

@@ -101,7 +101,8 @@ def _coupled_model(scene: Scene, settings: ModelSettings, restarted: bool) -> Co
     # nothing of them (riprap.coupling.filter_layer: a porous zone stands for them).
     left_out = obstacle_bodies + list(scene.contact_only_bodies)
     return CoupledModel(CoupledSolver(scene.fluid, scene.solver, obstacle_bodies=left_out,
-                                      adaptive_substep=settings.adaptive_time_step))
+                                      adaptive_substep=settings.adaptive_time_step,
+                                      cut_faces=scene.cut_faces))
 
 
 def _refuse_adaptive_step(settings: ModelSettings) -> None:
@@ -144,6 +145,9 @@ def _deformable_coupled_model(scene: Scene, settings: ModelSettings,
         raise CaseFileError("contact-only bodies (fixed bodies the flow does not see) are not for "
                             "runs with deformable bodies: their coupling keeps every rigid body "
                             "in the flow")
+    if scene.cut_faces != "mixture":
+        raise CaseFileError(f"[fluid] cut_faces = {scene.cut_faces!r} is for rigid bodies: the "
+                            "coupling of deformable bodies keeps the \"mixture\" cut faces")
     if "coupled solver" in scene.holds():
         raise CaseFileError("deformable bodies cannot join a CoupledSolver built by the caller: "
                             "give the Simulation a FluidSolver")
