@@ -671,10 +671,13 @@ KEYS: tuple[Key, ...] = (
         "faces and the step): \"mixture\", the face's one velocity of water and body, taken the "
         "body's solid fraction of the way to the body every step (verified against ten Cate and "
         "the floating box; the load on a moving body grows as the step shrinks: a towed cube's "
-        "drag 1.32-1.81 times the dynamic pressure at 3 cells across); \"own_velocity\", the "
+        "drag 1.47, 1.27 and 1.11 times the dynamic pressure at 3, 4.5 and 6 cells across, 14-18 "
+        "% more at a step 4 times shorter); \"own_velocity\", the "
         "water's own velocity, drawn to the body at a rate per second, the bodies' faces counted "
-        "in their frame (the towed cube 0.93-0.98, Hoerner's 1.05, whatever the step; ten Cate's "
-        "low-Reynolds sphere falls 8 % too fast at 4 cells across). Rigid bodies only.",
+        "in their frame (the towed cube's drag changes 4-12 % for a step 4 times shorter, against "
+        "14-18 %, but is 0.91, 0.75 and 0.77 of the dynamic pressure at 3, 4.5 and 6 cells across "
+        "where Hoerner gives 1.05; ten Cate's low-Reynolds sphere falls 8 % too fast at 4 cells "
+        "across): an option to study, not yet a method to trust. Rigid bodies only.",
         default="mixture", choices=("mixture", "own_velocity")),
     # [[water_regions]]
     Key("water_regions", "type", "string", "-", "Kind of region; selects the keys below.",

@@ -79,10 +79,10 @@ SUBSTEP_MAX_OVER_ESTIMATE = 30.0
 #: at 3 cells per side: C_D 1.32, 1.69, 1.81 at Courant numbers 0.3, 0.075, 0.019 against about
 #: 1.05). "own_velocity": the fluid's own velocity, taken towards the body's at a rate per
 #: second (``rigid_coupling.cut_face_grip``), and the predictor's change of the bodies' faces
-#: counted in the bodies' frame (``_in_the_bodies_frame``): the towed cube's C_D 0.93, 0.96,
-#: 0.98 at Courant 0.2, 0.05, 0.0125; but ten Cate's sphere (Re 4) falls 8 % too fast at 4
-#: cells per diameter and 4 % at 6 (the cut faces' fluid slips where a resolved boundary layer
-#: would hold it), so it is not yet the default.
+#: counted in the bodies' frame (``_in_the_bodies_frame``): the towed cube's drag changes by
+#: 4-12 % for a step four times shorter (the default 14-18 %), but falls with resolution (0.91,
+#: 0.75, 0.77 at 3, 4.5, 6 cells across against Hoerner's 1.05), and ten Cate's sphere (Re 4)
+#: falls 8 % too fast at 4 cells per diameter and 4 % at 6: an option to study, not the default.
 CUT_FACE_TREATMENTS = ("mixture", "own_velocity")
 #: With "own_velocity": the viscous renewal rate of the fluid in a cut face is this times
 #: nu / d^2, d = (1 - phi) h the face's open width: the wall shear mu u / (d / 2) on a film of
