@@ -758,13 +758,16 @@ class CoupledSolver:
         # The fluid's load on a free body: its own momentum change (fixed bodies': _output_loads).
         loads = (rhs - np.einsum("bij,bj->bi", body_matrices, predicted_dry)
                  - np.einsum("bij,bj->bi", matrices - body_matrices, final)) / dt
-        gripped, rigid = faces.zeros(), faces.zeros()
+        gripped = faces.zeros()
         rigid_coupling.accumulate_rigid(self._body_faces(faces), centres, final, faces.phi, grip,
                                         gripped)
-        rigid_coupling.accumulate_rigid(self._body_faces(faces), centres, final, faces.phi,
-                                        self._ones(faces), rigid)
         fluid_after = kept * fluid_own + gripped
-        after = fluid_share * fluid_after + rigid if own_velocity else fluid_after
+        after = fluid_after
+        if own_velocity:    # the face holds the mixture; the "mixture" treatment's grip is 1
+            rigid = faces.zeros()
+            rigid_coupling.accumulate_rigid(self._body_faces(faces), centres, final, faces.phi,
+                                            self._ones(faces), rigid)
+            after = fluid_share * fluid_after + rigid
         faces.scatter(after, (u, v, w))
         # The projected field is divergence free; the water and the mass of the next step move
         # with it (FluidSolver.predict's advecting), not with the rigid motion written above.
