@@ -27,6 +27,15 @@ last ``METRIC damage_curve_wall_s <seconds> s`` (the wall time of this call; the
 done before it are not counted again).
 
     python bench/damage_curve.py [--out DIR] [--waves N] [--steps 1.8,2.4,3.0,3.6]
+        [--first-seed K] [--cut-faces own_velocity] [--filter-below-cells 4]
+        [--concrete-on-rock 0.7]
+
+Issue 51's options (their defaults are the curve as first run): ``--first-seed K`` gives the steps
+the seeds K, K+1, ... (the series numbers its steps' seeds from 1, so ``--steps 2.4
+--first-seed 2`` runs the sea of the ladder's step 2 alone, on the freshly placed layer);
+``--cut-faces`` the ``[fluid] cut_faces`` treatment; ``--filter-below-cells`` makes the
+underlayer rocks contact-only under a fitted filter zone (``[fluid] contact_only_below_cells``);
+``--concrete-on-rock`` a ``[[friction]]`` pair for the cubes on the rocks.
 """
 import argparse
 import math
@@ -120,7 +129,9 @@ directory = "pack"
 """
 
 
-def series_case(steps: list[float], waves: int) -> str:
+def series_case(steps: list[float], waves: int, *, first_seed: int = 1,
+                cut_faces: str = "mixture", filter_below_cells: float = 0.0,
+                concrete_on_rock: float | None = None) -> str:
     crest = DEPTH + FREEBOARD
     top_x = crest * COT
     ladder = "".join(f"""
@@ -128,7 +139,13 @@ def series_case(steps: list[float], waves: int) -> str:
 significant_height = {ns * DELTA * DN:.4f}
 wave_steepness = {STEEPNESS}
 waves = {waves}
-""" for ns in steps)
+""" + (f"seed = {first_seed + k}\n" if first_seed != 1 else "") for k, ns in enumerate(steps))
+    fluid_options = f'cut_faces = "{cut_faces}"\n' if cut_faces != "mixture" else ""
+    if filter_below_cells > 0:
+        fluid_options += f"contact_only_below_cells = {filter_below_cells:g}\n"
+    friction = ("" if concrete_on_rock is None else
+                f'[[friction]]\nmaterials = ["concrete", "rock"]\n'
+                f"friction_coefficient = {concrete_on_rock:g}\n\n")
     length = 4.1
     height = 0.75
     # three gauges for the incident waves, 0.3 and 0.6 m apart (0.07-0.33 of the wave lengths)
@@ -151,8 +168,8 @@ cells = [{round(length / CELL)}, {round(WIDTH / CELL) + 1}, {round(height / CELL
 surface_tension = 0.0
 limit_air_speed = true
 pressure_volume_tolerance = 1e-3
-
-[[water_regions]]
+{fluid_options}
+{friction}[[water_regions]]
 type = "level"
 level = {DEPTH}
 
@@ -198,6 +215,11 @@ def main() -> None:
     parser.add_argument("--waves", type=int, default=50)
     parser.add_argument("--steps", default="1.8,2.4,3.0,3.6",
                         help="stability numbers Hm0 / (Delta Dn) of the steps")
+    parser.add_argument("--first-seed", type=int, default=1,
+                        help="seed of the first step's sea (the next steps count on from it)")
+    parser.add_argument("--cut-faces", default="mixture", choices=("mixture", "own_velocity"))
+    parser.add_argument("--filter-below-cells", type=float, default=0.0)
+    parser.add_argument("--concrete-on-rock", type=float, default=None)
     args = parser.parse_args()
     out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
@@ -210,7 +232,9 @@ def main() -> None:
               f"packing density {summary.get('packing_density_coefficient', float('nan')):.3f}, "
               f"{time.perf_counter() - started:.0f} s")
     steps = [float(v) for v in args.steps.split(",")]
-    (out / "series.toml").write_text(series_case(steps, args.waves))
+    (out / "series.toml").write_text(series_case(
+        steps, args.waves, first_seed=args.first_seed, cut_faces=args.cut_faces,
+        filter_below_cells=args.filter_below_cells, concrete_on_rock=args.concrete_on_rock))
     results = run_series(load_case(out / "series.toml"), output_directory=out / "series",
                          progress=False)
     curve = results["curve"]

@@ -23,11 +23,16 @@ measured here yet.
 from __future__ import annotations
 
 import argparse
+import tempfile
 import time
+import warnings
 
 import numpy as np
 
+from riprap.benchmarks import held_cube_flume
 from riprap.benchmarks.towing_tank import tow, towing_tank
+from riprap.case.build_fluid import build_fluid_run
+from riprap.case.load import load_case
 from riprap.coupling.coupled import CUT_FACE_TREATMENTS
 
 SIDE = 0.05            # m, the cube's side (the damage curve's units are 4.6 cm)
@@ -54,12 +59,81 @@ def towed_cube_drag(cells_per_side: float, *, dt_scale: float = 1.0,
             "wall_s": time.perf_counter() - started}
 
 
+def held_cube_loads(cells_per_dn: float, max_time_step: float, cut_faces: str = "mixture") -> dict:
+    """The fluid's force on the cube held on the flume's slope (``held_cube_flume``) at every
+    fluid step over its ten recorded periods: rms and peak of F_x and F_z (N), and their mean."""
+    with tempfile.TemporaryDirectory() as folder:
+        case = load_case(held_cube_flume.held_cube_case(folder, cells_per_dn, max_time_step,
+                                                        cut_faces))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            simulation = build_fluid_run(case, output_directory=f"{folder}/out", progress=False)
+        coupled = simulation.model.solver
+        rows = []
+        step = coupled.step
+
+        def recorded(dt=None):
+            report = step(dt)
+            if report.time > held_cube_flume.RECORD_FROM:
+                force = coupled.pressure_loads[held_cube_flume.CUBE, :3] \
+                    + coupled.viscous_loads[held_cube_flume.CUBE, :3]
+                rows.append((report.time, report.time_step, *force))
+            return report
+
+        coupled.step = recorded
+        started = time.perf_counter()
+        simulation.run()
+        wall = time.perf_counter() - started
+    rows = np.array(rows)
+    weights = rows[:, 1] / rows[:, 1].sum()          # time averages over unequal steps
+    out = {"cells_per_dn": cells_per_dn, "max_time_step_s": max_time_step, "cut_faces": cut_faces,
+           "steps": len(rows), "mean_step_s": float(rows[:, 1].mean()), "wall_s": wall}
+    for name, column in (("x", 2), ("z", 4)):
+        force = rows[:, column]
+        mean = float(np.sum(weights * force))
+        out[f"mean_F{name}_N"] = mean
+        out[f"rms_F{name}_N"] = float(np.sqrt(np.sum(weights * (force - mean) ** 2)))
+        out[f"peak_F{name}_N"] = float(np.abs(force).max())
+    return out
+
+
+def flume_part(cells: list[float], treatment: str) -> None:
+    """The held cube at ``max_time_step`` 5 and 1.25 ms at each resolution; prints the rows and
+    the largest relative change of the rms forces."""
+    results = {}
+    for n in cells:
+        for longest in (0.005, 0.00125):
+            row = held_cube_loads(n, longest, treatment)
+            results[(n, longest)] = row
+            print(f"flume {treatment:13s} {n:4.1f} cells per Dn, max step {longest * 1e3:.2f} ms "
+                  f"(mean {row['mean_step_s'] * 1e3:.2f} ms, {row['steps']} steps): "
+                  f"F_x rms {row['rms_Fx_N']:.3f} peak {row['peak_Fx_N']:.3f} N, "
+                  f"F_z mean {row['mean_Fz_N']:.3f} rms {row['rms_Fz_N']:.3f} "
+                  f"peak {row['peak_Fz_N']:.3f} N, {row['wall_s']:.0f} s", flush=True)
+    change = max(abs(results[(n, 0.00125)][key] / results[(n, 0.005)][key] - 1.0)
+                 for n in cells for key in ("rms_Fx_N", "rms_Fz_N"))
+    print(f"flume: the largest change of an rms force from 5 to 1.25 ms: {change:.3f}")
+    if 4.5 in cells and 6.0 in cells:
+        resolution = max(abs(results[(6.0, 0.005)][key] / results[(4.5, 0.005)][key] - 1.0)
+                         for key in ("rms_Fx_N", "rms_Fz_N"))
+        print(f"flume: the largest change of an rms force from 4.5 to 6 cells per Dn: "
+              f"{resolution:.3f}")
+    return change
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cells", type=float, nargs="+", default=[3.0, 4.5, 6.0])
     parser.add_argument("--treatment", nargs="+", default=list(CUT_FACE_TREATMENTS),
                         choices=CUT_FACE_TREATMENTS)
+    parser.add_argument("--flume", action="store_true",
+                        help="the cube held on the flume's slope (riprap.benchmarks."
+                             "held_cube_flume) instead of the towing tank")
     args = parser.parse_args()
+    if args.flume:
+        change = flume_part(args.cells, args.treatment[0])
+        print(f"METRIC load_change_dt_5_to_1_25ms {change:.3f} ratio")
+        return
     results = {}
     for treatment in args.treatment:
         for cells in args.cells:
