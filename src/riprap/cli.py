@@ -103,6 +103,9 @@ def _series_case(path: Path, case, out: str | None, quiet: bool) -> int:
 
     print(f"riprap: test series {path}: {len(case.series_steps)} steps, {case.body_count} bodies")
     results = run_series(case, output_directory=out, progress=not quiet)
+    if results.get("run_mode") == "smoke":
+        print(f"riprap: SMOKE RUN: {results['run_mode_note']}; the figures below are not a "
+              "damage curve")
     curve = results["curve"]
     for k, step in enumerate(curve["step"]):
         print(f"riprap: step {step}: Hm0 {curve['Hm0_m'][k]:.3g} m, N_s "
@@ -116,6 +119,7 @@ def _series_case(path: Path, case, out: str | None, quiet: bool) -> int:
 def _campaign(args) -> int:
     from riprap.workflows.campaign import members_of, run_campaign  # lazy: Dask is optional
 
+    _say_if_smoke()
     members = members_of(args.cases, args.seeds)
     result = run_campaign(members, args.out, workers=args.workers, threads=args.threads,
                           scheduler=args.scheduler)
@@ -124,6 +128,8 @@ def _campaign(args) -> int:
             print(f"riprap: {case_name} step {step}: N_od {columns['N_od_mean'][k]:.3g} "
                   f"({columns['N_od_min'][k]:.3g}..{columns['N_od_max'][k]:.3g}) over "
                   f"{columns['members'][k]} members, S {columns['S_mean'][k]:.3g}")
+    if result.get("run_mode") == "smoke":
+        print(f"riprap: SMOKE RUN: {result['run_mode_note']}; the figures above are not results")
     print(f"riprap: campaign results: {Path(args.out) / 'campaign_results.json'}")
     return 0
 

@@ -344,7 +344,9 @@ def test_a_campaign_folder_of_other_members_or_version_is_refused_before_any_wor
     root, case, _, _ = unbroken
     folder = root / "other_campaign"
     folder.mkdir()
-    record = {"format": 1, "riprap_version": "0.0.1", "members": []}
+    record = {"format": 2, "riprap_version": "0.0.1", "run_mode": "full",
+              "members": [{"name": "other_seed0", "case_file": "/elsewhere/other.toml",
+                           "seed_offset": 0, "fingerprint": "0"}]}
     (folder / CAMPAIGN_RECORD).write_text(json.dumps(record))
     with pytest.raises(RiprapError, match="written by riprap '0.0.1'"):
         run_campaign(members_of([case], [0]), folder, client=object())
@@ -352,7 +354,7 @@ def test_a_campaign_folder_of_other_members_or_version_is_refused_before_any_wor
 
     record["riprap_version"] = riprap_version()
     (folder / CAMPAIGN_RECORD).write_text(json.dumps(record))
-    with pytest.raises(RiprapError, match="a campaign of other members"):
+    with pytest.raises(RiprapError, match="holds the members other_seed0, not given now"):
         run_campaign(members_of([case], [0]), folder, client=object())
     assert json.loads((folder / CAMPAIGN_RECORD).read_text()) == record
     with pytest.raises(CaseFileError, match="given more than once"):

@@ -6,12 +6,14 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import shutil
 from pathlib import Path
 
 from riprap.errors import RiprapError
 
 __all__ = ["OutputFolderError", "prepare_output_folder", "check_output_folder",
-           "describe_os_error", "naming_the_file"]
+           "describe_os_error", "naming_the_file", "move_into",
+           "remove_folder"]
 
 
 class OutputFolderError(RiprapError):
@@ -90,3 +92,30 @@ def prepare_output_folder(path) -> Path:
         raise OutputFolderError(f"cannot write the output folder {folder}: "
                                 f"{describe_os_error(error)}") from None
     return folder
+
+
+def move_into(folder, names, into) -> Path:
+    """Move the entries ``names`` of ``folder`` into the folder ``into`` (made empty first: what
+    it held is removed), keeping their names; the folder's other entries stay."""
+    folder, into = Path(folder), Path(into)
+    try:
+        if into.exists():
+            shutil.rmtree(into)
+        into.mkdir(parents=True)
+        for name in names:
+            os.replace(folder / name, into / name)
+    except OSError as error:
+        raise OutputFolderError(f"cannot move {', '.join(names)} of {folder} into {into}: "
+                                f"{describe_os_error(error)}") from None
+    return into
+
+
+def remove_folder(path) -> None:
+    """Remove the folder ``path`` and what it holds (riprap's own outputs, made again)."""
+    try:
+        shutil.rmtree(path)
+    except FileNotFoundError:
+        pass
+    except OSError as error:
+        raise OutputFolderError(f"cannot remove {path} to write it again: "
+                                f"{describe_os_error(error)}") from None

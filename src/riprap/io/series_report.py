@@ -52,10 +52,27 @@ def _damage_curve_figure(path: Path, results: dict) -> Path:
     right.grid(alpha=0.3)
     if results.get("per_wave"):
         right.legend(fontsize=7)
+    _smoke_title(figure, results)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
     return path
+
+
+def _smoke_title(figure, results: dict) -> None:
+    """A smoke run's figures say so above their axes."""
+    if results.get("run_mode") == "smoke":
+        figure.suptitle("SMOKE RUN (RIPRAP_SMOKE=1): not results", color="C3", fontsize=11)
+
+
+def _smoke_banner(results: dict) -> str:
+    """A smoke run's report says so first."""
+    if results.get("run_mode") != "smoke":
+        return ""
+    return ("<p class='smoke'><b>SMOKE RUN</b> (RIPRAP_SMOKE=1): "
+            + html.escape(results.get("run_mode_note", "every step was cut short"))
+            + ". Nothing on this page is a result: run the series again without RIPRAP_SMOKE "
+            "(into the same folder: the smoke steps are set aside and run in full).</p>")
 
 
 def _overtopping_figure(path: Path, results: dict) -> Path:
@@ -71,6 +88,7 @@ def _overtopping_figure(path: Path, results: dict) -> Path:
     axes.set_ylabel("q (m^3/s per m)")
     axes.legend(fontsize=8)
     axes.grid(alpha=0.3, which="both")
+    _smoke_title(figure, results)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
@@ -111,7 +129,7 @@ def _crest_width_note(results: dict) -> str:
 
 _STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
           "collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 7px;font-size:13px}"
-          "img{max-width:100%}")
+          "img{max-width:100%}.smoke{background:#fde2e1;border:2px solid #c0392b;padding:8px}")
 
 
 def write_series_report(out, results: dict) -> dict:
@@ -123,7 +141,8 @@ def write_series_report(out, results: dict) -> dict:
     curve = results["curve"]
     first = results.get("first_displacement")
     start = results["formulas"]["start_of_damage"]
-    parts = [f"<p>Case {html.escape(results['case_file'])}. A unit is displaced once it moved more "
+    parts = [_smoke_banner(results),
+             f"<p>Case {html.escape(results['case_file'])}. A unit is displaced once it moved more "
              f"than {results['displacement_threshold_over_dn']:g} Dn from where the series "
              "started; every figure below is counted from that start.</p>",
              "<h2>Damage curve</h2>",
@@ -155,8 +174,9 @@ def write_series_report(out, results: dict) -> dict:
                 parts.append(f"<img src='{relative}/survey/{picture.name}' style='max-width:49%'>")
     parts.append("<p>Data: <a href='damage_curve.csv'>damage_curve.csv</a>, "
                  "<a href='series_results.json'>series_results.json</a>.</p>")
-    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>riprap test series</title>"
-            f"<style>{_STYLE}</style></head><body><h1>riprap test series</h1>{''.join(parts)}"
+    title = "riprap test series" + (" (SMOKE RUN)" if results.get("run_mode") == "smoke" else "")
+    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{title}</title>"
+            f"<style>{_STYLE}</style></head><body><h1>{title}</h1>{''.join(parts)}"
             "</body></html>\n")
     (out / "report.html").write_text(page, encoding="utf-8")
     outputs["report"] = str(out / "report.html")

@@ -8,17 +8,22 @@ with ``threads`` numba threads of its own. The scheduler is a ``LocalCluster`` o
 default, or the one at ``scheduler`` (``tcp://host:8786``; a SLURM or PBS cluster made with
 dask-jobqueue gives one); ``client`` takes a ``dask.distributed.Client`` the caller made.
 
-Resuming: the campaign folder records the riprap version and its members (``campaign.json``); a
-folder of another version or other members is refused before anything starts. Every member
-resumes on its own (``run_series``): finished steps are not run again, a step that was cut off
-goes on from its last checkpoint. So a campaign killed or lost, or a member whose worker died,
-is started again with the same command.
+Resuming and growing: the campaign folder records the riprap version, the run mode (smoke or
+full) and its members (``campaign.json``); a folder of another version, or whose members were run
+from other cases, is refused before anything starts. Members may be added (``--seeds 0 1 2`` after
+``0 1``: only seed 2 runs), not dropped. Every member resumes on its own (``run_series``):
+finished steps are not run again, a step that was cut off goes on from its last checkpoint, smoke
+steps are run again in full, and a change of a survey key only surveys the steps again. So a
+campaign killed or lost, or a member whose worker died, is started again with the same command.
+A smoke campaign (``RIPRAP_SMOKE=1``) over a full one is refused; the mode is handed to every
+worker (a remote worker's own environment does not decide it).
 
 Dask is optional: ``pip install 'riprap[campaign]'``; riprap and single runs work without it.
 """
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,12 +36,15 @@ from riprap.io.json_files import read_json_object, write_json
 from riprap.io.output_folder import prepare_output_folder
 from riprap.io.pack import riprap_version
 from riprap.io.csv_tables import write_columns_csv
-from riprap.workflows.series import check_series, run_series, series_fingerprint
+from riprap.workflows.series import check_series, run_series
+from riprap.workflows.series_record import (RUN_MODES, mode_words, run_mode, series_fingerprint,
+                                            smoke_note)
 
 __all__ = ["Member", "members_of", "run_campaign", "CAMPAIGN_RECORD", "SCHEDULER_TIMEOUT_S"]
 
 CAMPAIGN_RECORD = "campaign.json"
-CAMPAIGN_FORMAT = 1
+#: Its format: 2 records the run mode and lets members be added (2026-12).
+CAMPAIGN_FORMAT = 2
 #: Seconds a scheduler address is given to answer before the campaign is refused.
 SCHEDULER_TIMEOUT_S = 5.0
 
@@ -70,10 +78,16 @@ def members_of(case_files, seeds=(0,)) -> list[Member]:
     return members
 
 
-def _run_member(case_file: str, folder: str, seed_offset: int, threads: int) -> dict:
-    """A member on a worker: its series, with ``threads`` numba threads (no progress bar)."""
+def _run_member(case_file: str, folder: str, seed_offset: int, threads: int,
+                mode: str = "full") -> dict:
+    """A member on a worker: its series, with ``threads`` numba threads (no progress bar), in the
+    campaign's run ``mode`` whatever the worker's own environment says."""
     import numba
 
+    if mode == "smoke":
+        os.environ["RIPRAP_SMOKE"] = "1"
+    else:
+        os.environ.pop("RIPRAP_SMOKE", None)
     numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     lines = []
     results = run_series(load_case(case_file), output_directory=folder, progress=False,
@@ -102,28 +116,57 @@ def _client(scheduler: str | None, workers: int, threads: int):
     return Client(cluster), cluster
 
 
-def _claim(out: Path, members: list[Member], fingerprints: list[str], *,
-           write: bool = True) -> None:
-    """Refuse a campaign folder of another riprap version or other members (nothing in it is
-    touched); otherwise record the campaign there (``write``)."""
-    record = {"format": CAMPAIGN_FORMAT, "riprap_version": riprap_version(),
-              "members": [{"name": m.name, "case_file": str(m.case_file),
-                           "seed_offset": m.seed_offset, "fingerprint": f}
-                          for m, f in zip(members, fingerprints)]}
+def _claim(out: Path, members: list[Member], fingerprints: list[str]) -> str:
+    """Refuse a campaign folder of another riprap version, a smoke campaign over a full one, or
+    one whose members were run from other cases or that this campaign would drop (nothing in it
+    is touched); returns what this campaign adds to it, in words ("" when nothing)."""
+    mode = run_mode()
     path = out / CAMPAIGN_RECORD
-    if path.is_file():
-        old = read_json_object(path, "campaign record", "riprap campaign wrote it")
-        if old.get("format") != CAMPAIGN_FORMAT or old.get("riprap_version") != riprap_version():
-            raise RiprapError(f"{path}: a campaign written by riprap {old.get('riprap_version')!r}, "
-                              f"this is {riprap_version()}; nothing in it is resumed or "
-                              "overwritten: give another --out folder")
-        if old.get("members") != record["members"]:
-            before = ", ".join(m.get("name", "?") for m in old.get("members", []))
-            raise RiprapError(f"{path}: a campaign of other members or cases ({before}); "
-                              "nothing in it is resumed or overwritten: give another --out "
-                              "folder, or the same cases and seeds as before")
-    if write:
-        write_json(path, record)
+    if not path.is_file():
+        return ""
+    old = read_json_object(path, "campaign record", "riprap campaign wrote it")
+    if old.get("format") != CAMPAIGN_FORMAT or old.get("riprap_version") != riprap_version():
+        raise RiprapError(f"{path}: a campaign written by riprap {old.get('riprap_version')!r} "
+                          f"(format {old.get('format')!r}), this is {riprap_version()} (format "
+                          f"{CAMPAIGN_FORMAT}); nothing in it is resumed or overwritten: give "
+                          "another --out folder")
+    if old.get("run_mode") not in RUN_MODES:
+        raise RiprapError(f"{path}: run_mode = {old.get('run_mode')!r} is not one riprap writes "
+                          f"({' or '.join(RUN_MODES)}): the record was edited or damaged; nothing "
+                          "in it is resumed or overwritten: give another --out folder")
+    if mode == "smoke" and old.get("run_mode") != "smoke":
+        raise RiprapError(f"{path}: a campaign run in full; {mode_words('smoke')} would "
+                          "overwrite its members' steps: give the smoke campaign another --out "
+                          "folder, or run without RIPRAP_SMOKE")
+    new = {m.name: (m, f) for m, f in zip(members, fingerprints)}
+    before = {entry.get("name"): entry for entry in old.get("members", [])}
+    dropped = [name for name in before if name not in new]
+    if dropped:
+        raise RiprapError(f"{path}: this campaign holds the members {', '.join(dropped)}, not "
+                          "given now; a campaign grows, it does not shrink: give them too (the "
+                          "same cases and --seeds as before, and any new ones), or another --out "
+                          "folder")
+    changed = []
+    for name, entry in before.items():
+        member, fingerprint = new[name]
+        if entry.get("case_file") != str(member.case_file):
+            changed.append(f"{name}: case file {entry.get('case_file')} -> {member.case_file}")
+        elif (entry.get("fingerprint") != fingerprint and old.get("run_mode") == mode):
+            changed.append(f"{name}: its case {member.case_file} changed since (its series.json "
+                           "holds the keys it was run from)")
+    if changed:
+        raise RiprapError(f"{path}: members run from other cases ({'; '.join(changed)}); nothing "
+                          "in it is resumed or overwritten: give another --out folder, or restore "
+                          "the cases")
+    added = [name for name in new if name not in before]
+    return f"members added: {', '.join(added)} (the others resume)" if added else ""
+
+
+def _record(members: list[Member], fingerprints: list[str]) -> dict:
+    return {"format": CAMPAIGN_FORMAT, "riprap_version": riprap_version(), "run_mode": run_mode(),
+            "members": [{"name": m.name, "case_file": str(m.case_file),
+                         "seed_offset": m.seed_offset, "fingerprint": f}
+                        for m, f in zip(members, fingerprints)]}
 
 
 def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int = 1,
@@ -142,17 +185,20 @@ def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int =
                                 "case needs [series] and [[series_steps]]")
         check_series(case, out / member.name, member.seed_offset)
     fingerprints = [series_fingerprint(cases[m.case_file]) for m in members]
-    _claim(out, members, fingerprints, write=False)      # before any worker starts
+    growth = _claim(out, members, fingerprints)      # before any worker starts
     own_cluster = None
     if client is None:
         client, own_cluster = _client(scheduler, workers, threads)
     try:
         prepare_output_folder(out)
-        _claim(out, members, fingerprints)
+        write_json(out / CAMPAIGN_RECORD, _record(members, fingerprints))
         say(f"riprap: campaign of {len(members)} members on the Dask scheduler "
-            f"{getattr(client.scheduler, 'address', '')}: " + ", ".join(m.name for m in members))
+            f"{getattr(client.scheduler, 'address', '')}: " + ", ".join(m.name for m in members)
+            + (f"; {growth}" if growth else "")
+            + (f"; {mode_words('smoke')}" if run_mode() == "smoke" else ""))
         futures = [client.submit(_run_member, str(m.case_file), str(out / m.name), m.seed_offset,
-                                 threads, key=f"riprap-{m.name}", pure=False) for m in members]
+                                 threads, run_mode(), key=f"riprap-{m.name}", pure=False)
+                   for m in members]
         results, failed = {}, {}
         for member, future in zip(members, futures):
             try:
@@ -166,17 +212,21 @@ def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int =
             client.close()
             own_cluster.close()
     if failed:
-        write_json(out / "campaign_results.json", {"members": results, "failed": failed})
+        write_json(out / "campaign_results.json", {"run_mode": run_mode(), "members": results,
+                                                   "failed": failed})
         raise RiprapError(
             f"{len(failed)} of {len(members)} campaign members failed ("
             + "; ".join(f"{name}: {why}" for name, why in failed.items())
             + f"); the others are done. Their folders under {out} keep what was done: mend the "
             "cause and start the same command again to resume them")
     summary = _spread(members, results)
-    write_json(out / "campaign_results.json", {"members": results, "spread": summary})
+    campaign = {"run_mode": run_mode(),
+                **({"run_mode_note": smoke_note()} if run_mode() == "smoke" else {}),
+                "members": results, "spread": summary}
+    write_json(out / "campaign_results.json", campaign)
     for case_name, columns in summary.items():
         write_columns_csv(out / f"{case_name}_spread.csv", columns)
-    return {"members": results, "spread": summary}
+    return campaign
 
 
 def _spread(members: list[Member], results: dict) -> dict:

@@ -11,16 +11,19 @@ pictures, report.html) with its *per-wave table* (``survey/per_wave.csv``). At t
 (``damage_curve.csv``, ``damage_curve.png``, ``series_results.json``, ``report.html``) beside the
 design formulas.
 
-Resuming: the series folder records the riprap version and a fingerprint of the case
-(``series.json``); a folder of another version or case is refused before anything runs. A step
-with its ``summary.json`` is done and is not run again; a step with a checkpoint is continued
-from it; the others start from the step before. Every step is checked (the flume can carry its
-sea) before the first one runs.
+Resuming: the series folder records the riprap version, the run mode (smoke or full), the case's
+keys and a fingerprint of them (``series.json``, ``riprap.workflows.series_record``); a folder of
+another version, or one whose steps were run from other keys, is refused before anything runs,
+naming each changed key with its old and new values. A step with its ``summary.json`` is done and
+is not run again; a step with a checkpoint is continued from it; the others start from the step
+before. Smoke steps (``RIPRAP_SMOKE=1``) are never taken for results: a full run sets them aside
+(``smoke_run/``) and runs the steps again, and a smoke run over full steps is refused. When only
+a survey key changed (``[series] displacement_threshold``) the finished steps are surveyed again,
+their own files untouched. Every step is checked (the flume can carry its sea) before the first
+one runs.
 """
 from __future__ import annotations
 
-import hashlib
-import json
 import math
 import time as wallclock
 from dataclasses import dataclass
@@ -32,21 +35,17 @@ from riprap.analysis.series_damage import series_curve
 from riprap.case.build_fluid import build_fluid_run, build_fluid_solver
 from riprap.case.load import parse_case
 from riprap.case.series_steps import step_case_text, step_seas
-from riprap.errors import CaseFileError, RiprapError
+from riprap.errors import CaseFileError
 from riprap.io.json_files import read_json_object, write_json
-from riprap.io.output_folder import prepare_output_folder
-from riprap.io.pack import riprap_version
+from riprap.io.output_folder import prepare_output_folder, remove_folder
 from riprap.io.csv_tables import read_columns_csv, write_columns_csv
 from riprap.io.series_report import write_series_report
 from riprap.workflows.analyse import analyse
+from riprap.workflows.series_record import (SERIES_RECORD, claim_series_folder, run_mode,
+                                            smoke_note, series_fingerprint, series_record,
+                                            set_smoke_steps_aside)
 
-__all__ = ["run_series", "series_fingerprint", "SERIES_RECORD", "step_folder"]
-
-#: The series folder's record: riprap version, case fingerprint, steps.
-SERIES_RECORD = "series.json"
-#: Its format (a folder of another format is refused).
-SERIES_FORMAT = 1
-
+__all__ = ["run_series", "check_series", "series_fingerprint", "SERIES_RECORD", "step_folder"]
 
 def step_folder(out: Path, number: int) -> Path:
     """The folder of step ``number`` (from 1)."""
@@ -59,24 +58,6 @@ class _Step:
     text: str
     case: object
     folder: Path
-
-
-def series_fingerprint(case) -> str:
-    """A fingerprint of what defines the series: the case file's content (as TOML data, not its
-    comments or layout) and the pack it includes, so that a folder written for another case is
-    recognised."""
-    import tomllib
-
-    digest = hashlib.sha256()
-    data = tomllib.loads(Path(case.source).read_text(encoding="utf-8"))
-    data.get("output", {}).pop("directory", None)
-    digest.update(json.dumps(data, sort_keys=True, default=str).encode())
-    pack = data.get("pack")
-    if isinstance(pack, str):
-        pack_path = (Path(case.base_dir) / pack).resolve()
-        if pack_path.is_file():
-            digest.update(pack_path.read_bytes())
-    return digest.hexdigest()
 
 
 def _steps(case, out: Path, seed_offset: int = 0) -> list[_Step]:
@@ -98,40 +79,12 @@ def _steps(case, out: Path, seed_offset: int = 0) -> list[_Step]:
     return steps
 
 
-def _claim_folder(out: Path, record: dict, *, write: bool = True) -> None:
-    """Refuse a folder written by another riprap version or for another case (nothing in it is
-    touched); otherwise record the series there (``write``)."""
-    path = out / SERIES_RECORD
-    if path.is_file():
-        old = read_json_object(path, "series record", "it was written by riprap series")
-        if old.get("format") != SERIES_FORMAT or old.get("riprap_version") != riprap_version():
-            raise RiprapError(
-                f"{path}: this folder holds a series written by riprap "
-                f"{old.get('riprap_version')!r} (format {old.get('format')!r}), this is "
-                f"{riprap_version()} (format {SERIES_FORMAT}); its steps are not resumed or "
-                "overwritten: give another --out folder")
-        if (old.get("fingerprint"), old.get("seed_offset", 0)) != (record["fingerprint"],
-                                                                   record["seed_offset"]):
-            raise RiprapError(
-                f"{path}: this folder holds the series of another case ({old.get('case_file')}, "
-                "or the same file since changed, another pack or other seeds); its steps are not "
-                "resumed or "
-                "overwritten: give another --out folder, or restore that case")
-    elif out.is_dir() and any(step_folder(out, 1).parent.glob("step_*")):
-        raise RiprapError(f"{out}: holds step folders but no {SERIES_RECORD}: not a series riprap "
-                          "wrote; give another --out folder")
-    if write:
-        write_json(path, record)
-
-
 def _record(case, steps: list[_Step], seed_offset: int = 0) -> dict:
-    return {"format": SERIES_FORMAT, "riprap_version": riprap_version(),
-            "case_file": str(Path(case.source).resolve()),
-            "fingerprint": series_fingerprint(case), "seed_offset": int(seed_offset),
-            "steps": [{"step": s.sea.number, "Hm0_m": s.sea.significant_height,
-                       "Tp_s": s.sea.peak_period, "peak_enhancement": s.sea.peak_enhancement,
-                       "seed": s.sea.seed, "waves": s.sea.waves, "sea_duration_s": s.sea.duration,
-                       "end_time_s": s.sea.end_time} for s in steps]}
+    return series_record(case, [
+        {"step": s.sea.number, "Hm0_m": s.sea.significant_height, "Tp_s": s.sea.peak_period,
+         "peak_enhancement": s.sea.peak_enhancement, "seed": s.sea.seed, "waves": s.sea.waves,
+         "sea_duration_s": s.sea.duration, "end_time_s": s.sea.end_time} for s in steps],
+        seed_offset)
 
 
 def check_series(case, output_directory=None, seed_offset: int = 0) -> list[str]:
@@ -140,15 +93,15 @@ def check_series(case, output_directory=None, seed_offset: int = 0) -> list[str]
     out = Path(output_directory or case.output.directory)
     steps = _steps(case, out, seed_offset)
     first = build_fluid_run(steps[0].case, output_directory=steps[0].folder, progress=False)
-    if out.is_dir():
-        _claim_folder(out, _record(case, steps, seed_offset), write=False)
+    claim = claim_series_folder(out, _record(case, steps, seed_offset))
     layer = first.filter_layer
     return [f"{len(steps)} steps: each step's sea in the flume (as [waves]), Hm0 "
             + ", ".join(f"{s.sea.significant_height:g}" for s in steps) + " m",
             f"bodies of the first step ({case.body_count})",
             *([] if layer is None
               else [f"filter layer: {line}" for line in layer.lines(entries=False)]),
-            f"the series folder {out} (a series of this case and riprap version, or none)"]
+            f"the series folder {out} (a series of this case, run mode and riprap version, or "
+            "none)" + (f": {claim.note}" if claim.note else "")]
 
 
 def run_series(case, *, output_directory=None, progress: bool = True, say=print,
@@ -161,8 +114,13 @@ def run_series(case, *, output_directory=None, progress: bool = True, say=print,
     out = Path(output_directory or case.output.directory)
     steps = _steps(case, out, seed_offset)
     record = _record(case, steps, seed_offset)
+    claim = claim_series_folder(out, record)
     prepare_output_folder(out)
-    _claim_folder(out, record)
+    if claim.note:
+        say(f"riprap: series folder {out}: {claim.note}")
+    if claim.set_smoke_aside:
+        set_smoke_steps_aside(out)
+    write_json(out / SERIES_RECORD, record)
     total = sum(s.sea.end_time for s in steps)
     simulated, wall = 0.0, 0.0
     for index, step in enumerate(steps):
@@ -222,9 +180,16 @@ def _survey(step: _Step, first: Path, case, say) -> None:
     """The survey after a step (``survey/``: the layer analysis from the series' start, with its
     ``per_wave.csv``), unless written before."""
     survey = step.folder / "survey"
-    if (survey / "layer_summary.json").is_file():
-        return
     threshold = case.series.displacement_threshold
+    if (survey / "layer_summary.json").is_file():
+        before = read_json_object(survey / "layer_summary.json", "survey's layer summary",
+                                  "delete the step's survey folder to make it again"
+                                  ).get("damage_threshold_over_dn", threshold)
+        if before == threshold:
+            return
+        say(f"riprap: series step {step.sea.number}: surveyed again, [series] "
+            f"displacement_threshold {before:g} -> {threshold:g} (the step is not run again)")
+        remove_folder(survey)
     analysis = analyse(step.folder, out=survey, reference_run=first,
                        displaced_threshold_dn=threshold)
     layer = analysis.layer
@@ -271,6 +236,9 @@ def _series_results(out: Path, steps: list[_Step], case) -> dict:
                            slope_cot=float(flume.get("slope_cot", math.nan)), freeboard=freeboard,
                            crest_width=crest_width, crest_width_source=crest_width_source)
     results["per_wave"] = per_wave
+    results["run_mode"] = run_mode()
+    if results["run_mode"] != "full":
+        results["run_mode_note"] = smoke_note()
     results["case_file"] = str(Path(case.source).resolve())
     results["displacement_threshold_over_dn"] = case.series.displacement_threshold
     results["steps"] = [{"step": s.sea.number, "folder": str(s.folder),
