@@ -164,14 +164,29 @@ def _place_case(path: Path, out: str | None, quiet: bool) -> int:
             print(f"riprap: {key}: {value}")
         return 0
     print(f"riprap: {summary['units_placed']} units placed, {summary['units_at_rest']} at rest, "
-          f"{len(summary['units_rolled_off'])} rolled off; packing density coefficient "
-          f"{summary['packing_density_coefficient']:.3f} (design "
-          f"{summary['design_packing_density_coefficient']:.3f}), porosity "
-          f"{summary['porosity']:.3f}, layer thickness {summary['layer_thickness_m']:.3f} m, "
+          f"{len(summary['units_rolled_off'])} rolled off; {_layer_figures(summary)}, "
           f"largest overlap {100 * summary['max_overlap_over_dn']:.2f} % of Dn")
     for key, value in summary["outputs"].items():
         print(f"riprap: {key}: {value}")
     return 0
+
+
+def _measured(value, form: str) -> str:
+    """``value`` in ``form``, or "not measured" where it is null or NaN (summary.json's null)."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and value == value:
+        return form.format(value)
+    return "not measured"
+
+
+def _layer_figures(layer: dict) -> str:
+    """The layer's packing density coefficient, porosity and thickness (riprap place, riprap
+    analyse), each "not measured" where it was not, and why."""
+    text = (f"packing density coefficient {_measured(layer['packing_density_coefficient'], '{:.3f}')} "
+            f"(design {_measured(layer.get('design_packing_density_coefficient'), '{:.3f}')}), "
+            f"porosity {_measured(layer['porosity'], '{:.3f}')}, layer thickness "
+            f"{_measured(layer['layer_thickness_m'], '{:.3f} m')}")
+    why = layer.get("layer_figures_not_measured")
+    return text + (f" (not measured: {why})" if why else "")
 
 
 def _analyse(paths: list[Path], out: str | None, frame: int, labels: list[str] | None) -> int:
@@ -196,9 +211,7 @@ def _analyse(paths: list[Path], out: str | None, frame: int, labels: list[str] |
                   f"{layer['max_displacement_m']:.3g} m ({layer['max_displacement_over_dn']:.2f} Dn), "
                   f"mean {layer['mean_displacement_m']:.3g} m; {len(layer['units_moved'])} unit(s) "
                   "moved more than 0.1 Dn")
-        print(f"riprap: packing density coefficient {layer['packing_density_coefficient']:.3f} "
-              f"(design {layer['design_packing_density_coefficient']:.3f}), porosity "
-              f"{layer['porosity']:.3f}, layer thickness {layer['layer_thickness_m']:.3f} m")
+        print(f"riprap: {_layer_figures(layer)}")
         _say_flume_test(layer.get("flume_test"))
         print(f"riprap: report: {layer['outputs']['report']}")
         return 0
@@ -207,7 +220,8 @@ def _analyse(paths: list[Path], out: str | None, frame: int, labels: list[str] |
     analyses = compare_layers(paths, out=out, labels=labels, frame=frame)
     for analysis in analyses:
         layer = analysis.layer
-        print(f"riprap: {layer['source']}: packing density {layer['packing_density_coefficient']:.3f}, "
+        print(f"riprap: {layer['source']}: packing density "
+              f"{_measured(layer['packing_density_coefficient'], '{:.3f}')}, "
               f"mean coordination {layer['coordination_number_mean']:.2f}, largest contact force "
               f"{layer['max_contact_force_N']:.4g} N, smallest FoS {layer['factor_of_safety_min']:.3f}")
     print(f"riprap: comparison: {Path(out) / 'comparison.html'}")

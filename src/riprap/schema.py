@@ -343,7 +343,9 @@ KEYS: tuple[Key, ...] = (
     Key("simulation", "end_time", "number", "s", "Simulated time at which the run stops.",
         valid_range=_POSITIVE),
     Key("simulation", "time_step", "number", "s",
-        "Time step; 0 chooses it automatically from the body masses and contact stiffness.",
+        "Time step; 0 chooses it automatically from the body masses and contact stiffness. A "
+        "step at which a contact the bodies can make (a whole face pressed in at the farthest "
+        "corner) would pass the stability ratio dt / (2 sqrt(m/k)) = 0.5 is refused.",
         default=0.0, valid_range=_NON_NEGATIVE),
     Key("simulation", "time_step_safety", "number", "-",
         "Fraction of the critical time step used when the time step is automatic.",
@@ -914,6 +916,9 @@ PLAUSIBLE: dict[tuple[str, str], Range] = {
     # gravity: the earth's 9.81; a geotechnical centrifuge spins models at up to a few hundred g
     # (simulation._ABSURD_GRAVITY is 1000 m/s^2 too)
     ("simulation", "gravity"): _between(-1000.0, 1000.0),
+    # simulated time: a laboratory test of thousands of waves lasts hours, a week-long storm
+    # 6e5 s; 1e8 s is three years of sea (an end time of 1e308 is a slip, not a frame count)
+    ("simulation", "end_time"): Range(maximum=1.0e8),
     # densities of solids: expanded polystyrene (about 15 kg/m^3) to osmium (22,590)
     ("materials", "density"): _between(10.0, 25000.0),
     # Coulomb friction: ice on ice about 0.02, rock on rock 0.6-0.9, rubber on concrete up to 2

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from riprap.errors import CaseFileError, InstabilityError, RiprapError
-from riprap.io.checkpoint import load_checkpoint, save_checkpoint
+from riprap.io.checkpoint import load_checkpoint, remove_stale_temporaries, save_checkpoint
 from riprap.io.output_folder import prepare_output_folder
 from riprap.parallel.communicator import world
 from riprap.io.summary import write_json
@@ -33,7 +33,7 @@ from riprap.outputs.base import ModelFrames
 from riprap.scene import DEFAULT_GRAVITY, Scene
 from riprap.scene.choose_model import build_model
 from riprap.schedules import Every
-from riprap.schema import default_of
+from riprap.schema import default_of, key as schema_key
 from riprap.solid.contact_statistics import solver_contact_statistics
 from riprap.solid.surfaces import surface_arrays
 from riprap.work_estimate import (MAX_CHECKPOINTS, MAX_FRAMES, RiprapWarning,
@@ -193,6 +193,9 @@ class Simulation:
                  adaptive_time_step: bool = False, fluid=None,
                  body_forces_interval: float = default_of("output", "body_forces_interval")):
         _require(end_time > 0, "end_time", end_time, "> 0 s")
+        longest = schema_key("simulation", "end_time").plausible.maximum
+        _require(end_time <= longest, "end_time", end_time,
+                 f"<= {longest:g} s (three years of simulated time; a slip of the exponent?)")
         _require(time_step >= 0, "time_step", time_step, ">= 0 s (0 = automatic)")
         _require(0 < time_step_safety <= 1, "time_step_safety", time_step_safety, "in (0, 1]")
         _require(output_interval > 0, "output_interval", output_interval, "> 0 s")
@@ -362,6 +365,8 @@ class Simulation:
         out = self.output_directory
         if world().rank == 0:
             prepare_output_folder(out)
+            # what a run killed while writing a checkpoint left (process 0 writes them here)
+            remove_stale_temporaries(out)
         if restart_from is not None:
             self.restart(restart_from)
         self.prepare()
@@ -426,6 +431,7 @@ class Simulation:
                     if after_chunk(self):
                         end_reason = "done"
                         break
+                    model.state_changed()
                     good = model.state_arrays()
                 if model.at_rest():
                     end_reason = "at_rest"

@@ -102,6 +102,11 @@ ABSURD_CASES = {
     "mesh_file_scale_1e150": (_edit(MESH_FILE_CASE, 'file = "cube.vtu"',
                                     'file = "good_cube.vtu"\nscale = 1e150'), "run",
                               ["[[shapes]] 'cube'", "scale", "good_cube.vtu"]),
+    # a sphere this small is refused by its radius; a mesh file's body by its extent (issue 52:
+    # it passed check with 2.8e7 steps estimated, then ran for ever)
+    "mesh_file_a_micrometre_across": (_edit(MESH_FILE_CASE, 'file = "cube.vtu"', 'file = "tiny.vtu"'),
+                                      "run", ["[[shapes]] 'cube'", "tiny.vtu", "extent 1e-06 m",
+                                              "outside the sizes riprap meshes"]),
     "mesh_file_vertex_at_1e300": (_edit(MESH_FILE_CASE, 'file = "cube.vtu"', 'file = "far.vtu"'),
                                   "run", ["far.vtu", "from the origin"]),
 }
@@ -119,6 +124,7 @@ def _write_inputs(tmp_path):
     meshio.write(tmp_path / "cube.vtu", meshio.Mesh(
         np.vstack([cube.nodes, extra]), [("tetra", np.vstack([cube.tets, [[n, n + 1, n + 2, n + 3]]]))]))
     meshio.write(tmp_path / "good_cube.vtu", meshio.Mesh(cube.nodes, [("tetra", cube.tets)]))
+    meshio.write(tmp_path / "tiny.vtu", meshio.Mesh(cube.nodes * 1e-5, [("tetra", cube.tets)]))
     meshio.write(tmp_path / "far.vtu", meshio.Mesh(cube.nodes + 1e300, [("tetra", cube.tets)]))
     (tmp_path / "far_grid.csv").write_text("x,y,z\n1.0,1.0,1.0\n1e308,1.0,1.0\n")
     (tmp_path / "plain.toml").write_text(RIGID)

@@ -130,12 +130,21 @@ def _broken_copy(flume_run, tmp_path, name, edit):
     return copy
 
 
+def _without_column(text: str, name: str) -> str:
+    rows = [line.split(",") for line in text.splitlines()]
+    keep = [k for k, column in enumerate(rows[0]) if column != name]
+    assert len(keep) < len(rows[0]), name
+    return "\n".join(",".join(row[k] for k in keep) for row in rows) + "\n"
+
+
 @pytest.mark.parametrize("name, edit, expected", [
     ("body_forces.csv", lambda text: text.replace("\n1,", "\n1,zero,", 1), "line 3"),
     ("body_forces.csv", lambda text: "time,body\n" + text.split("\n", 1)[1], "line 1"),
     ("body_forces.csv", lambda text: text.replace("\n3,", "\n999,", 1), "body 999"),
     ("gauges.csv", lambda text: text + "0.5,abc\n", "fields, the header has"),
     ("gauges.csv", lambda text: "t," + text.split(",", 1)[1], "gauges.csv:1"),
+    # a gauge's column lost (issue 52): refused naming it, not a KeyError in the per-wave table
+    ("gauges.csv", lambda text: _without_column(text, "g2_eta_m"), "no column 'g2_eta_m'"),
 ])
 def test_a_broken_file_of_the_run_is_refused_naming_it(flume_run, tmp_path, capsys, name, edit,
                                                        expected):

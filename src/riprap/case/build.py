@@ -48,12 +48,16 @@ def build_shape(spec) -> TetMesh:
     if spec.type == "mesh_file":
         mesh = read_mesh(p["file"], mesh_size=mesh_size)
         scale = float(p.get("scale", 1.0))
+        # the (scaled) body must be a size riprap meshes, as a sphere's radius must: a scale of
+        # 1e150 overflows its volume, a body a micrometre across needs tens of millions of
+        # contact steps a second of simulated time
+        extent = float(np.ptp(mesh.nodes, axis=0).max())
+        with np.errstate(over="ignore", under="ignore"):
+            check_body_length(np.float64(extent) * scale,
+                              "scale x the mesh's extent" if scale != 1.0 else "the mesh's extent",
+                              f"mesh_file '{p['file']}' (extent {extent:.4g} m"
+                              + (f", scale {scale:g})" if scale != 1.0 else ")"))
         if scale != 1.0:
-            # the scaled body must be a size riprap meshes: a scale of 1e150 overflows its volume
-            extent = float(np.ptp(mesh.nodes, axis=0).max())
-            with np.errstate(over="ignore", under="ignore"):
-                check_body_length(np.float64(extent) * scale, "scale x the mesh's extent",
-                                  f"mesh_file '{p['file']}' (extent {extent:.4g} m, scale {scale:g})")
             mesh = TetMesh(nodes=mesh.nodes * scale, tets=mesh.tets, name=mesh.name)
         return mesh
     builders = {

@@ -24,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import zipfile
 from collections.abc import Iterator, Mapping
 from pathlib import Path
@@ -34,7 +35,7 @@ from riprap.errors import CaseFileError, RiprapError
 from riprap.io.output_folder import naming_the_file
 
 __all__ = ["CheckpointError", "CHECKPOINT_FORMAT", "save_checkpoint", "load_checkpoint",
-           "save_checkpoint_piece"]
+           "remove_stale_temporaries", "save_checkpoint_piece"]
 
 #: Version of the checkpoint layout written by :func:`save_checkpoint`.
 CHECKPOINT_FORMAT = 1
@@ -78,6 +79,40 @@ def _atomic_target(path: str | os.PathLike) -> Iterator[Path]:
     finally:
         with contextlib.suppress(FileNotFoundError):
             temporary.unlink()
+
+
+# The temporary files of _atomic_target: ".<name>.<pid>.tmp".
+_TEMPORARY = re.compile(r"^\..+\.(\d+)\.tmp$")
+
+
+def _process_alive(pid: int) -> bool:
+    """Whether a process of this id runs on this machine (one of another user's counts)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True
+    return True
+
+
+def remove_stale_temporaries(folder: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files (``.<name>.<pid>.tmp``) that a run killed while writing a
+    checkpoint left in ``folder``: those of processes no longer running (a file of a running
+    process, or of an id now reused, is kept). Returns the files removed."""
+    folder = Path(folder)
+    removed = []
+    if not folder.is_dir():
+        return removed
+    for path in folder.iterdir():
+        found = _TEMPORARY.match(path.name)
+        if found and path.is_file() and not _process_alive(int(found.group(1))):
+            with contextlib.suppress(FileNotFoundError):
+                path.unlink()
+                removed.append(path)
+    return removed
 
 
 def _json_default(value):

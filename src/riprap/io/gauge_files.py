@@ -23,10 +23,11 @@ def write_gauges_csv(path, gauges) -> Path:
     return path
 
 
-def read_gauges_csv(path) -> tuple[np.ndarray, dict] | None:
+def read_gauges_csv(path, required=()) -> tuple[np.ndarray, dict] | None:
     """``(times (s), {column: values})`` of a run's ``gauges.csv`` (None where the run wrote none),
-    checked: the header starts with ``time_s``, every field is a finite number, the times increase
-    (the file is rewritten whole at every frame). Errors name the file, the line and the column."""
+    checked: the header starts with ``time_s`` and holds every column of ``required`` (those of
+    the case's gauges), every field is a finite number, the times increase (the file is
+    rewritten whole at every frame). Errors name the file, the line and the column."""
     path = Path(path)
     if not path.is_file():
         return None
@@ -35,6 +36,11 @@ def read_gauges_csv(path) -> tuple[np.ndarray, dict] | None:
     if header[0] != "time_s":
         raise CaseFileError(f"{path}:1: the first column is {header[0]!r}; gauges.csv starts with "
                             f"time_s; {advice}")
+    missing = [name for name in required if name not in header]
+    if missing:
+        raise CaseFileError(f"{path}:1: no column {', '.join(repr(n) for n in missing)} (the "
+                            f"case's gauges write {len(required)} columns; the file has "
+                            f"{', '.join(header[1:]) or 'none'}); {advice}")
     times = table[:, 0]
     back = np.flatnonzero(np.diff(times) <= 0.0)
     if back.size:

@@ -52,6 +52,10 @@ class Model:
     def after_good_chunk(self) -> None:
         """Called after every chunk that did not fail (e.g. to grow an adaptive step)."""
 
+    def state_changed(self) -> None:
+        """Called where the state was changed from outside the model (a run's ``after_chunk``
+        callback fixed or moved bodies): what the model watched from before is void."""
+
     def at_rest(self) -> bool:
         """Whether the run may stop early because everything rests."""
         return False

@@ -9,19 +9,20 @@ import time as wallclock
 
 import numpy as np
 
-from riprap.errors import InstabilityError, RiprapError
+from riprap.errors import CaseFileError, InstabilityError, RiprapError
 from riprap.io.picture import bodies_to_draw, render_bodies_png
 from riprap.limits import PROGRESS_PERIOD, RUNAWAY_SPEED, START_OVERLAP_FRACTION
 from riprap.models.base import Model
 from riprap.models.body_frames import rigid_frame_fields
 from riprap.models.settings import ModelSettings
 from riprap.outputs.bodies import RigidBodiesWriter
-from riprap.solid.stability import MAX_MOTION_PER_STEP, max_speed, stability_ratio
+from riprap.solid.stability import (MAX_MOTION_PER_STEP, max_speed, stability_ratio,
+                                    worst_contact_rate)
 from riprap.solid.surfaces import surface_arrays
 from riprap.work_estimate import check_rigid_run
 
 __all__ = ["RigidModel", "at_rest", "body_setting_the_step", "build_bodies", "check_start_overlaps",
-           "max_speed", "prepare_bodies", "stability_ratio"]
+           "check_user_time_step", "max_speed", "prepare_bodies", "stability_ratio"]
 
 # Adaptive time step (``Simulation(adaptive_time_step=True)``): grow by _STEP_GROWTH while the
 # measured stability ratio stays below _GROW_BELOW_RATIO, cut by _STEP_CUT (from the last good
@@ -39,6 +40,11 @@ _ADAPT_CHUNK_STEPS = 50
 _MAX_STABILITY_RATIO = 0.5
 # A body rests when its net force is below this fraction of its weight (and it is slow).
 _REST_FORCE_RATIO = 0.05
+# The energy watch (:class:`EnergyWatch`): a dry run's kinetic and potential energy may not grow
+# past its start (with the energy stored in its contacts then) by more than this fraction of the
+# energy its bodies move with (the largest kinetic energy seen, the stored energy at the start,
+# and each free body's weight times its bounding radius).
+_ENERGY_GROWTH_FRACTION = 0.1
 # Gravity above this (m/s^2) is named as the likely cause of a blow-up (a centrifuge model runs
 # at tens of g; more is a typo).
 _ABSURD_GRAVITY = 1000.0
@@ -63,12 +69,38 @@ def prepare_bodies(solver, settings: ModelSettings, *, accepted_overlaps: dict,
     if solver.ready:
         return
     build_bodies(solver, settings)
+    check_user_time_step(solver, settings)
     check_rigid_run(end_time=settings.end_time, time_step=solver.time_step,
                     moving_bodies=int((~solver.fixed).sum()), start_time=solver.time,
                     setting_the_step=lambda numbered=True: body_setting_the_step(
                         solver, settings, numbered=numbered))
     if not restarted:
         check_start_overlaps(solver, accepted_overlaps)
+
+
+def check_user_time_step(solver, settings: ModelSettings) -> None:
+    """Refuse a given time step (``[simulation] time_step``) at which some contact the bodies can
+    make would pass the stability ratio a run stops at (:func:`worst_contact_rate`: a whole face
+    pressed in at the farthest corner of the lightest, stiffest pair), before any work. The
+    contacts present at the start say nothing of the impacts to come: a step 40 times the
+    automatic one passed the check of the contacts present and made energy at the first impact.
+    The automatic step stays below it (0.2 to 0.28 of the bound ratio over the examples at the
+    default time_step_safety)."""
+    if settings.time_step <= 0:
+        return
+    rate, where = worst_contact_rate(solver)
+    ratio = settings.time_step * rate
+    if ratio <= _MAX_STABILITY_RATIO:
+        return
+    automatic = solver.stable_time_step(settings.time_step_safety)
+    raise CaseFileError(
+        f"simulation.time_step = {settings.time_step:g} s is too large for the contacts these "
+        f"bodies can make: at {where}, pressed in over a whole face at its farthest corner, "
+        f"dt / (2 sqrt(m/k)) would be {ratio:.3g}, above the {_MAX_STABILITY_RATIO} at which a "
+        f"run stops (such a step makes energy at the first hard impact). The largest step that "
+        f"holds for every contact is {_MAX_STABILITY_RATIO / rate:.3g} s; the automatic step is "
+        f"{automatic:.3g} s: set time_step = 0 (automatic) or at most "
+        f"{_MAX_STABILITY_RATIO / rate:.3g} s")
 
 
 def body_setting_the_step(solver, settings: ModelSettings, numbered: bool = True) -> str:
@@ -153,6 +185,72 @@ def blow_up_advice(solver, settings: ModelSettings, good: dict) -> str:
             "other change to the case, such as contact_penalty or gravity, needs a new run).")
 
 
+def stored_contact_energy(solver) -> float:
+    """Energy held in the contacts now (J), estimated: |F_n|^2 / (2 k_n) of each contact's
+    normal force and stiffness (a linear spring's; the normal force includes its damping, so
+    this overestimates an approaching contact a little) and the tangential and twisting springs'
+    F_s^2 / (2 k_t) and T^2 / (2 k_twist)."""
+    c = solver.contacts
+    normal = np.sum(c.normal_forces ** 2, axis=1)
+    stored = float(np.sum(np.divide(normal, 2.0 * c.stiffness, out=np.zeros_like(normal),
+                                    where=c.stiffness > 0.0)))
+    springs = np.asarray(solver.history_springs).reshape(-1, 6)
+    for energy, stiffness in ((np.sum(springs[:, :3] ** 2, axis=1), springs[:, 4]),
+                              (springs[:, 3] ** 2, springs[:, 5])):
+        stored += float(np.sum(np.divide(energy, 2.0 * stiffness, out=np.zeros_like(energy),
+                                         where=stiffness > 0.0)))
+    return stored
+
+
+class EnergyWatch:
+    """Stops a dry rigid run whose bodies gain energy from nothing. Gravity is the only load of
+    a dry run and is held in the potential energy; contact damping, friction and local damping
+    only take energy out; so the kinetic plus potential energy K + P can pass its value at the
+    start plus the energy then stored in the contacts (``stored_contact_energy``) only by the
+    integrator's error, which stays small at a stable step. Growth beyond
+    ``_ENERGY_GROWTH_FRACTION`` of the energy the bodies move with (the largest K seen, the
+    stored energy at the start and the sum over free bodies of m g R) is energy the time step
+    made. The reference is taken afresh where the state is changed from outside (bodies fixed,
+    moved, a restart). Not used for bodies in a flow: the fluid's work on them is not summed."""
+
+    def __init__(self):
+        self.reference = None
+        #: The largest gain seen over its tolerance (a run stops above 1).
+        self.largest_share = 0.0
+
+    def forget(self) -> None:
+        """Take the reference again at the next check (the state was changed from outside)."""
+        self.reference = None
+
+    def check(self, solver, since: float) -> None:
+        """Raise InstabilityError if K + P grew past the reference by more than the tolerance
+        (``since``: the time of the last good state, for the message)."""
+        kinetic = solver.kinetic_energy()
+        energy = kinetic + solver.potential_energy()
+        fixed = solver.fixed.copy()
+        if self.reference is None or not np.array_equal(fixed, self.reference["fixed"]):
+            stored = stored_contact_energy(solver)
+            free = ~fixed
+            weight = float(np.linalg.norm(solver.gravity)) * float(np.sum(
+                solver.masses[free] * solver.bounding_radius[solver.shape_index[free]]))
+            self.reference = {"fixed": fixed, "energy": energy + stored, "time": solver.time,
+                              "scale": stored + weight, "kinetic": kinetic}
+            return
+        reference = self.reference
+        tolerance = _ENERGY_GROWTH_FRACTION * (reference["scale"] + reference["kinetic"])
+        gain = energy - reference["energy"]
+        self.largest_share = max(self.largest_share, gain / tolerance)
+        if gain > tolerance:
+            raise InstabilityError(
+                f"energy from nothing: the bodies' kinetic and potential energy grew to "
+                f"{energy:.4g} J at t = {solver.time:.6g} s, {gain:.3g} J above the "
+                f"{reference['energy']:.4g} J they held at t = {reference['time']:.6g} s (with the "
+                f"energy stored in their contacts then), more than the {tolerance:.3g} J the "
+                f"integrator may err by; no load of a dry run puts energy in, so the time step "
+                f"{solver.time_step:.3e} s is too large for a contact met after t = {since:.6g} s")
+        reference["kinetic"] = max(reference["kinetic"], kinetic)
+
+
 class RigidModel(Model):
     """The bodies of a :class:`riprap.solid.solver.SolidSolver`, with the meshes and names of its
     shapes (checkpoints carry them, a restart compares them), the run's ``settings``, the resting
@@ -176,6 +274,8 @@ class RigidModel(Model):
         self.cuts = 0
         self.last_stability_ratio = 0.0
         self.max_stability_ratio = 0.0
+        #: Stops a run whose bodies gain energy from nothing (None: not watched).
+        self.energy_watch = EnergyWatch()
 
     # ------------------------------------------------------------------ clock
     @property
@@ -204,10 +304,15 @@ class RigidModel(Model):
     def advance(self, until: float) -> None:
         solver = self.solver
         n = min(self.solver.steps_at(until) - solver.step_count, self._chunk)
+        since = solver.time
+        if self.energy_watch is not None and self.energy_watch.reference is None:
+            self.energy_watch.check(solver, since)
         tick = wallclock.perf_counter()
         solver.advance(n)
         check_runaway(solver)
         self._check_contact_stability()
+        if self.energy_watch is not None:
+            self.energy_watch.check(solver, since)
         elapsed = wallclock.perf_counter() - tick
         if self.settings.adaptive_time_step:
             self._chunk = _ADAPT_CHUNK_STEPS
@@ -245,6 +350,10 @@ class RigidModel(Model):
                 and step_keeps_motion_small(solver, grown)):
             solver.set_time_step(grown)
             self.largest_step = max(self.largest_step, solver.time_step)
+
+    def state_changed(self) -> None:
+        if self.energy_watch is not None:
+            self.energy_watch.forget()
 
     def at_rest(self) -> bool:
         return self.settings.rest_speed > 0 and at_rest(self.solver, self.settings)

@@ -21,6 +21,9 @@ from __future__ import annotations
 
 import numpy as np
 
+#: The key of :func:`layer_figures` saying why a figure is not measured (absent where all are).
+NOT_MEASURED = "layer_figures_not_measured"
+
 
 def body_tops(slope, node_sets) -> np.ndarray:
     """Highest point of each body above the face (m), from its world nodes."""
@@ -62,7 +65,9 @@ def layer_figures(slope, unit_positions, unit_node_sets, *, rows, nominal_diamet
     if len(labels) < 2:
         return {"packing_density_coefficient": float("nan"), "layer_thickness_m": float("nan"),
                 "porosity": float("nan"), "units_measured": 0, "measuring_area_m2": 0.0,
-                "rows_measured": int(len(labels))}
+                "rows_measured": int(len(labels)),
+                NOT_MEASURED: f"{len(labels)} row(s) of units on the face; the figures are "
+                              "measured between the first and the last of at least two rows"}
     counts = np.array([(rows == r).sum() for r in labels], dtype=float)
     means = np.array([coords[rows == r, 0].mean() for r in labels])
     order = np.argsort(means)
@@ -75,6 +80,12 @@ def layer_figures(slope, unit_positions, unit_node_sets, *, rows, nominal_diamet
     packing = weighted * nominal_diameter ** 2 / area if area > 0 else float("nan")
     porosity = (1.0 - weighted * unit_volume / (area * thickness) if area > 0 and thickness > 0
                 else float("nan"))
-    return {"packing_density_coefficient": float(packing), "layer_thickness_m": thickness,
-            "porosity": float(porosity), "units_measured": float(weighted),
-            "measuring_area_m2": float(area), "rows_measured": int(len(labels))}
+    figures = {"packing_density_coefficient": float(packing), "layer_thickness_m": thickness,
+               "porosity": float(porosity), "units_measured": float(weighted),
+               "measuring_area_m2": float(area), "rows_measured": int(len(labels))}
+    if not area > 0:
+        figures[NOT_MEASURED] = "the rows' mean positions span no area of the face"
+    elif not thickness > 0:
+        figures[NOT_MEASURED] = ("the units' tops are not above the underlayer's top: no layer "
+                                 "thickness, so no porosity")
+    return figures

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["MAX_MOTION_PER_STEP", "contact_stability_rate", "max_speed", "motion_limited_step",
-           "stability_ratio"]
+           "shape_inverse_masses", "stability_ratio", "worst_contact_rate"]
 
 #: No body should move more than this fraction of the thinnest boundary layer of tets in a step,
 #: so that a contact cannot go from nothing to a deep overlap in one step.
@@ -105,3 +105,103 @@ def motion_limited_step(solver) -> float:
         return np.inf
     smallest = min(shape.min_subtet_height for shape in solver.shapes)
     return MAX_MOTION_PER_STEP * smallest / speed
+
+
+def shape_inverse_masses(shape) -> tuple[float, float]:
+    """(along the normal, across it) the largest inverse mass of a contact anywhere on
+    ``shape``'s surface, per unit density (1/m^3; divide by the density for 1/kg):
+
+    - along the normal: max over the boundary nodes r and every unit normal n of
+      1/V + (r x n) . J^-1 (r x n), J the principal moments per unit density. For a node r the
+      vectors r x n fill the disc of radius |r| across r, so the maximum is |r|^2 times the
+      largest eigenvalue of J^-1 restricted to the plane across r. A contact at a face, an edge
+      or a corner has its force-weighted point inside the hull of the nodes, whose lever arm is
+      no longer than the farthest node's, so this holds for every contact the shape can make;
+    - across the normal (the tangential and twisting springs): 1/V + R^2 / J_min, R the
+      bounding radius, as :func:`_contact_rates` takes it.
+
+    A cube: 5.5 / V along (a corner: 1/V + 4.5/V), the same across."""
+    nodes = shape.mesh.nodes[np.unique(shape.triangles)]
+    inverse_moments = 1.0 / np.asarray(shape.unit_principal_moments, dtype=float)
+    lengths = np.linalg.norm(nodes, axis=1)
+    unit = nodes / np.maximum(lengths, np.finfo(float).tiny)[:, None]
+    across = np.eye(3)[None] - unit[:, :, None] * unit[:, None, :]        # P = I - r r^T
+    restricted = across @ np.diag(inverse_moments) @ across                 # P J^-1 P
+    largest = np.linalg.eigvalsh(restricted)[:, -1]
+    normal = 1.0 / shape.volume + float(np.max(lengths ** 2 * largest, initial=0.0))
+    tangential = 1.0 / shape.volume + shape.bounding_radius ** 2 * float(inverse_moments.max())
+    return normal, tangential
+
+
+def worst_contact_rate(solver) -> tuple[float, str]:
+    """(the largest stability ratio per second of step, 1/s, of any contact the bodies can make;
+    that contact, in words): the rate sqrt(k w) / 2 of :func:`_contact_rates` with, for every
+    kind of body (shape, material, free or fixed) that can meet another or a wall,
+
+    - the largest plausible stiffness of their contact: a whole face pressed in,
+      k = p min(A_i, A_j) (1/h_i + 1/h_j), A = V^(2/3) and h the 10th-percentile boundary sub-tet
+      height of each (a wall is meshed as the body touching it: k = 2 p A_i / h_i, the estimate
+      of the automatic step); p the pair's penalty;
+    - the largest inverse mass anywhere on each free body's surface (:func:`shape_inverse_masses`),
+      summed over the pair's free bodies, along the normal and (times the pair's tangential
+      stiffness ratio) across it,
+
+    not those of the contacts present now. (0, "") without free bodies."""
+    free = ~solver.fixed
+    if not free.any():
+        return 0.0, ""
+    laws = solver._pair_laws
+    materials = solver.material_index_of_body
+    kinds = {}
+    for b in range(len(materials)):
+        kinds.setdefault((int(solver.shape_index[b]), int(materials[b]), bool(free[b])), []).append(b)
+    keys = list(kinds)
+    per_shape = {}
+    for shape_index, _, _ in keys:
+        if shape_index not in per_shape:
+            shape = solver.shapes[shape_index]
+            per_shape[shape_index] = (shape.volume ** (2.0 / 3.0), shape.min_subtet_height,
+                                      *shape_inverse_masses(shape))
+    density = [solver.materials[m].density for _, m, _ in keys]
+    area = np.array([per_shape[s][0] for s, _, _ in keys])
+    height = np.array([per_shape[s][1] for s, _, _ in keys])
+    moving = np.array([f for _, _, f in keys])
+    normal = np.where(moving, [per_shape[s][2] / rho for (s, _, _), rho in zip(keys, density)], 0.0)
+    across = np.where(moving, [per_shape[s][3] / rho for (s, _, _), rho in zip(keys, density)], 0.0)
+    material = np.array([m for _, m, _ in keys])
+    # every pair of kinds of which one at least moves (a kind meets itself when it has two bodies)
+    i, j = np.triu_indices(len(keys))
+    alone = (i == j) & np.array([len(kinds[keys[k]]) < 2 for k in i])
+    keep = (moving[i] | moving[j]) & ~alone
+    i, j = i[keep], j[keep]
+    stiffness = (laws.penalty[material[i], material[j]] * np.minimum(area[i], area[j])
+                 * (1.0 / height[i] + 1.0 / height[j]))
+    rates = stiffness * np.maximum(normal[i] + normal[j], laws.tangential_ratio[material[i], material[j]]
+                                   * (across[i] + across[j]))
+    found = []
+    if len(rates):
+        best = int(np.argmax(rates))
+        found.append((float(rates[best]), _pair_in_words(solver, keys, kinds, int(i[best]),
+                                                          int(j[best]))))
+    if len(solver.walls):
+        walls = np.flatnonzero(moving)
+        wall_materials = np.asarray(solver.wall_materials)
+        penalty = laws.penalty[material[walls][:, None], wall_materials[None, :]].max(axis=1)
+        ratio = laws.tangential_ratio[material[walls][:, None], wall_materials[None, :]].max(axis=1)
+        wall_rates = (2.0 * penalty * area[walls] / height[walls]
+                      * np.maximum(normal[walls], ratio * across[walls]))
+        best = int(np.argmax(wall_rates))
+        k = int(walls[best])
+        found.append((float(wall_rates[best]),
+                      f"body {kinds[keys[k]][0]} (shape '{solver.shapes[keys[k][0]].name}') "
+                      "against a wall"))
+    rate, where = max(found)
+    return float(np.sqrt(rate) / 2.0), where
+
+
+def _pair_in_words(solver, keys, kinds, a: int, b: int) -> str:
+    """The bodies of kinds ``a`` and ``b`` meeting, named by a body of each and its shape."""
+    bodies = (kinds[keys[a]][0], kinds[keys[b]][1] if a == b else kinds[keys[b]][0])
+    named = [f"body {body} ({'fixed, ' if not keys[k][2] else ''}shape "
+             f"'{solver.shapes[keys[k][0]].name}')" for body, k in zip(bodies, (a, b))]
+    return f"{named[0]} against {named[1]}"

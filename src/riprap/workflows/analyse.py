@@ -20,11 +20,10 @@ from riprap.io.analysis_input import is_run_folder, load_waves_report
 from riprap.io.analysis_report import write_analysis, write_comparison
 from riprap.io.body_forces import read_peak_fluid_forces
 from riprap.io.frame_contacts import read_unit_contacts_per_frame
-from riprap.io.gauge_files import read_gauges_csv
 from riprap.io.output_folder import prepare_output_folder
 from riprap.io.csv_tables import write_columns_csv
 from riprap.workflows.layer_input import load_layer_state, load_run_case
-from riprap.workflows.per_wave_records import run_per_wave_table
+from riprap.workflows.per_wave_records import read_run_gauges, run_per_wave_table
 
 __all__ = ["analyse", "compare_layers"]
 
@@ -37,8 +36,13 @@ def analyse(path, *, out=None, frame: int = -1, reference_run=None,
     ``reference_run``: the run folder whose frame 0 the displacements count from (a test series'
     first step; default the run's own frame 0); ``displaced_threshold_dn``: a unit moved more than
     this many Dn is displaced (default 1)."""
-    # A broken waves report is refused before any work (and before the output folder is made).
+    # A broken waves report or gauge file is refused before any work (and before the output
+    # folder is made).
     waves = load_waves_report(path)
+    if is_run_folder(path):
+        case = load_run_case(path)
+        if case.fluid is not None:
+            read_run_gauges(Path(path), case)
     if out is not None:
         prepare_output_folder(out)
     analysis = analyse_layer(load_layer_state(path, frame=frame, reference_run=reference_run),
@@ -109,7 +113,7 @@ def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:
         slope_cot=layer.slope.cotangent)
     # where the crest begins, for the crest width of a series' EurOtop comparison
     analysis.layer["flume_test"]["slope_crest_x_m"] = float(layer.slope.crest_x)
-    gauges = read_gauges_csv(Path(path) / "gauges.csv")
+    gauges = read_run_gauges(Path(path), case)
     times, columns = gauges if gauges is not None else (None, {})
     contacts = read_unit_contacts_per_frame(path, bodies, until=state.time)
     records = FlumeRecords(waves_report=waves, times=times, columns=columns, target=_target(case),

@@ -11,12 +11,21 @@ import numpy as np
 from riprap.analysis.per_wave_table import FlumeLayout, UnitTracks, per_wave_table
 from riprap.io.body_forces import read_body_tracks
 from riprap.io.gauge_files import read_gauges_csv
+from riprap.waves.gauges import Gauge
 
-__all__ = ["run_per_wave_table", "EVENT_THRESHOLD"]
+__all__ = ["run_per_wave_table", "read_run_gauges", "EVENT_THRESHOLD"]
 
 #: Overtopping events smaller than this (m^3 per m of crest) are not counted (traces of water
 #: that the VOF field carries over the crest; EurOtop counts waves that overtop, not spray).
 EVENT_THRESHOLD = 1.0e-6
+
+
+def read_run_gauges(folder: Path, case) -> tuple[np.ndarray, dict] | None:
+    """The flume run's ``gauges.csv`` in ``folder`` (run of ``case``; None where it wrote none),
+    refused naming the file and the column where a column of the case's gauges is missing."""
+    columns = [name for spec in case.gauges
+               for name in Gauge(name=spec.name, kind=spec.type, position=()).columns]
+    return read_gauges_csv(Path(folder) / "gauges.csv", required=columns)
 
 
 def run_per_wave_table(folder: Path, case, *, units, nominal_diameter: float,
@@ -27,7 +36,7 @@ def run_per_wave_table(folder: Path, case, *, units, nominal_diameter: float,
     start, else the surface gauge nearest the structure), the units' (body indices ``units``)
     displacements counted from the first rows of ``body_forces.csv`` of ``reference_run`` (a test
     series' first step; default this run's own)."""
-    gauges = read_gauges_csv(folder / "gauges.csv")
+    gauges = read_run_gauges(folder, case)
     if gauges is None or case.waves is None or case.fluid is None:
         return None
     times, columns = gauges
