@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import warnings
 
-from riprap.errors import RiprapError
+from riprap.errors import RiprapError, plain_numbers
 
 #: Measured speed of a rigid run (body-steps per second), the low end of bench/README.md.
 RIGID_BODY_STEPS_PER_SECOND = 3.0e4
@@ -45,6 +45,17 @@ class WorkTooLargeError(RiprapError):
 
 class RiprapWarning(UserWarning):
     """Something the user should know before waiting for the result."""
+
+
+def warning_line(message, category) -> str | None:
+    """A warning as riprap says it, one line: ``riprap: warning: ...`` for riprap's own, the
+    category named for another library's; None for numpy's RuntimeWarnings (riprap checks that
+    the state stays finite and names the body and time when it does not)."""
+    if issubclass(category, RiprapWarning):
+        return f"riprap: warning: {plain_numbers(str(message))}"
+    if issubclass(category, RuntimeWarning):
+        return None
+    return f"riprap: warning ({category.__name__}): {message}"
 
 
 def _duration(seconds: float) -> str:
@@ -135,3 +146,34 @@ def check_fluid_grid(cells) -> None:
             f"a fluid grid of {' x '.join(str(int(n)) for n in cells)} = {count:.3g} cells needs about "
             f"{need / 2**30:.3g} GiB of memory ({FLUID_BYTES_PER_CELL:.0f} bytes per cell); this "
             f"machine has {have / 2**30:.3g} GiB. Use fewer, larger cells")
+
+
+#: The measured pace of a flume run with bodies: examples/10 (226,800 cells of 0.1 m, 2 m of
+#: water, 25 free units on 135 fixed rocks) ran 60 s of simulated time in 1,606 s of wall time on
+#: 2 cores (bench/flume_test.py, 2026-11-28; 9,266 fluid steps). As wall seconds per cell, per
+#: simulated second and per sqrt(g d) / cell size (the fluid's step follows the flow's speed,
+#: which scales with the shallow-water wave speed sqrt(g d), over the cell size).
+FLUME_WALL_PER_CELL_AND_WAVE_SPEED = 1606.0 / (60.0 * 226_800 * (9.81 * 2.0) ** 0.5 / 0.1)
+
+
+def flume_run_seconds(*, simulated_time: float, cells: int, cell_size: float, depth: float,
+                      gravity: float = 9.81) -> float:
+    """Wall seconds a flume run with bodies is likely to take on 2 cores: examples/10's measured
+    pace (``FLUME_WALL_PER_CELL_AND_WAVE_SPEED``) scaled by the cells, the simulated time and the
+    wave speed sqrt(g ``depth``) over the (smallest) ``cell_size``. Within a factor of 2-3 for a
+    case like it; many more bodies, or breaking much harder, take longer."""
+    speed = (max(gravity, 0.0) * max(depth, 0.0)) ** 0.5
+    return (FLUME_WALL_PER_CELL_AND_WAVE_SPEED * simulated_time * cells * speed
+            / max(cell_size, 1e-12))
+
+
+def duration_words(seconds: float) -> str:
+    """A wall-clock duration as a person says it: "40 s", "12 min", "2.5 h", "3 days".
+
+    >>> duration_words(118.8), duration_words(7200.0), duration_words(12.3)
+    ('2 min', '2 h', '12 s')
+    """
+    for size, unit in ((86400.0, "days"), (3600.0, "h"), (60.0, "min")):
+        if seconds >= 0.95 * size * (2 if unit == "days" else 1):
+            return f"{seconds / size:.2g} {unit}"
+    return f"{seconds:.0f} s" if seconds >= 1 else "under 1 s"

@@ -284,12 +284,19 @@ def _step_error(tmp_path, steps, series="settle_time = 1.0"):
 
 
 @pytest.mark.parametrize("steps, message", [
-    (STEPS.replace("0.12", "0.09"), r"significant_height = 0.09: does not rise above step 1"),
+    (STEPS.replace("0.12", "0.09"),
+     r"series_steps\[1\]\.significant_height = 0\.09: does not rise above series_steps\[0\]'s "
+     r"0\.09 m \(step 2 of the series against step 1"),
     (STEPS.replace("waves = 5\n", "waves = 5\nduration = 20.0\n", 1),
      r"series_steps\[0\]\.waves = 5: give either waves"),
     (STEPS.replace("peak_period = 1.2\n", "peak_period = 1.2\nwave_steepness = 0.03\n", 1),
      r"series_steps\[0\]\.peak_period = 1.2: give either peak_period or wave_steepness"),
     ("", r"series: a test series needs its sea states"),
+    # neither of a pair given: the message shows no value the user never wrote
+    (STEPS.replace("peak_period = 1.2\n", "", 1),
+     r"series_steps\[0\]: neither peak_period nor wave_steepness is given: give one of them"),
+    (STEPS.replace("waves = 5\n", "", 1),
+     r"series_steps\[0\]: neither waves \(a number of waves\) nor duration \(s\) is given"),
 ])
 def test_bad_steps_are_refused_at_their_key(tmp_path, steps, message):
     with pytest.raises(CaseFileError, match=message):

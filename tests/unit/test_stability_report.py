@@ -38,3 +38,13 @@ def test_cubes_get_van_der_meer_and_no_gauge_gives_a_note():
     empty = flume_stability({"gauges": {}}, LAYER, unit_kind="cube", nominal_diameter=1.0,
                             armour_density=2400.0, water_density=1025.0, slope_cot=1.5)
     assert "note" in empty and "stability_number" not in empty
+
+
+def test_hudsons_number_is_given_without_waves_as_with_them():
+    """Hudson's N_s depends on the unit and the slope only: a survey that measured no wave gives
+    it as the series' table does (issue 52), only the measured / Hudson ratio is missing."""
+    empty = flume_stability({"gauges": {}}, LAYER, unit_kind="core_loc_like", nominal_diameter=0.5,
+                            armour_density=2400.0, water_density=1000.0, slope_cot=1.33)
+    assert "stability_number" not in empty
+    assert empty["hudson"]["stability_number"] == pytest.approx((16.0 * 1.33) ** (1 / 3))
+    assert "ratio" not in empty["hudson"]

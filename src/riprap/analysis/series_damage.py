@@ -10,8 +10,8 @@ overtopping q. Beside them, per step:
   to the waves actually run, cumulatively over the steps as Van der Meer (1988) sums a sequence
   of sea states: the damage of the steps before is carried into step k as the number of step k's
   waves that would have done it (equivalent waves), and step k's waves are added to those;
-- for cubes, the single-layer thresholds of Van Gent (2002, as in
-  ``shared/validation/armour_design.md``): N_s = 2.9-3.0 start of damage, 3.5-3.75 failure;
+- for cubes, the single-layer thresholds of Van Gent (2002; ``docs/campaign.md``, The formulas
+  beside the damage curve): N_s = 2.9-3.0 start of damage, 3.5-3.75 failure;
 - EurOtop's (2018, eq. 5.18, mean value approach) mean overtopping discharge for the section,
   q / sqrt(g Hm0^3) = 0.09 exp(-(1.5 Rc / (Hm0 gamma_f))^1.3), with the roughness factor
   gamma_f of the unit (EurOtop 2018 table 6.2) and Rc the crest freeboard (the overtopping
@@ -40,7 +40,7 @@ __all__ = ["series_curve", "cumulative_damage", "eurotop_mean_overtopping",
 
 GRAVITY = 9.81
 #: Van Gent (2002) single-layer cubes, N_s at the start of damage and at failure (lower ends of
-#: the ranges 2.9-3.0 and 3.5-3.75 in shared/validation/armour_design.md).
+#: the ranges 2.9-3.0 and 3.5-3.75; docs/campaign.md).
 SINGLE_LAYER_CUBES_START = 2.9
 SINGLE_LAYER_CUBES_FAILURE = 3.5
 #: Van der Meer's N_od taken as the start of damage of double-layer cubes (a few units moved).

@@ -68,6 +68,14 @@ def flume_stability(waves_report: dict, layer_summary: dict, *, unit_kind: str,
     # What the waves report could not compute, and its cautions (few waves), go on to the report.
     result["not_computed"] = list(waves_report.get("not_computed", []))
     result["cautions"] = list(waves_report.get("cautions", []))
+    stability_coefficient = HUDSON_TRUNK_STABILITY.get(unit_kind)
+    if stability_coefficient is not None:
+        # Hudson's limit depends on the unit and the slope only: given with or without waves
+        result["hudson"] = {"K_D": stability_coefficient,
+                            "stability_number": hudson_stability_number(stability_coefficient,
+                                                                        slope_cot),
+                            "meaning": "Hudson's no-damage (0-5 % displaced) limit for a trunk "
+                                       "under non-breaking waves; ratio < 1: below it"}
     if height is None:
         result["note"] = "the waves report has no analysed surface gauge: no stability number"
         result["not_computed"].append(
@@ -77,13 +85,8 @@ def flume_stability(waves_report: dict, layer_summary: dict, *, unit_kind: str,
         return result
     stability = height / (delta * nominal_diameter)
     result.update({"Hm0_m": height, "Tz_s": period, "waves": waves, "stability_number": stability})
-    stability_coefficient = HUDSON_TRUNK_STABILITY.get(unit_kind)
-    if stability_coefficient is not None:
-        allowed = hudson_stability_number(stability_coefficient, slope_cot)
-        result["hudson"] = {"K_D": stability_coefficient, "stability_number": allowed,
-                            "ratio": stability / allowed,
-                            "meaning": "Hudson's no-damage (0-5 % displaced) limit for a trunk "
-                                       "under non-breaking waves; ratio < 1: below it"}
+    if "hudson" in result:
+        result["hudson"]["ratio"] = stability / result["hudson"]["stability_number"]
     if unit_kind in ("cube", "antifer_cube") and period and waves and math.isfinite(period):
         result["van_der_meer_cubes"] = {
             "N_od": van_der_meer_cubes_damage(hs=height, tm=period, waves=waves, delta=delta,

@@ -163,20 +163,29 @@ def _check_series(tables: Tables, add: Callable, ok: Callable) -> None:
             continue
         period, steepness = step.get("peak_period"), step.get("wave_steepness")
         if ok(period, steepness) and (period > 0) == (steepness > 0):
-            add(("series_steps", number, "peak_period"),
-                "give either peak_period or wave_steepness (the other 0)"
-                if period > 0 else "give peak_period or wave_steepness", period)
+            if period > 0:
+                add(("series_steps", number, "peak_period"),
+                    "give either peak_period or wave_steepness (the other 0)", period)
+            else:       # neither given: no value of the user's to show
+                add(("series_steps", number),
+                    "neither peak_period nor wave_steepness is given: give one of them")
         waves_run, duration = step.get("waves"), step.get("duration")
         if ok(waves_run, duration) and (waves_run > 0) == (duration > 0):
-            add(("series_steps", number, "waves"),
-                "give either waves (a number of waves) or duration (s), the other 0"
-                if waves_run > 0 else "give waves (a number of waves) or duration (s)", waves_run)
+            if waves_run > 0:
+                add(("series_steps", number, "waves"),
+                    "give either waves (a number of waves) or duration (s), the other 0",
+                    waves_run)
+            else:
+                add(("series_steps", number), "neither waves (a number of waves) nor duration "
+                    "(s) is given: give one of them")
         height = step.get("significant_height")
         if not ok(height):
             continue
         if previous is not None and not height > previous[1]:
             add(("series_steps", number, "significant_height"),
-                f"does not rise above step {previous[0] + 1}'s {previous[1]:g} m: a test series "
-                "runs rising sea states on one structure (another sea on the same structure is "
-                "another member of a campaign: docs/campaign.md)", height)
+                f"does not rise above series_steps[{previous[0]}]'s {previous[1]:g} m (step "
+                f"{number + 1} of the series against step {previous[0] + 1}: the steps count "
+                "from 1, the entries from 0): a test series runs rising sea states on one "
+                "structure (another sea on the same structure is another member of a campaign: "
+                "docs/campaign.md)", height)
         previous = (number, height)

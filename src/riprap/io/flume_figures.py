@@ -184,18 +184,25 @@ def unit_damage_figure(path, units: dict, layer: dict) -> Path:
     if with_force:
         ratio = np.asarray(units["max_fluid_force_over_submerged_weight"], dtype=float)
         if np.isfinite(ratio).any():
-            axes[2].bar(ids, ratio, color="tab:blue")
             delta = (layer.get("flume_test") or {}).get("relative_density")
             if isinstance(delta, (int, float)) and delta > 0:
-                # the force includes buoyancy: its still-water share, and what lifts a unit
-                axes[2].axhline(1.0 / delta, color="0.5", linewidth=0.8, linestyle="--",
-                                label=f"buoyancy, submerged: 1/Delta = {1.0 / delta:.2f}")
-                axes[2].axhline(1.0 + 1.0 / delta, color="crimson", linewidth=0.8,
-                                linestyle="--", label=f"lifts its weight: {1.0 + 1.0 / delta:.2f}")
+                # the force includes buoyancy, which a unit at rest under water carries too
+                # (1/Delta of its submerged weight): drawn apart from what the waves add
+                buoyancy = 1.0 / delta
+                still = np.minimum(ratio, buoyancy)
+                axes[2].bar(ids, still, color="0.8",
+                            label=f"buoyancy (still water): 1/Delta = {buoyancy:.2f}")
+                axes[2].bar(ids, np.maximum(ratio - buoyancy, 0.0), bottom=still,
+                            color="tab:blue", label="beyond buoyancy: the waves' load")
+                axes[2].axhline(1.0 + buoyancy, color="crimson", linewidth=0.8,
+                                linestyle="--", label=f"lifts its weight: {1.0 + buoyancy:.2f}")
                 axes[2].legend(fontsize=7)
+            else:
+                axes[2].bar(ids, ratio, color="tab:blue")
         else:
             _say(axes[2], "no fluid forces recorded")
-        axes[2].set_ylabel("largest fluid force /\nsubmerged weight", fontsize=8)
+        axes[2].set_ylabel("largest fluid force\n(buoyancy included) /\nsubmerged weight",
+                           fontsize=8)
     axes[-1].set_xlabel("unit")
     figure.suptitle("Each unit: displacement, rocking" + (", fluid load" if with_force else ""),
                     fontsize=10)

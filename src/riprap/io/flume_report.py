@@ -248,8 +248,11 @@ def stability_section(analysis) -> str:
     if hudson:
         rows.append(_row(f"Hudson, K_D = {hudson['K_D']:g}, cot alpha = {test['slope_cot']:.2f}: "
                          "Ns = (K_D cot alpha)^(1/3)",
-                         f"{hudson['stability_number']:.2f} (measured / Hudson "
-                         f"{hudson['ratio']:.2f}; {html.escape(hudson['meaning'])})"))
+                         f"{hudson['stability_number']:.2f} ("
+                         + (f"measured / Hudson {hudson['ratio']:.2f}; " if "ratio" in hudson
+                            else "measured / Hudson <span class='missing'>not computed: "
+                            f"{html.escape(no_height)}</span>; ")
+                         + f"{html.escape(hudson['meaning'])})"))
     else:
         rows.append(_row("Hudson", "<span class='missing'>not computed: "
                          + html.escape(no_height or f"no K_D retrieved for {test['unit']} units")

@@ -9,7 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_series_report"]
+from riprap.io.flume_figures import _say as _panel_note
+
+__all__ = ["write_series_report", "figures_not_computed", "COLUMN_NAMES"]
 
 
 def _pyplot():
@@ -19,11 +21,101 @@ def _pyplot():
     return plt
 
 
-def _damage_curve_figure(path: Path, results: dict) -> Path:
+#: What each damage-curve column is called in the report, with its unit (``damage_curve.csv`` and
+#: ``series_results.json`` keep the keys; the report gives each key as its column's tooltip).
+COLUMN_NAMES = {
+    "step": "step",
+    "Hm0_m": "Hm0 at the toe (m)",
+    "Tm_s": "Tm (s)",
+    "waves": "waves",
+    "cumulative_waves": "waves so far",
+    "stability_number": "N_s = Hm0 / (Delta Dn)",
+    "units_displaced": "units displaced",
+    "N_od": "N_od (displaced per Dn of width)",
+    "S": "damage level S",
+    "rocking_events": "rocking events",
+    "q_m3_s_m": "q (m^3/s per m)",
+    "hudson_stability_number": "Hudson N_s, no damage",
+    "van_der_meer_cubes_N_od": "Van der Meer (1988) N_od, cubes",
+    "eurotop_crest_width_factor": "EurOtop C_r (crest width)",
+    "eurotop_q_m3_s_m": "EurOtop q (m^3/s per m)",
+}
+#: A mean overtopping discharge below this (m^3/s per m, 1e-6 l/s per m: a few drops over a
+#: test) is drawn as none: a log axis down to round-off would hide the rest.
+DRY_Q = 1e-9
+#: Columns measured in the flume (a NaN there: "not measured"); the others are computed.
+MEASURED_COLUMNS = ("Hm0_m", "Tm_s", "stability_number", "q_m3_s_m")
+#: The formulas' start of damage (``formulas.start_of_damage``) in words.
+START_NAMES = {"hudson_stability_number": "Hudson's N_s (no damage)",
+               "single_layer_cubes_start": "single-layer cubes' start of damage, N_s",
+               "single_layer_cubes_failure": "single-layer cubes' failure, N_s",
+               "van_der_meer_cubes_start_N_od": "Van der Meer's start of damage for cubes, N_od"}
+
+
+def _finite(values) -> np.ndarray:
+    return np.isfinite(np.asarray(values, dtype=float))
+
+
+def _no_wave_height(results: dict) -> str:
+    """Why no step has an incident wave height at the toe, from the steps' surveys."""
+    reasons = [step.get("wave_height_not_measured") for step in results.get("steps", [])]
+    reasons = [reason for reason in reasons if reason]
+    return ("no step measured an incident wave height at the toe"
+            + (f": {reasons[0]}" if reasons else ""))
+
+
+def figures_not_computed(results: dict) -> dict[str, str]:
+    """The series report's plots that have nothing to show, each with why (``{plot: why}``):
+    they are written as that sentence, not as empty axes."""
+    curve = results["curve"]
+    missing = {}
+    if not _finite(curve["stability_number"]).any():
+        missing["damage curve"] = _no_wave_height(results)
+    if not any(np.asarray(table.get("cumulative_wave", [])).size
+               for table in results.get("per_wave", {}).values()):
+        missing["damage development N_od(N)"] = (
+            "no step's per-wave table holds a wave (it counts the incident waves at the toe: "
+            "each step must run until its waves have reached the structure)")
+    q = np.asarray(curve["q_m3_s_m"], dtype=float)
+    if not _finite(curve["Hm0_m"]).any():
+        missing["overtopping"] = _no_wave_height(results)
+    elif not (_finite(q).any() or _finite(curve["eurotop_q_m3_s_m"]).any()):
+        missing["overtopping"] = ("neither a measured q (an overtopping gauge and waves at the "
+                                  "toe) nor EurOtop's (the crest's freeboard) in any step")
+    return missing
+
+
+def _damage_curve_figure(path: Path, results: dict, missing: dict) -> Path:
     plt = _pyplot()
     curve = results["curve"]
     ns = np.asarray(curve["stability_number"], dtype=float)
     figure, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    if "damage curve" in missing:
+        _panel_note(left, "damage curve N_od(N_s): not computed:\n" + missing["damage curve"])
+    else:
+        _damage_curve_panel(left, ns, curve, results)
+    if "damage development N_od(N)" in missing:
+        _panel_note(right, "damage development N_od(N): not computed:\n"
+                    + missing["damage development N_od(N)"])
+    else:
+        for step, table in results.get("per_wave", {}).items():
+            waves = np.asarray(table.get("cumulative_wave", []), dtype=float)
+            if waves.size:
+                right.step(waves, table["N_od"], where="post", label=f"step {step}")
+        right.set_xlabel("waves since the series started")
+        right.set_ylabel("N_od")
+        right.set_title("damage development N_od(N)", fontsize=9)
+        right.grid(alpha=0.3)
+        right.legend(fontsize=7)
+    _smoke_title(figure, results)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+    return path
+
+
+def _damage_curve_panel(left, ns: np.ndarray, curve: dict, results: dict) -> None:
+    """N_od and S against N_s for the steps that measured their waves, beside the formulas."""
     left.plot(ns, curve["N_od"], "o-", color="C0", label="N_od, riprap")
     formula = np.asarray(curve["van_der_meer_cubes_N_od"], dtype=float)
     if np.isfinite(formula).any():
@@ -42,21 +134,6 @@ def _damage_curve_figure(path: Path, results: dict) -> Path:
     twin = left.twinx()
     twin.plot(ns, curve["S"], "^-", color="C2", alpha=0.7, label="S")
     twin.set_ylabel("damage level S", color="C2")
-    for step, table in results.get("per_wave", {}).items():
-        waves = np.asarray(table.get("cumulative_wave", []), dtype=float)
-        if waves.size:
-            right.step(waves, table["N_od"], where="post", label=f"step {step}")
-    right.set_xlabel("waves since the series started")
-    right.set_ylabel("N_od")
-    right.set_title("damage development N_od(N)", fontsize=9)
-    right.grid(alpha=0.3)
-    if results.get("per_wave"):
-        right.legend(fontsize=7)
-    _smoke_title(figure, results)
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
-    return path
 
 
 def _smoke_title(figure, results: dict) -> None:
@@ -69,25 +146,39 @@ def _smoke_banner(results: dict) -> str:
     """A smoke run's report says so first."""
     if results.get("run_mode") != "smoke":
         return ""
-    return ("<p class='smoke'><b>SMOKE RUN</b> (RIPRAP_SMOKE=1): "
-            + html.escape(results.get("run_mode_note", "every step was cut short"))
+    return ("<p class='smoke'><b>SMOKE RUN</b>: "
+            + html.escape(results.get("run_mode_note", "every step was cut short (RIPRAP_SMOKE=1)"))
             + ". Nothing on this page is a result: run the series again without RIPRAP_SMOKE "
             "(into the same folder: the smoke steps are set aside and run in full).</p>")
 
 
-def _overtopping_figure(path: Path, results: dict) -> Path:
+def _overtopping_figure(path: Path, results: dict, missing: dict) -> Path:
     plt = _pyplot()
     curve = results["curve"]
     figure, axes = plt.subplots(figsize=(5.5, 4))
-    axes.semilogy(curve["Hm0_m"], np.maximum(np.asarray(curve["q_m3_s_m"], float), 1e-12), "o-",
-                  label="riprap")
-    reduced = results["formulas"].get("crest_width_m") is not None
-    axes.semilogy(curve["Hm0_m"], curve["eurotop_q_m3_s_m"], "s--",
-                  label="EurOtop (2018) eq. 5.18, mean" + (" x C_r (eq. 6.8)" if reduced else ""))
-    axes.set_xlabel("Hm0 at the toe (m)")
-    axes.set_ylabel("q (m^3/s per m)")
-    axes.legend(fontsize=8)
-    axes.grid(alpha=0.3, which="both")
+    if "overtopping" in missing:
+        _panel_note(axes, "overtopping q(Hm0): not computed:\n" + missing["overtopping"])
+    else:
+        hm0 = np.asarray(curve["Hm0_m"], dtype=float)
+        q = np.asarray(curve["q_m3_s_m"], dtype=float)
+        eurotop = np.asarray(curve["eurotop_q_m3_s_m"], dtype=float)
+        wet = np.isfinite(q) & (q > DRY_Q)
+        if wet.any():
+            axes.semilogy(hm0[wet], q[wet], "o-", color="C0", label="riprap")
+        reduced = results["formulas"].get("crest_width_m") is not None
+        if np.isfinite(eurotop).any():
+            axes.semilogy(hm0, eurotop, "s--", color="C1", label="EurOtop (2018) eq. 5.18, mean"
+                          + (" x C_r (eq. 6.8)" if reduced else ""))
+        dry = np.isfinite(q) & (q <= DRY_Q) & np.isfinite(hm0)
+        if dry.any():
+            axes.set_yscale("log")
+            floor = axes.get_ylim()[0]
+            axes.plot(hm0[dry], np.full(dry.sum(), floor), "v", color="C0", clip_on=False,
+                      label=f"riprap: q below {DRY_Q:g} m^3/s per m (none over the crest)")
+        axes.set_xlabel("Hm0 at the toe (m)")
+        axes.set_ylabel("q (m^3/s per m)")
+        axes.legend(fontsize=8)
+        axes.grid(alpha=0.3, which="both")
     _smoke_title(figure, results)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
@@ -95,20 +186,44 @@ def _overtopping_figure(path: Path, results: dict) -> Path:
     return path
 
 
-def _cell(value) -> str:
+def _cell(value, missing: str = "not computed") -> str:
     if isinstance(value, (int, np.integer)):
         return str(int(value))
     if isinstance(value, float) or isinstance(value, np.floating):
-        return "not computed" if not math.isfinite(value) else f"{value:.4g}"
+        return (f"<span class='missing'>{missing}</span>" if not math.isfinite(value)
+                else f"{value:.4g}")
     return html.escape(str(value))
 
 
-def _table(columns: dict, names: list[str]) -> str:
-    head = "".join(f"<th>{html.escape(name)}</th>" for name in names)
-    count = len(columns[names[0]]) if names else 0
-    rows = "".join("<tr>" + "".join(f"<td>{_cell(columns[name][k])}</td>" for name in names)
-                   + "</tr>" for k in range(count))
-    return f"<table><tr>{head}</tr>{rows}</table>"
+def _curve_table(curve: dict) -> str:
+    """The damage curve as a table: readable column names with units (the key as each header's
+    tooltip), "not measured" where the flume gave nothing, "not computed" where a formula."""
+    names = list(curve)
+    head = "".join(f"<th title='{html.escape(name)}'>{html.escape(COLUMN_NAMES.get(name, name))}"
+                   "</th>" for name in names)
+    missing = {name: "not measured" if name in MEASURED_COLUMNS else "not computed"
+               for name in names}
+    rows = "".join("<tr>" + "".join(f"<td>{_cell(curve[name][k], missing[name])}</td>"
+                                    for name in names) + "</tr>"
+                   for k in range(len(curve[names[0]])))
+    return f"<div class='wide'><table><tr>{head}</tr>{rows}</table></div>"
+
+
+def _first_displacement(results: dict) -> str:
+    """The first displacement beside the formulas' start of damage, in one paragraph."""
+    first = results.get("first_displacement")
+    if first:
+        measured = (f"First displacement at step {first['step']}, N_s = "
+                    f"{_cell(first['stability_number'], 'not measured')}"
+                    + (f" (none at N_s = {first['below']:.3g})"
+                       if isinstance(first.get("below"), float) and math.isfinite(first["below"])
+                       else "") + ".")
+    else:
+        measured = "No unit was displaced in the series."
+    start = [f"{html.escape(START_NAMES.get(key, key))} {value:.3g}"
+             for key, value in results["formulas"]["start_of_damage"].items() if value]
+    return (f"<p>{measured}"
+            + (f" The formulas' start of damage: {'; '.join(start)}." if start else "") + "</p>")
 
 
 def _crest_width_note(results: dict) -> str:
@@ -127,34 +242,51 @@ def _crest_width_note(results: dict) -> str:
             f"({html.escape(str(formulas.get('crest_width_source', '')))}): {factors}.</p>")
 
 
-_STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
-          "collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 7px;font-size:13px}"
-          "img{max-width:100%}.smoke{background:#fde2e1;border:2px solid #c0392b;padding:8px}")
+_STYLE = ("body{font-family:sans-serif;max-width:1100px;margin:auto;padding:0 12px}"
+          "p{overflow-wrap:anywhere}table{border-collapse:collapse;margin:8px 0}"
+          "td,th{border:1px solid #bbb;padding:3px 6px;font-size:13px}"
+          "th{font-weight:600;background:#f3f3f3;vertical-align:bottom}.wide{overflow-x:auto}"
+          "img{max-width:100%}.missing{color:#777;font-style:italic}"
+          ".smoke{background:#fde2e1;border:2px solid #c0392b;padding:8px}")
+
+
+def _figure_html(name: str, plots: list[str], missing: dict, width: str = "") -> str:
+    """A figure's image, unless every plot in it is not computed, and each that is, named."""
+    notes = "".join(f"<p class='missing'>{html.escape(plot)}: not computed: "
+                    f"{html.escape(missing[plot])}.</p>" for plot in plots if plot in missing)
+    if all(plot in missing for plot in plots):
+        return notes
+    style = f" style='max-width:{width}'" if width else ""
+    return f"<img src='{name}' alt='{html.escape(', '.join(plots))}'{style}>{notes}"
 
 
 def write_series_report(out, results: dict) -> dict:
     """``damage_curve.png``, ``overtopping.png`` and ``report.html`` in ``out``; returns their
-    paths by name."""
+    paths by name. A plot with nothing to show (``figures_not_computed``) is drawn as the
+    sentence saying why, and the page names it as not computed instead of showing it."""
     out = Path(out)
-    outputs = {"damage_curve_figure": str(_damage_curve_figure(out / "damage_curve.png", results)),
-               "overtopping_figure": str(_overtopping_figure(out / "overtopping.png", results))}
+    missing = figures_not_computed(results)
+    outputs = {"damage_curve_figure": str(_damage_curve_figure(out / "damage_curve.png", results,
+                                                               missing)),
+               "overtopping_figure": str(_overtopping_figure(out / "overtopping.png", results,
+                                                             missing))}
     curve = results["curve"]
-    first = results.get("first_displacement")
-    start = results["formulas"]["start_of_damage"]
+    unmeasured = [f"Step {step['step']}: Hm0 not measured ({step['wave_height_not_measured']})."
+                  for step in results["steps"] if step.get("wave_height_not_measured")]
     parts = [_smoke_banner(results),
-             f"<p>Case {html.escape(results['case_file'])}. A unit is displaced once it moved more "
-             f"than {results['displacement_threshold_over_dn']:g} Dn from where the series "
+             f"<p>Case <code>{html.escape(Path(results['case_file']).name)}</code> (its keys "
+             "are in <a href='series.json'>series.json</a>). A unit is displaced once it moved "
+             f"more than {results['displacement_threshold_over_dn']:g} Dn from where the series "
              "started; every figure below is counted from that start.</p>",
              "<h2>Damage curve</h2>",
-             _table(curve, list(curve)),
-             "<p>" + (f"First displacement at step {first['step']}, N_s = "
-                      f"{first['stability_number']:.3g}" + (f" (none at N_s = {first['below']:.3g})"
-                                                            if first.get("below") else "")
-                      if first else "No unit was displaced in the series.")
-             + "; the formulas' start of damage: "
-             + ", ".join(f"{html.escape(k)} = {v:g}" for k, v in start.items() if v) + ".</p>",
+             _curve_table(curve),
+             ("<p class='missing'>" + html.escape(" ".join(unmeasured)) + "</p>"
+              if unmeasured else ""),
+             _first_displacement(results),
              _crest_width_note(results),
-             "<img src='damage_curve.png'><img src='overtopping.png'>",
+             _figure_html("damage_curve.png", ["damage curve", "damage development N_od(N)"],
+                          missing),
+             _figure_html("overtopping.png", ["overtopping"], missing, "49%"),
              f"<p>Sources: {html.escape(results['formulas']['sources'])}.</p>",
              "<h2>Before the series</h2><p><a href='start/report.html'>the layer as built</a> "
              "(frame 0 of step 1)</p>"]

@@ -318,8 +318,9 @@ def world():
     except ImportError as error:
         raise ParallelError(
             f"riprap was started as {launched} processes, but mpi4py is not installed, so they "
-            "cannot work as one run: install it with `python3 -m pip install 'riprap[mpi]'` "
-            "(mpi4py and the MPICH wheel), or run one process without mpiexec") from error
+            "cannot work as one run: install it with `python3 -m pip install '.[mpi]'` in "
+            "riprap's folder (mpi4py and the MPICH wheel; or `python3 -m pip install mpi4py` "
+            "for your cluster's MPI), or run one process without mpiexec") from error
     comm = MPI.COMM_WORLD
     if comm.Get_size() == 1:
         _WORLD = SingleProcess()

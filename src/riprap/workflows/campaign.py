@@ -18,12 +18,20 @@ campaign killed or lost, or a member whose worker died, is started again with th
 A smoke campaign (``RIPRAP_SMOKE=1``) over a full one is refused; the mode is handed to every
 worker (a remote worker's own environment does not decide it).
 
-Dask is optional: ``pip install 'riprap[campaign]'``; riprap and single runs work without it.
+Dask is optional: ``python3 -m pip install '.[campaign]'`` in riprap's folder (as the README
+installs riprap; or ``python3 -m pip install distributed``); riprap and single runs work without
+it.
+
+Progress: every member keeps its messages, its steps' progress and its warnings in its
+``series.log``; the campaign follows those logs and says each line with the member's name, on the
+terminal and in the campaign folder's ``campaign.log`` (a warning once, however many members
+give it).
 """
 from __future__ import annotations
 
 import math
 import os
+import time as wallclock
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,17 +44,25 @@ from riprap.io.json_files import read_json_object, write_json
 from riprap.io.output_folder import prepare_output_folder
 from riprap.io.pack import riprap_version
 from riprap.io.csv_tables import write_columns_csv
-from riprap.workflows.series import check_series, run_series
+from riprap.io.log_file import append_log_lines, log_size, read_new_log_lines
+from riprap.work_estimate import duration_words, warning_line
+from riprap.workflows.series import check_series, run_series, series_wall_seconds
+from riprap.workflows.series_progress import SERIES_LOG
 from riprap.workflows.series_record import (RUN_MODES, mode_words, run_mode, series_fingerprint,
                                             smoke_note)
 
-__all__ = ["Member", "members_of", "run_campaign", "CAMPAIGN_RECORD", "SCHEDULER_TIMEOUT_S"]
+__all__ = ["Member", "members_of", "run_campaign", "campaign_cost", "CAMPAIGN_RECORD",
+           "CAMPAIGN_LOG", "SCHEDULER_TIMEOUT_S"]
 
 CAMPAIGN_RECORD = "campaign.json"
 #: Its format: 2 records the run mode and lets members be added (2026-12).
 CAMPAIGN_FORMAT = 2
 #: Seconds a scheduler address is given to answer before the campaign is refused.
 SCHEDULER_TIMEOUT_S = 5.0
+#: The campaign folder's log: the campaign's messages and its members' progress and warnings.
+CAMPAIGN_LOG = "campaign.log"
+#: Wall seconds between two looks at the members' logs while they run.
+POLL_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -91,7 +107,7 @@ def _run_member(case_file: str, folder: str, seed_offset: int, threads: int,
     numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     lines = []
     results = run_series(load_case(case_file), output_directory=folder, progress=False,
-                         say=lines.append, seed_offset=seed_offset)
+                         say=lines.append, seed_offset=seed_offset, log_warnings=True)
     results["log"] = lines
     return results
 
@@ -101,8 +117,8 @@ def _client(scheduler: str | None, workers: int, threads: int):
         from dask.distributed import Client, LocalCluster
     except ImportError:
         raise RiprapError("a campaign runs its members on Dask (dask.distributed), which is not "
-                          "installed: pip install 'riprap[campaign]' (or: pip install "
-                          "distributed)") from None
+                          "installed: python3 -m pip install '.[campaign]' in riprap's "
+                          "folder (or: python3 -m pip install distributed)") from None
     if scheduler:
         try:
             return Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s"), None
@@ -178,12 +194,13 @@ def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int =
     if workers < 1 or threads < 1:
         raise CaseFileError(f"workers ({workers}) and threads ({threads}) must be >= 1")
     cases = {member.case_file: load_case(member.case_file) for member in members}
-    for member in members:
-        case = cases[member.case_file]
-        if not case.is_series:
-            raise CaseFileError(f"{member.case_file}: a campaign member is a test series: the "
-                                "case needs [series] and [[series_steps]]")
-        check_series(case, out / member.name, member.seed_offset)
+    with warnings.catch_warnings(record=True) as caught:
+        for member in members:
+            case = cases[member.case_file]
+            if not case.is_series:
+                raise CaseFileError(f"{member.case_file}: a campaign member is a test series: "
+                                    "the case needs [series] and [[series_steps]]")
+            check_series(case, out / member.name, member.seed_offset)
     fingerprints = [series_fingerprint(cases[m.case_file]) for m in members]
     growth = _claim(out, members, fingerprints)      # before any worker starts
     own_cluster = None
@@ -192,21 +209,37 @@ def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int =
     try:
         prepare_output_folder(out)
         write_json(out / CAMPAIGN_RECORD, _record(members, fingerprints))
-        say(f"riprap: campaign of {len(members)} members on the Dask scheduler "
-            f"{getattr(client.scheduler, 'address', '')}: " + ", ".join(m.name for m in members)
-            + (f"; {growth}" if growth else "")
-            + (f"; {mode_words('smoke')}" if run_mode() == "smoke" else ""))
+        logs = _MemberLogs(out, members, say)
+        for warning in caught:          # the checks' warnings, once (the workers' are not said)
+            logs.say_warning(warning_line(warning.message, warning.category))
+        logs.say(f"riprap: campaign of {len(members)} members on the Dask scheduler "
+                 f"{getattr(client.scheduler, 'address', '')}: "
+                 + ", ".join(m.name for m in members) + (f"; {growth}" if growth else "")
+                 + (f"; {mode_words('smoke')}" if run_mode() == "smoke" else "")
+                 + f"; progress in {out / CAMPAIGN_LOG}")
+        logs.say(f"riprap: {campaign_cost(members, cases, workers)}")
         futures = [client.submit(_run_member, str(m.case_file), str(out / m.name), m.seed_offset,
                                  threads, run_mode(), key=f"riprap-{m.name}", pure=False)
                    for m in members]
         results, failed = {}, {}
-        for member, future in zip(members, futures):
-            try:
-                results[member.name] = future.result()
-                say(f"riprap: campaign member {member.name} done")
-            except Exception as error:  # noqa: BLE001 - one member's failure ends only it
-                failed[member.name] = f"{type(error).__name__}: {error}"
-                say(f"riprap: campaign member {member.name} failed: {failed[member.name]}")
+        waiting = dict(zip(members, futures))
+        while waiting:
+            finished = [m for m, future in waiting.items() if future.done()]
+            logs.follow()
+            if not finished:
+                wallclock.sleep(POLL_S)
+                continue
+            for member in finished:
+                future = waiting.pop(member)
+                try:
+                    results[member.name] = future.result()
+                    logs.follow()
+                    logs.say(f"riprap: campaign member {member.name} done")
+                except Exception as error:  # noqa: BLE001 - one member's failure ends only it
+                    failed[member.name] = f"{type(error).__name__}: {error}"
+                    logs.follow()
+                    logs.say(f"riprap: campaign member {member.name} failed: "
+                             f"{failed[member.name]}")
     finally:
         if own_cluster is not None:
             client.close()
@@ -227,6 +260,58 @@ def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int =
     for case_name, columns in summary.items():
         write_columns_csv(out / f"{case_name}_spread.csv", columns)
     return campaign
+
+
+def campaign_cost(members: list[Member], cases: dict, workers: int) -> str:
+    """The wall time a campaign of ``members`` is likely to take on ``workers`` workers (one
+    member each at once), in words: each member's series estimate
+    (``riprap.workflows.series.series_wall_seconds``), the longest first on the least busy
+    worker."""
+    costs = sorted((series_wall_seconds(cases[m.case_file], m.seed_offset)[0] for m in members),
+                   reverse=True)
+    busy = [0.0] * max(1, min(workers, len(members)))
+    for cost in costs:
+        busy[busy.index(min(busy))] += cost
+    return (f"cost: about {duration_words(max(busy))} of wall time for the campaign: "
+            f"{len(members)} members of about {duration_words(min(costs))}"
+            + (f" to {duration_words(max(costs))}" if duration_words(max(costs))
+               != duration_words(min(costs)) else "")
+            + f" each (2 cores per member, examples/10's measured pace, within a factor of "
+            f"2-3) on {len(busy)} worker{'s' if len(busy) > 1 else ''} at once")
+
+
+class _MemberLogs:
+    """The campaign's terminal and ``campaign.log``: its own messages, and every member's
+    progress and warnings as they are appended to the member's ``series.log`` (each line said
+    with the member's name; a warning already said, by the checks or another member, is not
+    said again)."""
+
+    def __init__(self, out: Path, members: list[Member], say):
+        self.path = out / CAMPAIGN_LOG
+        self._say = say
+        self._members = {m.name: out / m.name / SERIES_LOG for m in members}
+        # a resumed campaign: what the members' logs held before is not said again
+        self._offsets = {name: log_size(path) for name, path in self._members.items()}
+        self._warnings = set()
+
+    def say(self, line: str) -> None:
+        self._say(line)
+        append_log_lines(self.path, [line])
+
+    def say_warning(self, line: str | None) -> None:
+        if line is not None and line not in self._warnings:
+            self._warnings.add(line)
+            self.say(line)
+
+    def follow(self) -> None:
+        """Say what the members appended to their logs since the last call."""
+        for name, path in self._members.items():
+            lines, self._offsets[name] = read_new_log_lines(path, self._offsets[name])
+            for line in lines:
+                if line.startswith("riprap: warning"):
+                    self.say_warning(line)
+                else:
+                    self.say(f"riprap: {name}: {line.removeprefix('riprap: ')}")
 
 
 def _spread(members: list[Member], results: dict) -> dict:

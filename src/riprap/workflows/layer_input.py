@@ -187,7 +187,8 @@ def load_run_state(run_folder, *, frame: int = -1, reference_run=None):
     history = _rotation_history(run_folder, frames, frame, pack, pack_file, own_reference,
                                 rotations)
     return _layer_state(pack, positions=positions, rotations=rotations, contacts=contacts,
-                        time=time, source=f"{run_folder} frame {frame} (t = {time:g} s)",
+                        time=time, source=f"{run_folder}, frame {frame % len(frames)}"
+                        + (" (the last)" if frame % len(frames) == len(frames) - 1 else ""),
                         contacts_recorded=not coupled, rotation_history=history, **reference)
 
 

@@ -34,18 +34,21 @@ import numpy as np
 from riprap.analysis.series_damage import series_curve
 from riprap.case.build_fluid import build_fluid_run, build_fluid_solver
 from riprap.case.load import parse_case
-from riprap.case.series_steps import step_case_text, step_seas
+from riprap.case.series_steps import mean_zero_crossing_period, step_case_text, step_seas
 from riprap.errors import CaseFileError
 from riprap.io.json_files import read_json_object, write_json
 from riprap.io.output_folder import prepare_output_folder, remove_folder
 from riprap.io.csv_tables import read_columns_csv, write_columns_csv
 from riprap.io.series_report import write_series_report
 from riprap.workflows.analyse import analyse
+from riprap.work_estimate import duration_words, flume_run_seconds
+from riprap.workflows.series_progress import SERIES_LOG, SeriesLog, StepProgress
 from riprap.workflows.series_record import (SERIES_RECORD, claim_series_folder, run_mode,
                                             smoke_note, series_fingerprint, series_record,
                                             set_smoke_steps_aside)
 
-__all__ = ["run_series", "check_series", "series_fingerprint", "SERIES_RECORD", "step_folder"]
+__all__ = ["run_series", "check_series", "series_wall_seconds", "series_fingerprint",
+           "SERIES_RECORD", "step_folder"]
 
 def step_folder(out: Path, number: int) -> Path:
     """The folder of step ``number`` (from 1)."""
@@ -95,8 +98,11 @@ def check_series(case, output_directory=None, seed_offset: int = 0) -> list[str]
     first = build_fluid_run(steps[0].case, output_directory=steps[0].folder, progress=False)
     claim = claim_series_folder(out, _record(case, steps, seed_offset))
     layer = first.filter_layer
+    seconds, basis = series_wall_seconds(case, seed_offset)
     return [f"{len(steps)} steps: each step's sea in the flume (as [waves]), Hm0 "
             + ", ".join(f"{s.sea.significant_height:g}" for s in steps) + " m",
+            f"cost: about {duration_words(seconds)} of wall time for the series ({basis}); a "
+            "campaign runs one member (series) per worker at once",
             f"bodies of the first step ({case.body_count})",
             *([] if layer is None
               else [f"filter layer: {line}" for line in layer.lines(entries=False)]),
@@ -104,11 +110,40 @@ def check_series(case, output_directory=None, seed_offset: int = 0) -> list[str]
             "none)" + (f": {claim.note}" if claim.note else "")]
 
 
+def series_wall_seconds(case, seed_offset: int = 0) -> tuple[float, str]:
+    """The wall seconds the series of ``case`` is likely to take on 2 cores
+    (``riprap.work_estimate.flume_run_seconds`` over every step's simulated time) and what the
+    estimate stands on, in words."""
+    fluid = case.fluid
+    cells = int(np.prod(fluid.cells))
+    cell_size = float(min((high - low) / count for high, low, count
+                          in zip(fluid.upper, fluid.lower, fluid.cells)))
+    depth = case.waves.still_water_level - fluid.lower[2]
+    simulated = sum(sea.end_time for sea in step_seas(case, seed_offset))
+    seconds = flume_run_seconds(simulated_time=simulated, cells=cells, cell_size=cell_size,
+                                depth=depth, gravity=float(-case.simulation.gravity[2]))
+    return seconds, (f"{simulated:.4g} s simulated on {cells:,} cells of {cell_size:.3g} m in "
+                     f"{depth:.3g} m of water, at examples/10's measured pace on 2 cores, "
+                     "within a factor of 2-3")
+
+
 def run_series(case, *, output_directory=None, progress: bool = True, say=print,
-               seed_offset: int = 0) -> dict:
+               seed_offset: int = 0, log_warnings: bool = False) -> dict:
     """Run the test series of ``case`` (a case with ``[series]``) into ``output_directory``
     (default ``[output] directory``), every step's seed raised by ``seed_offset`` (a campaign's
-    member); returns the series results (``series_results.json``)."""
+    member); returns the series results (``series_results.json``). Every message is said
+    (``say``) and kept in the folder's ``series.log`` with each step's progress;
+    ``log_warnings``: warnings go there too, as ``riprap: warning:`` lines, instead of being
+    printed by Python (a campaign's worker)."""
+    log = SeriesLog(say)
+    if not log_warnings:
+        return _run_series(case, output_directory, progress, log, seed_offset)
+    with log.warnings_logged():
+        return _run_series(case, output_directory, progress, log, seed_offset)
+
+
+def _run_series(case, output_directory, progress: bool, say: SeriesLog,
+                seed_offset: int) -> dict:
     if not case.is_series:
         raise CaseFileError(f"{case.source}: has no [series] table: run it with riprap run")
     out = Path(output_directory or case.output.directory)
@@ -120,6 +155,7 @@ def run_series(case, *, output_directory=None, progress: bool = True, say=print,
         say(f"riprap: series folder {out}: {claim.note}")
     if claim.set_smoke_aside:
         set_smoke_steps_aside(out)
+    say.open(out / SERIES_LOG)
     write_json(out / SERIES_RECORD, record)
     total = sum(s.sea.end_time for s in steps)
     simulated, wall = 0.0, 0.0
@@ -136,14 +172,19 @@ def run_series(case, *, output_directory=None, progress: bool = True, say=print,
                           .get("wall_time", 0.0))
         else:
             to_go = ("" if simulated == 0 or wall == 0 else
-                     f"; about {(total - simulated) * wall / simulated / 3600:.2g} h of the series "
-                     "to go at the pace so far")
+                     f"; about {duration_words((total - simulated) * wall / simulated)} of the "
+                     "series to go at the pace so far")
             say(f"riprap: series step {sea.number}/{len(steps)}: Hm0 = {sea.significant_height:g} "
                 f"m, Tp = {sea.peak_period:.3g} s, {sea.duration:.4g} s of sea"
                 + (f" (~{sea.waves} waves)" if sea.waves else "")
                 + f", {sea.end_time:.4g} s simulated{to_go}")
             started = wallclock.perf_counter()
-            _run_step(step, steps[index - 1] if index else None, len(steps), progress)
+            _run_step(step, steps[index - 1] if index else None, len(steps), progress,
+                      StepProgress(say, label=f"series step {sea.number}/{len(steps)}",
+                                   end_time=sea.end_time, sea_duration=sea.duration,
+                                   waves=sea.waves or sea.duration / mean_zero_crossing_period(
+                                       sea.peak_period, sea.peak_enhancement),
+                                   later_simulated_s=total - simulated - sea.end_time))
             wall += wallclock.perf_counter() - started
         simulated += sea.end_time
         if index == 0 and not (out / "start" / "layer_summary.json").is_file():
@@ -158,11 +199,14 @@ def run_series(case, *, output_directory=None, progress: bool = True, say=print,
     return results
 
 
-def _run_step(step: _Step, before: _Step | None, count: int, progress: bool) -> None:
+def _run_step(step: _Step, before: _Step | None, count: int, progress: bool,
+              progress_log: StepProgress) -> None:
     folder = step.folder
     prepare_output_folder(folder)
     (folder / "step.toml").write_text(step.text, encoding="utf-8")
     sim = build_fluid_run(step.case, output_directory=folder, progress=progress)
+    progress_log.run_ends_at(sim.end_time)
+    sim.add_writer(progress_log)
     sim.case_file = str((folder / "step.toml").resolve())
     sea = step.sea
     sim.progress_label = (f"step {sea.number}/{count}, Hm0 {sea.significant_height:g} m"
@@ -201,12 +245,14 @@ def _survey(step: _Step, first: Path, case, say) -> None:
 
 def _series_results(out: Path, steps: list[_Step], case) -> dict:
     """The damage curve from every step's survey and per-wave table, beside the formulas."""
-    rows, flume, per_wave, counted_so_far = [], {}, {}, 0
+    rows, flume, per_wave, counted_so_far, unmeasured = [], {}, {}, 0, {}
     for step in steps:
         folder = step.folder
         layer = read_json_object(folder / "survey" / "layer_summary.json", "layer summary",
                                  "riprap series wrote it after the step")
         flume = layer.get("flume_test") or {}
+        if not isinstance(flume.get("Hm0_m"), (int, float)):
+            unmeasured[step.sea.number] = _why_not_measured(flume)
         waves = {"overtopping_m3_per_m": [], "wave": []}
         if (folder / "survey" / "per_wave.csv").is_file():
             waves = read_columns_csv(folder / "survey" / "per_wave.csv")
@@ -243,9 +289,20 @@ def _series_results(out: Path, steps: list[_Step], case) -> dict:
     results["displacement_threshold_over_dn"] = case.series.displacement_threshold
     results["steps"] = [{"step": s.sea.number, "folder": str(s.folder),
                          "target_Hm0_m": s.sea.significant_height, "Tp_s": s.sea.peak_period,
-                         "target_waves": s.sea.waves, "sea_duration_s": s.sea.duration}
+                         "target_waves": s.sea.waves, "sea_duration_s": s.sea.duration,
+                         "wave_height_not_measured": unmeasured.get(s.sea.number)}
                         for s in steps]
     return results
+
+
+def _why_not_measured(flume: dict) -> str:
+    """Why a step's survey has no incident wave height at the toe, from its flume test."""
+    reasons = [str(text) for text in flume.get("not_computed", [])
+               if str(text).startswith("stability number")]
+    if reasons:
+        why = reasons[0].removeprefix("stability number: ").removeprefix("no incident wave height")
+        return why.strip().removeprefix("(").removesuffix(")") or "no incident wave height"
+    return str(flume.get("note") or "the step's survey has no flume test (no waves report)")
 
 
 def _crest_width(over, flume: dict) -> tuple[float | None, str | None]:

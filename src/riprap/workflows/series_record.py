@@ -46,7 +46,7 @@ SURVEY_KEYS = (("series", "displacement_threshold"),)
 SMOKE_FOLDER = "smoke_run"
 #: What a series writes in its folder besides the steps (set aside with smoke steps).
 SERIES_OUTPUTS = ("start", "series_results.json", "damage_curve.csv", "damage_curve.png",
-                  "overtopping.png", "report.html")
+                  "overtopping.png", "report.html", "series.log")
 
 
 def run_mode() -> str:
