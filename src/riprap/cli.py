@@ -28,12 +28,12 @@ import riprap
 from riprap.case.build import SMOKE_END_TIME, build_simulation, smoke_mode
 from riprap.case.build_fluid import build_fluid_run
 from riprap.case.load import load_case
-from riprap.errors import CaseFileError, RiprapError, plain_numbers
+from riprap.errors import CaseFileError, RiprapError
 from riprap.io.json_files import read_json_object
 from riprap.io.output_folder import describe_os_error
 from riprap.parallel.communicator import launched_processes, world
 from riprap.solid.kernels.pair_rule import PAIR_RULE_TEXT
-from riprap.work_estimate import RiprapWarning
+from riprap.work_estimate import warning_line
 from riprap.workflows.analyse import analyse, compare_layers
 from riprap.workflows.check import check_case
 from riprap.workflows.place import run_placement
@@ -99,18 +99,15 @@ def _run_case(path: Path, out: str | None, restart: str | None, quiet: bool) -> 
 
 
 def _series_case(path: Path, case, out: str | None, quiet: bool) -> int:
-    from riprap.workflows.series import run_series  # lazy: only series cases need it
+    from riprap.workflows.series import run_series, series_summary_lines  # lazy: series only
 
     print(f"riprap: test series {path}: {len(case.series_steps)} steps, {case.body_count} bodies")
     results = run_series(case, output_directory=out, progress=not quiet)
     if results.get("run_mode") == "smoke":
         print(f"riprap: SMOKE RUN: {results['run_mode_note']}; the figures below are not a "
               "damage curve")
-    curve = results["curve"]
-    for k, step in enumerate(curve["step"]):
-        print(f"riprap: step {step}: Hm0 {curve['Hm0_m'][k]:.3g} m, N_s "
-              f"{curve['stability_number'][k]:.3g}, {curve['waves'][k]} waves, N_od "
-              f"{curve['N_od'][k]:.3g}, S {curve['S'][k]:.3g}, q {curve['q_m3_s_m'][k]:.3g} m3/s/m")
+    for line in series_summary_lines(results):
+        print(line)
     for key, value in results["outputs"].items():
         print(f"riprap: {key}: {value}")
     return 0
@@ -378,10 +375,9 @@ def _dispatch(args) -> int:
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     """riprap's own warnings as one line each; numpy's RuntimeWarnings are not shown (riprap checks
     that the state stays finite and names the body and time when it does not)."""
-    if issubclass(category, RiprapWarning):
-        print(f"riprap: warning: {plain_numbers(str(message))}", file=sys.stderr)
-    elif not issubclass(category, RuntimeWarning):
-        print(f"riprap: warning ({category.__name__}): {message}", file=sys.stderr)
+    text = warning_line(message, category)
+    if text is not None:
+        print(text, file=sys.stderr)
 
 
 def main(argv: list[str] | None = None) -> int:

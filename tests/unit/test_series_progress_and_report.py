@@ -27,6 +27,7 @@ from riprap.io.series_report import write_series_report
 from riprap.work_estimate import duration_words
 from riprap.workflows.campaign import CAMPAIGN_LOG, campaign_cost, members_of, run_campaign
 from riprap.workflows.check import check_case
+from riprap.workflows.series import series_summary_lines
 from riprap.workflows.series_progress import SeriesLog, StepProgress
 
 from test_series import STEPS, _write_series_case
@@ -65,6 +66,10 @@ def test_a_campaigns_log_holds_every_members_progress_and_each_warning_once(
         assert any("series step 1 survey" in line for line in member)
         survey = (out / name / "step_01" / "survey" / "report.html").read_text()
         assert "frame -1" not in survey and "frame 1 (the last), t = 0.01 s" in survey
+        # the step's survey says it is of a smoke run, as the series report does
+        assert "<title>riprap armour layer analysis (SMOKE RUN)</title>" in survey
+        assert json.loads((out / name / "step_01" / "survey" / "layer_summary.json").read_text()
+                          )["run_mode"] == "smoke"
     # the smoke run's end-time warning of each member: one riprap line each, no raw warning
     warnings = [line for line in log if line.startswith("riprap: warning")]
     assert warnings and len(warnings) == len(set(warnings))
@@ -138,6 +143,15 @@ def test_a_series_report_that_measured_nothing_draws_no_empty_axes(tmp_path, dra
     assert "No unit was displaced in the series. The formulas' start of damage: " in page
     assert ".;" not in page
     assert "series.toml" in page and str(tmp_path / "deep") not in page
+
+
+def test_the_terminal_says_not_measured_never_nan(tmp_path):
+    lines = series_summary_lines(_results(tmp_path, measured=False))
+    assert lines[0] == ("riprap: step 1: Hm0 and N_s not measured (no surface gauge could be "
+                        "analysed; the record ends at t = 0.01 s), N_od 0, S 0.1, q not measured")
+    assert not any("nan" in line for line in lines)
+    measured = series_summary_lines(_results(tmp_path, measured=True))
+    assert measured[1].startswith("riprap: step 2: Hm0 0.12 m, N_s 0.71, 22 waves, N_od 0.4")
 
 
 def test_a_series_report_that_measured_waves_draws_them(tmp_path, drawn):

@@ -30,7 +30,7 @@ from riprap.solid.solver import ContactRecords
 
 __all__ = ["is_run_folder", "pack_folder", "included_pack", "read_pvd_frames", "read_frame_mesh",
            "read_bodies_frame", "read_contacts_vtu", "no_contact_records", "run_case_file",
-           "load_waves_report"]
+           "load_waves_report", "run_was_smoke"]
 
 
 def pack_folder(path: Path) -> tuple[Path, Path]:
@@ -46,6 +46,15 @@ def is_run_folder(path) -> bool:
     path = Path(path)
     return (path.is_dir() and (path / "bodies.pvd").is_file()
             and not (path / "pack.toml").is_file())
+
+
+def run_was_smoke(path) -> bool:
+    """Whether the run in folder ``path`` was a smoke run (its ``summary.json`` says so:
+    ``RIPRAP_SMOKE=1``, cut short, no results); False for a pack or a run without a summary."""
+    summary = Path(path) / "summary.json"
+    if not (is_run_folder(path) and summary.is_file()):
+        return False
+    return read_json_object(summary, "run summary", "riprap run wrote it").get("smoke") is True
 
 
 def included_pack(case_file: Path) -> Path | None:

@@ -228,6 +228,7 @@ td.inside { color: #1a7f37; font-weight: bold; } td.outside { color: #b42318; fo
 .figures { display: flex; flex-wrap: wrap; gap: 1em; } .figures img { max-width: 34em; }
 img.wide { max-width: 100%; } .note { color: #555; font-size: 0.85em; }
 h3 { font-size: 1em; margin-top: 1.2em; } .missing { color: #9a6700; font-style: italic; }
+.smoke { background: #fde2e1; border: 2px solid #c0392b; padding: 0.5em; }
 """
 
 
@@ -405,8 +406,14 @@ def _write_report(out: Path, analysis) -> Path:
         f"<img src='layer_{column}.png' alt='layer, {html.escape(label)}'>"
         f"<img src='slope_{column}.svg' alt='face view, {html.escape(label)}'></div>"
         for column, (label, _) in PER_UNIT_FIELDS.items() if column in drawn_fields(units))
+    smoke = ("<p class='smoke'><b>SMOKE RUN</b>: the run was cut to a few steps (RIPRAP_SMOKE=1, "
+             "its <code>summary.json</code>: <code>smoke</code>); nothing on this page is a "
+             "result: run it again without RIPRAP_SMOKE.</p>"
+             if layer.get("run_mode") == "smoke" else "")
     body = (
-        f"<p class='note'>Analysed: {html.escape(str(layer['source']))}, t = {layer['time_s']:g} s. "
+        f"{smoke}<p class='note'>Analysed: {html.escape(str(layer['source']))}"
+        # a run's frame names its time (frame 3 (the last), t = 4 s); a pack's does not
+        + ("" if "t = " in str(layer["source"]) else f", t = {layer['time_s']:g} s") + ". "
         f"{layer['units']} {html.escape(layer['unit'])} units (D<sub>n</sub> = "
         f"{layer['nominal_diameter_m']:.3f} m) on a {layer['slope_angle_deg']:.1f}&deg; slope. "
         "Tables: <a href='units.csv'>units.csv</a> (one row per unit), "
@@ -440,7 +447,9 @@ def _write_report(out: Path, analysis) -> Path:
         "row by row (riprap/placement/layer_metrics.py). Stereonet: lower hemisphere, equal area, "
         "exponential Kamb contours.</p>")
     path = out / "report.html"
-    path.write_text(_page("riprap armour layer analysis", body), encoding="utf-8")
+    path.write_text(_page("riprap armour layer analysis"
+                          + (" (SMOKE RUN)" if layer.get("run_mode") == "smoke" else ""), body),
+                    encoding="utf-8")
     return path
 
 

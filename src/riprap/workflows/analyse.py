@@ -16,7 +16,7 @@ from riprap.analysis.flume_test import FlumeRecords, fluid_force_columns, with_d
 from riprap.analysis.layer_analysis import DISPLACED_THRESHOLD_DN, LayerAnalysis, analyse_layer
 from riprap.analysis.stability_report import flume_stability
 from riprap.errors import CaseFileError
-from riprap.io.analysis_input import is_run_folder, load_waves_report
+from riprap.io.analysis_input import is_run_folder, load_waves_report, run_was_smoke
 from riprap.io.analysis_report import write_analysis, write_comparison
 from riprap.io.body_forces import read_peak_fluid_forces
 from riprap.io.frame_contacts import read_unit_contacts_per_frame
@@ -48,6 +48,8 @@ def analyse(path, *, out=None, frame: int = -1, reference_run=None,
     analysis = analyse_layer(load_layer_state(path, frame=frame, reference_run=reference_run),
                              displaced_threshold_dn=displaced_threshold_dn)
     analysis = _add_flume_test(path, waves, analysis)
+    if run_was_smoke(path):
+        analysis.layer["run_mode"] = "smoke"      # the report and layer_summary.json say so
     if out is not None:
         analysis.layer["outputs"] = write_analysis(out, analysis)
         # the whole run's waves: with its last frame only

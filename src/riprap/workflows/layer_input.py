@@ -188,7 +188,8 @@ def load_run_state(run_folder, *, frame: int = -1, reference_run=None):
                                 rotations)
     return _layer_state(pack, positions=positions, rotations=rotations, contacts=contacts,
                         time=time, source=f"{run_folder}, frame {frame % len(frames)}"
-                        + (" (the last)" if frame % len(frames) == len(frames) - 1 else ""),
+                        + (" (the last)" if frame % len(frames) == len(frames) - 1 else "")
+                        + f", t = {time:g} s",
                         contacts_recorded=not coupled, rotation_history=history, **reference)
 
 

@@ -47,7 +47,8 @@ from riprap.workflows.series_record import (SERIES_RECORD, claim_series_folder, 
                                             smoke_note, series_fingerprint, series_record,
                                             set_smoke_steps_aside)
 
-__all__ = ["run_series", "check_series", "series_wall_seconds", "series_fingerprint",
+__all__ = ["run_series", "check_series", "series_wall_seconds", "series_summary_lines",
+           "series_fingerprint",
            "SERIES_RECORD", "step_folder"]
 
 def step_folder(out: Path, number: int) -> Path:
@@ -293,6 +294,28 @@ def _series_results(out: Path, steps: list[_Step], case) -> dict:
                          "wave_height_not_measured": unmeasured.get(s.sea.number)}
                         for s in steps]
     return results
+
+
+def series_summary_lines(results: dict) -> list[str]:
+    """One line per step of the damage curve for the terminal, saying "not measured" (and why)
+    where the flume gave nothing, never "nan"."""
+    curve, lines = results["curve"], []
+    why = {step["step"]: step.get("wave_height_not_measured") for step in results["steps"]}
+
+    def shown(value, form: str, unit: str = "") -> str:
+        value = _number(value)         # a null of series_results.json too
+        return f"{value:{form}}{unit}" if math.isfinite(value) else "not measured"
+
+    for k, step in enumerate(curve["step"]):
+        if math.isfinite(_number(curve["Hm0_m"][k])):
+            waves = (f"Hm0 {curve['Hm0_m'][k]:.3g} m, N_s {curve['stability_number'][k]:.3g}, "
+                     f"{curve['waves'][k]} waves")
+        else:
+            waves = ("Hm0 and N_s not measured" + (f" ({why[step]})" if why.get(step) else ""))
+        lines.append(f"riprap: step {step}: {waves}, N_od {shown(curve['N_od'][k], '.3g')}, S "
+                     f"{shown(curve['S'][k], '.3g')}, q "
+                     f"{shown(curve['q_m3_s_m'][k], '.3g', ' m3/s/m')}")
+    return lines
 
 
 def _why_not_measured(flume: dict) -> str:
