@@ -104,6 +104,7 @@ def _damage_curve_figure(path: Path, results: dict, missing: dict) -> Path:
                 right.step(waves, table["N_od"], where="post", label=f"step {step}")
         right.set_xlabel("waves since the series started")
         right.set_ylabel("N_od")
+        right.set_ylim(bottom=0.0)      # a count: no damage sits on the axis, not mid-plot
         right.set_title("damage development N_od(N)", fontsize=9)
         right.grid(alpha=0.3)
         right.legend(fontsize=7)
@@ -129,11 +130,13 @@ def _damage_curve_panel(left, ns: np.ndarray, curve: dict, results: dict) -> Non
             left.axvline(start[key], color="0.4", linestyle=style, label=label)
     left.set_xlabel("stability number Hm0 / (Delta Dn)")
     left.set_ylabel("N_od (displaced units per Dn of width)")
+    left.set_ylim(bottom=0.0)
     left.legend(fontsize=7)
     left.grid(alpha=0.3)
     twin = left.twinx()
     twin.plot(ns, curve["S"], "^-", color="C2", alpha=0.7, label="S")
     twin.set_ylabel("damage level S", color="C2")
+    twin.set_ylim(bottom=0.0)
 
 
 def _smoke_title(figure, results: dict) -> None:
