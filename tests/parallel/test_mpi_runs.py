@@ -224,6 +224,6 @@ def test_without_mpi4py_asking_for_processes_says_what_to_install(monkeypatch):
     monkeypatch.setenv("PMI_SIZE", "2")
     monkeypatch.setattr(communicator, "_WORLD", None)
     monkeypatch.setitem(sys.modules, "mpi4py", None)
-    with pytest.raises(communicator.ParallelError, match=r"riprap\[mpi\]"):
+    with pytest.raises(communicator.ParallelError, match=r"'\.\[mpi\]'"):
         communicator.world()
     monkeypatch.setattr(communicator, "_WORLD", None)
