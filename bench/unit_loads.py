@@ -15,10 +15,19 @@ Prints, last, ``METRIC cube_drag_coefficient_<cells> <value> ratio`` per resolut
 treatment at the reference step), ``METRIC load_change_dt_5_to_1_25ms`` (here: the relative
 change of the drag between the reference step and a quarter of it, the same factor of 4 as
 5 ms to 1.25 ms) and ``METRIC load_change_4_5_to_6_cells`` (the relative change of the drag from
-4.5 to 6 cells per D). The flume part of the issue (a cube held on examples/09's slope) is not
-measured here yet.
+4.5 to 6 cells per D).
+
+``--flume``: the cube held on a slope under regular waves instead (``riprap.benchmarks.
+held_cube_flume``: a 10 cm cube 2 mm off a 1:1.5 slope, its foot 5 cm under the still water,
+waves of H 0.12 m and T 1.4 s in 0.4 m of water), its fluid force at every fluid step over 10
+periods at ``max_time_step`` 5 and 1.25 ms per resolution: mean, rms and peak of F_x and F_z.
+Then ``METRIC load_change_dt_5_to_1_25ms`` is the largest relative change of the two rms forces
+(the first treatment given). The steps are those the flume takes under the cap (the Courant
+number may hold them lower); at 3 cells about 500 s of a free 2-core machine for both steps,
+about 3.4 and 8 times that at 4.5 and 6.
 
     python bench/unit_loads.py [--cells 3 4.5 6] [--treatment mixture own_velocity]
+    python bench/unit_loads.py --flume [--cells 3 4.5 6] [--treatment mixture]
 """
 from __future__ import annotations
 
