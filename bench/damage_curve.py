@@ -140,7 +140,7 @@ significant_height = {ns * DELTA * DN:.4f}
 wave_steepness = {STEEPNESS}
 waves = {waves}
 """ + (f"seed = {first_seed + k}\n" if first_seed != 1 else "") for k, ns in enumerate(steps))
-    fluid_options = f'cut_faces = "{cut_faces}"\n' if cut_faces != "mixture" else ""
+    fluid_options = f'cut_faces = "{cut_faces}"\n' if cut_faces != "auto" else ""
     if filter_below_cells > 0:
         fluid_options += f"contact_only_below_cells = {filter_below_cells:g}\n"
     friction = ("" if concrete_on_rock is None else
@@ -217,7 +217,7 @@ def main() -> None:
                         help="stability numbers Hm0 / (Delta Dn) of the steps")
     parser.add_argument("--first-seed", type=int, default=1,
                         help="seed of the first step's sea (the next steps count on from it)")
-    parser.add_argument("--cut-faces", default="mixture", choices=("mixture", "own_velocity"))
+    parser.add_argument("--cut-faces", default="mixture", choices=("mixture", "own_velocity", "auto"))
     parser.add_argument("--filter-below-cells", type=float, default=0.0)
     parser.add_argument("--concrete-on-rock", type=float, default=None)
     args = parser.parse_args()

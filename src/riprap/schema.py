@@ -670,17 +670,18 @@ KEYS: tuple[Key, ...] = (
         default=0.0, valid_range=_POSITIVE),
     Key("fluid", "cut_faces", "string", "-",
         "What the water in a cell face a body cuts keeps after a step (docs/coupling.md, Cut "
-        "faces and the step): \"mixture\", the face's one velocity of water and body, taken the "
-        "body's solid fraction of the way to the body every step (verified against ten Cate and "
-        "the floating box; the load on a moving body grows as the step shrinks: a towed cube's "
-        "drag 1.47, 1.27 and 1.11 times the dynamic pressure at 3, 4.5 and 6 cells across, 14-18 "
-        "% more at a step 4 times shorter); \"own_velocity\", the "
-        "water's own velocity, drawn to the body at a rate per second, the bodies' faces counted "
-        "in their frame (the towed cube's drag changes 4-12 % for a step 4 times shorter, against "
-        "14-18 %, but is 0.91, 0.75 and 0.77 of the dynamic pressure at 3, 4.5 and 6 cells across "
-        "where Hoerner gives 1.05; ten Cate's low-Reynolds sphere falls 8 % too fast at 4 cells "
-        "across): an option to study, not yet a method to trust. Rigid bodies only.",
-        default="mixture", choices=("mixture", "own_velocity")),
+        "faces and the step). \"auto\" (the default): \"own_velocity\" for rigid bodies, "
+        "\"mixture\" for runs with deformable bodies (their coupling has only that). "
+        "\"own_velocity\": the water's own velocity, drawn to the body at a rate per second by "
+        "the flow through the face and the shear of the body's wall in it, the bodies' faces "
+        "counted in their frame: a towed cube's drag changes 4 % for a step 4 times shorter at 3 "
+        "cells across (0.91 of the dynamic pressure where Hoerner gives 1.05), ten Cate's "
+        "settling sphere within 5 % at 4 cells across. \"mixture\": the face's one velocity of "
+        "water and body, taken the body's solid fraction of the way to the body every step, as "
+        "riprap did before issue 51: its load on a moving body grows as the step shrinks (the "
+        "towed cube's drag 1.47 at 3 cells across, 18 % more at a step 4 times shorter); a run "
+        "started with it continues with it only if the case says so.",
+        default="auto", choices=("auto", "own_velocity", "mixture")),
     # [[water_regions]]
     Key("water_regions", "type", "string", "-", "Kind of region; selects the keys below.",
         choices=("box", "level")),

@@ -171,10 +171,31 @@ def test_own_velocity_cut_faces_run_from_a_case_and_restart_bit_for_bit(tmp_path
                  "bodies_fluid_loads", "coupling_carried_excess"):
         assert np.array_equal(a[name], b[name]), name
     mixture = tmp_path / "mixture"
-    assert main(["run", str(_case(tmp_path, 0.1)), "--out", str(mixture), "--quiet"]) == 0
+    assert main(["run", str(_own_velocity_case(tmp_path, 0.1, '"mixture"')), "--out",
+                 str(mixture), "--quiet"]) == 0
     m, _ = load_checkpoint(mixture / "checkpoint.npz")
     assert not np.array_equal(a["bodies_velocities"], m["bodies_velocities"]), \
         "the treatment changes the run"
+    auto = tmp_path / "auto"
+    assert main(["run", str(_case(tmp_path, 0.1)), "--out", str(auto), "--quiet"]) == 0
+    d, _ = load_checkpoint(auto / "checkpoint.npz")
+    assert np.array_equal(a["bodies_velocities"], d["bodies_velocities"]), \
+        "rigid bodies take their own velocity by default"
+
+
+def test_a_run_started_with_mixture_cut_faces_continues_only_with_them(tmp_path, capsys):
+    """A checkpoint of a "mixture" run (as every run before issue 51: its record has no
+    cut_faces) is refused by a case that leaves cut_faces to the default, naming the key; the
+    case that says "mixture" continues it."""
+    pieces = tmp_path / "pieces"
+    assert main(["run", str(_own_velocity_case(tmp_path, 0.05, '"mixture"')), "--out",
+                 str(pieces), "--quiet"]) == 0
+    capsys.readouterr()
+    assert main(["run", str(_case(tmp_path, 0.1)), "--out", str(pieces), "--quiet",
+                 "--restart", str(pieces / "checkpoint.npz")]) == 2
+    assert "cut_faces" in capsys.readouterr().err
+    assert main(["run", str(_own_velocity_case(tmp_path, 0.1, '"mixture"')), "--out",
+                 str(pieces), "--quiet", "--restart", str(pieces / "checkpoint.npz")]) == 0
 
 
 def test_an_unknown_cut_face_treatment_in_a_case_is_refused(tmp_path, capsys):

@@ -1,12 +1,23 @@
 """A floating cube comes to rest at the Archimedes draught (issue 13: within 2 %).
 
-A cube of half water's density (0.1 m, 8 cells across, ``riprap.benchmarks.floating_box``) is
+A cube of half water's density (0.1 m, 12 cells across, ``riprap.benchmarks.floating_box``) is
 released 2 cm above its floating position in a 0.4 m tank, heaves, and settles: its mean draught over
 the third to sixth seconds lies within ``DRAUGHT_TOLERANCE`` of Archimedes' (half its height;
-measured −0.9 %; −0.6 % over the fifth and sixth, −0.5 % over the sixth), the heave dies down (its
-range in the sixth second under half that of the first), and the water is conserved. The heave
-(±8 mm in the third second) is slow to die, so a short window reads a part of a period too many or
-too few: over the third and fourth seconds alone −2.1 %.
+measured +0.2 %), the heave dies down (its range in the sixth second under half that of the
+first: measured 0.47), and the water is conserved.
+
+Why 12 cells across (8 until issue 51): the heave's decay over six seconds depends on the
+cut-face treatment at coarse grids, and the two treatments approach each other from both sides
+as the grid is refined (the sixth second's range over the first's, 2026-12-03):
+
+    cells across the cube      8      12      16
+    own_velocity (default)     0.59   0.47    0.38
+    mixture                    0.23   0.24    0.27
+
+so the heave's damping is not yet converged at 16 cells (the limit lies near 0.3); the default
+damps it too little at 8 cells across, "mixture" a little too much. The draught is within 1.1 %
+with either at every resolution. The heave (±8 mm in the third second) is slow to die, so a short
+window reads a part of a period too many or too few.
 """
 import numpy as np
 import pytest
@@ -19,7 +30,7 @@ SECONDS = 6.0
 
 @pytest.fixture(scope="module")
 def run():
-    return run_floating_box(cells=32, seconds=SECONDS, start_above=0.02)
+    return run_floating_box(cells=48, seconds=SECONDS, start_above=0.02)
 
 
 def test_the_cube_floats_at_the_archimedes_draught(run):

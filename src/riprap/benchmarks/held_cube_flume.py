@@ -55,7 +55,7 @@ def _wedge_obj() -> str:
 
 
 def held_cube_case(folder, cells_per_dn: float, max_time_step: float,
-                   cut_faces: str = "mixture") -> Path:
+                   cut_faces: str = "own_velocity") -> Path:
     """Write the flume's case (and ``slope.obj``) into ``folder``; return the case's path."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

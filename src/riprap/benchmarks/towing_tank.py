@@ -22,7 +22,7 @@ LENGTH, WIDTH = 16.0, 6.0     # in D
 START = 3.0                   # in D: the cube's centre at the start
 
 
-def towing_tank(side: float, speed: float, cells_per_side: float, *, cut_faces: str = "mixture",
+def towing_tank(side: float, speed: float, cells_per_side: float, *, cut_faces: str = "own_velocity",
                 check_momentum: bool = False) -> CoupledSolver:
     """The tank and the cube (concrete, 2400 kg/m^3) moving at ``speed`` (m/s) along x, its
     faces off the cell faces by a little so that none lies on one."""

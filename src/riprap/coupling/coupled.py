@@ -73,20 +73,26 @@ SUBSTEP_GROWTH = 1.25
 SUBSTEP_MAX_OVER_ESTIMATE = 30.0
 
 #: What the fluid's share of a face a body cuts keeps after a step (docs/coupling.md, Cut faces
-#: and the step). "mixture" (the default): the face's one projected velocity, taken a fraction
-#: phi of the way to the body's motion every step: verified against ten Cate, the floating box
-#: and the resting stacks, but its load on a moving body grows as the step shrinks (a towed cube
-#: at 3 cells per side: C_D 1.32, 1.69, 1.81 at Courant numbers 0.3, 0.075, 0.019 against about
-#: 1.05). "own_velocity": the fluid's own velocity, taken towards the body's at a rate per
-#: second (``rigid_coupling.cut_face_grip``), and the predictor's change of the bodies' faces
-#: counted in the bodies' frame (``_in_the_bodies_frame``): the towed cube's drag changes by
-#: 4-12 % for a step four times shorter (the default 14-18 %), but falls with resolution (0.91,
-#: 0.75, 0.77 at 3, 4.5, 6 cells across against Hoerner's 1.05), and ten Cate's sphere (Re 4)
-#: falls 8 % too fast at 4 cells per diameter and 4 % at 6: an option to study, not the default.
+#: and the step). "own_velocity" (the default since issue 51): the fluid's own velocity, taken
+#: towards the body's at a rate per second (``rigid_coupling.cut_face_grip``: the flow through
+#: the face and the shear of the wall that ``rigid_coupling.wall_geometry`` finds in it), and the
+#: predictor's change of the bodies' faces counted in the bodies' frame
+#: (``_in_the_bodies_frame``): a towed cube's drag at 3 cells per side changes 4 % for a step
+#: four times shorter, 0.91 of the dynamic pressure against Hoerner's 1.05. "mixture": the
+#: face's one projected velocity, taken a fraction phi of the way to the body's motion every
+#: step, whose load on a moving body grows as the step shrinks (the towed cube: C_D 1.47 and
+#: 1.73 at Courant numbers 0.2 and 0.05); kept for the deformable bodies' coupling and for runs
+#: started with it.
 CUT_FACE_TREATMENTS = ("mixture", "own_velocity")
-#: With "own_velocity": the viscous renewal rate of the fluid in a cut face is this times
-#: nu / d^2, d = (1 - phi) h the face's open width: the wall shear mu u / (d / 2) on a film of
-#: thickness d at its mean velocity u gives 2 nu / d^2 (``rigid_coupling.cut_face_grip``).
+#: With "own_velocity", a face whose fluid share is below this is filled by the bodies in the
+#: bodies' frame (``_in_the_bodies_frame``): a share of 1e-15 (phi's round-off) took the
+#: bodies' change divided by it, and runs split over processes (whose phi differ in the last
+#: bit) parted by 1e-5 of the velocity.
+FILLED_SHARE = 1e-6
+#: With "own_velocity", on a face no single wall plane describes (a film between two bodies):
+#: the viscous renewal rate of its fluid is this times nu / d^2, d = (1 - phi) h the face's
+#: open width: the wall shear mu u / (d / 2) on a film of thickness d at its mean velocity u
+#: gives 2 nu / d^2 (``rigid_coupling.cut_face_grip``).
 VISCOUS_RENEWAL = 2.0
 #: A moving body must span at least this many cells (by its nominal diameter, V^(1/3)): at 3
 #: the ten Cate sphere (4 cells across its diameter, nominal diameter 3.2 cells) still settles
@@ -196,7 +202,7 @@ class CoupledSolver:
     def __init__(self, fluid: FluidSolver, solids: SolidSolver, *, solid_time_step: float | None = None,
                  wall_material: str | None = "", check_momentum: bool = False,
                  obstacle_bodies=(), adaptive_substep: bool = False,
-                 cut_faces: str = "mixture"):
+                 cut_faces: str = "own_velocity"):
         if not np.allclose(fluid.gravity, solids.gravity):
             raise CaseFileError(f"coupling: the fluid's gravity {fluid.gravity.tolist()} differs from "
                                 f"the bodies' {solids.gravity.tolist()}")
@@ -247,6 +253,7 @@ class CoupledSolver:
         #: (the face set, the fluid's own velocity less the mixture on each of its faces) after
         #: the last step: on the same faces as ``_carried``
         self._excess = None
+        self._wall = None            # (face set, (wall area, distance)): _wall_geometry
         #: Faces between fixed bodies' cells and their deep cells (made obstacle cells of the
         #: fluid): (body, axis, face index, half cell fraction) arrays; None: none.
         self._shut = None
@@ -835,9 +842,10 @@ class CoupledSolver:
         pattern = faces.empty()
         rigid_coupling.moving_pattern(faces.axis, faces.index, vectors, fluid.u, fluid.v, fluid.w,
                                       fluid.h, dt, pattern)
-        # (a face the bodies fill has no fluid share to take it: left as it is)
+        # (a face the bodies fill has no fluid share to take it: left as it is; nor one they
+        # all but fill, whose share would take the bodies' change over the round-off of phi)
         open_share = 1.0 - faces.capped
-        pattern = np.where(open_share > 0.0, pattern, 0.0)
+        pattern = np.where(open_share > FILLED_SHARE, pattern, 0.0)
         moved = faces.capped * pattern / np.maximum(open_share, 1e-300)
         return impulses + rho_fluid * pattern, fluid_part_own - moved
 
@@ -878,12 +886,32 @@ class CoupledSolver:
         rigid_coupling.accumulate_rigid(self._body_faces(faces), centres, motions, faces.phi,
                                         self._ones(faces), rigid)
         body_velocity = rigid / np.maximum(faces.capped, 1e-300)
+        area, distance = self._wall_geometry(faces)
         grip = faces.empty()
         rigid_coupling.cut_face_grip(faces.phi, fluid_part, body_velocity, rho_fluid,
                                      fluid.water.density, fluid.water.dynamic_viscosity,
                                      fluid.air.density, fluid.air.dynamic_viscosity, fluid.h, dt,
-                                     VISCOUS_RENEWAL, grip)
+                                     VISCOUS_RENEWAL, area, distance, grip)
         return grip
+
+    def _wall_geometry(self, faces):
+        """Per cut face, the bodies' wall in its control volume as a plane: its area (h^2) and
+        the fluid's mean distance from it (h) (``rigid_coupling.wall_geometry``), kept while
+        the face set is (the bodies have not been clipped again)."""
+        if self._wall is not None and self._wall[0] is faces:
+            return self._wall[1]
+        fluid = self.fluid
+        dense = (np.zeros_like(fluid.u), np.zeros_like(fluid.v), np.zeros_like(fluid.w))
+        faces.scatter(faces.phi, dense)
+        entry_start, entry_face, _ = faces.entries
+        owner = np.repeat(np.arange(len(entry_start) - 1), np.diff(entry_start))
+        pairs = np.unique(entry_face.astype(np.int64) * len(entry_start) + owner)
+        bodies_on_face = np.bincount(pairs // len(entry_start), minlength=len(faces.axis))
+        area, distance = faces.empty(), faces.empty()
+        rigid_coupling.wall_geometry(faces.axis, faces.index, faces.phi, bodies_on_face, *dense,
+                                     area, distance)
+        self._wall = (faces, (area, distance))
+        return area, distance
 
     def _body_faces(self, faces) -> rigid_coupling.BodyFaces:
         """The face set as the coupling kernels take it."""

@@ -102,7 +102,13 @@ def _coupled_model(scene: Scene, settings: ModelSettings, restarted: bool) -> Co
     left_out = obstacle_bodies + list(scene.contact_only_bodies)
     return CoupledModel(CoupledSolver(scene.fluid, scene.solver, obstacle_bodies=left_out,
                                       adaptive_substep=settings.adaptive_time_step,
-                                      cut_faces=scene.cut_faces))
+                                      cut_faces=_rigid_cut_faces(scene.cut_faces)))
+
+
+def _rigid_cut_faces(choice: str) -> str:
+    """``[fluid] cut_faces`` for rigid bodies: "auto" is their own velocity (docs/coupling.md,
+    Cut faces and the step)."""
+    return "own_velocity" if choice == "auto" else choice
 
 
 def _refuse_adaptive_step(settings: ModelSettings) -> None:
@@ -145,7 +151,7 @@ def _deformable_coupled_model(scene: Scene, settings: ModelSettings,
         raise CaseFileError("contact-only bodies (fixed bodies the flow does not see) are not for "
                             "runs with deformable bodies: their coupling keeps every rigid body "
                             "in the flow")
-    if scene.cut_faces != "mixture":
+    if scene.cut_faces == "own_velocity":
         raise CaseFileError(f"[fluid] cut_faces = {scene.cut_faces!r} is for rigid bodies: the "
                             "coupling of deformable bodies keeps the \"mixture\" cut faces")
     if "coupled solver" in scene.holds():

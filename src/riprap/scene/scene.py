@@ -65,9 +65,9 @@ class Scene:
         #: Fixed bodies the flow does not see (``riprap.coupling.filter_layer``): left out of the
         #: fluid exchange (``CoupledSolver(obstacle_bodies=...)``), met by the other bodies.
         self.contact_only_bodies: list[int] = []
-        #: What the water of the faces bodies cut keeps after a step (``[fluid] cut_faces``,
-        #: ``riprap.coupling.coupled.CUT_FACE_TREATMENTS``).
-        self.cut_faces = "mixture"
+        #: What the water of the faces bodies cut keeps after a step (``[fluid] cut_faces``:
+        #: "auto", or one of ``riprap.coupling.coupled.CUT_FACE_TREATMENTS``).
+        self.cut_faces = "auto"
 
     # ------------------------------------------------------------------ what it holds
     def holds(self) -> frozenset[str]:
