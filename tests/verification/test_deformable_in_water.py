@@ -167,7 +167,10 @@ def test_deformable_sphere_falls_and_keeps_its_spin_as_the_rigid_one():
     solids.add_material(Material(name="body", density=density, restitution=0.5,
                                  contact_penalty=1e7))
     solids.add_body(shape=shape, material="body", position=centre, angular_velocity=spin)
-    rigid = CoupledSolver(_tank((0.4, 0.4, 1.0), (16, 16, 40), level=1.0), solids)
+    # the twin with the deformable coupling's cut faces ("mixture"): the rigid bodies' default
+    # ("own_velocity", issue 51) falls 38 % faster here (0.40 against 0.29 m/s after 0.6 s)
+    rigid = CoupledSolver(_tank((0.4, 0.4, 1.0), (16, 16, 40), level=1.0), solids,
+                          cut_faces="mixture")
     for _ in range(120):
         deformable.step(0.005)
         rigid.step(0.005)

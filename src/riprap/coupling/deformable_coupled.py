@@ -406,7 +406,8 @@ class DeformableCoupledSolver(CoupledSolver):
         if getattr(fluid, "obstacle_boxes", None):
             raise CaseFileError("deformable bodies in a flow with [[fluid.obstacles]] are not "
                                 "available yet: give the obstacles as walls or leave them out")
-        super().__init__(fluid, bodies, wall_material=None, check_momentum=check_momentum)
+        super().__init__(fluid, bodies, wall_material=None, check_momentum=check_momentum,
+                         cut_faces="mixture")   # (the own velocity is for rigid bodies only)
         #: Deformable steps in the last fluid step.
         self.last_substeps = 0
         #: Called (no arguments) whenever the bodies' step count reaches a multiple of
