@@ -307,7 +307,8 @@ class CoupledSolver:
             fluid = self.fluid
             axis, index, values = self._carried
             speed = self._largest(float(listed_pore_speed(fluid.fraction, axis, index, values,
-                                                          fluid.open_part, fluid.limit_air_speed)))
+                                                          fluid.open_part, fluid.limit_air_speed,
+                                                          fluid.periodic_y)))
             if speed > 0.0:
                 step = min(step, self.fluid.courant_number * self.fluid.h / speed)
         return step
@@ -628,7 +629,7 @@ class CoupledSolver:
 
             axis, index, values = self._carried
             limit_listed_faces(fluid.fraction, axis, index, values, fluid.open_part,
-                               fluid.air_speed_limit(dt))
+                               fluid.air_speed_limit(dt), fluid.periodic_y)
         free = ~solids.fixed
         inertia = self._world_inertia()
         # Every body is blended in with the motion it would have after falling freely for dt

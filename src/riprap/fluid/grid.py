@@ -12,7 +12,9 @@ the volume-of-fluid sweeps and the multigrid levels assume equal spacing in ever
 
 Boundaries: each side of the box is ``"no_slip"`` or ``"free_slip"`` (a wall, no flow through
 it), and the top may be ``"open"`` (the atmosphere: pressure 0 there, air and water may leave or
-enter).
+enter). The two y sides may together be ``"periodic"`` (a strip across the flume that stands for a
+wide one: what leaves at y = upper comes in at y = lower). Then face ``ny`` of ``v`` is face 0 again:
+both entries are kept and always equal, and cell ``ny - 1`` is the neighbour of cell 0.
 """
 from __future__ import annotations
 
@@ -28,8 +30,8 @@ __all__ = ["BlockGrid", "FluidGrid", "BOUNDARY_KINDS", "SIDES"]
 
 #: Sides of the box, in the order of the ``boundaries`` mapping.
 SIDES = ("x_low", "x_high", "y_low", "y_high", "z_low", "z_high")
-#: Kinds of boundary; ``open`` only on ``z_high``.
-BOUNDARY_KINDS = ("no_slip", "free_slip", "open")
+#: Kinds of boundary; ``open`` only on ``z_high``, ``periodic`` only on both y sides together.
+BOUNDARY_KINDS = ("no_slip", "free_slip", "open", "periodic")
 # Cell lengths that differ by less than this (relative) are the same cube side.
 _CUBE_TOLERANCE = 1e-9
 # Multigrid and the sweeps are fine with any size, but a grid this small has no interior.
@@ -90,7 +92,20 @@ class FluidGrid:
             if kind == "open" and side != "z_high":
                 raise CaseFileError(f"fluid grid: boundary {side} = 'open': only the top (z_high) "
                                     "can be open to the atmosphere")
+            if kind == "periodic" and side not in ("y_low", "y_high"):
+                raise CaseFileError(f"fluid grid: boundary {side} = 'periodic': only the y sides "
+                                    "(across the flume) can be periodic")
             boundaries[side] = kind
+        periodic_sides = [side for side in ("y_low", "y_high") if boundaries[side] == "periodic"]
+        if len(periodic_sides) == 1:
+            raise CaseFileError(f"fluid grid: boundary {periodic_sides[0]} = 'periodic' needs the "
+                                "other y side periodic too (what leaves at one comes in at the "
+                                "other)")
+        if periodic_sides and (cells[1] < 2 or cells[1] % 2):
+            raise CaseFileError(
+                f"fluid grid: a periodic y needs an even number of cells across (ny = "
+                f"{int(cells[1])}): the pressure solve's red-black sweeps meet across the "
+                "boundary; a multiple of 4 lets its multigrid coarsen y as well")
         object.__setattr__(self, "lower", tuple(float(v) for v in lower))
         object.__setattr__(self, "upper", tuple(float(v) for v in upper))
         object.__setattr__(self, "cells", tuple(int(v) for v in cells))
@@ -118,6 +133,11 @@ class FluidGrid:
         """Volume of a cell (m^3); in 2D, per the cell's width in y (the box's)."""
         h = self.cell_size
         return h * h * (self.upper[1] - self.lower[1] if self.two_dimensional else h)
+
+    @property
+    def periodic_y(self) -> bool:
+        """The y sides are one periodic boundary (module docstring)."""
+        return self.boundaries["y_low"] == "periodic"
 
     @property
     def open_top(self) -> bool:

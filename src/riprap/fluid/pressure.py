@@ -20,6 +20,8 @@ Conventions (uniform grid of cubic cells of side ``cell_size`` h, arrays [i, j, 
 - an interior face with beta = 0 separates its two cells; a cell with all six faces 0 is inactive
   (a solid obstacle): its p is returned as 0 and its rhs is ignored;
 - a 2D problem in the x-z plane is ny == 1 with beta_y all zero;
+- ``periodic_y``: the y faces 0 and ny are one face between the cells ny - 1 and 0 (a periodic
+  strip; ny even, and y coarsened only while its cells stay even: ``level_shapes``);
 - with no Dirichlet face at all (a closed tank) the operator is singular: the mean of rhs over the
   active cells is removed (only the compatible part is solved) and the returned p has zero mean
   over the active cells. One mean over all active cells: separate closed regions are not handled.
@@ -115,7 +117,7 @@ def _as_float_array(array):
     return np.ascontiguousarray(array, dtype=np.float64)
 
 
-def apply_operator(beta_x, beta_y, beta_z, p, cell_size) -> np.ndarray:
+def apply_operator(beta_x, beta_y, beta_z, p, cell_size, periodic_y=False) -> np.ndarray:
     """div(beta grad p) of the solver, exactly as discretised there (module docstring).
 
     ``p`` (nx, ny, nz); returns a new (nx, ny, nz) array. Use it to check a solution's residual and
@@ -132,7 +134,7 @@ def apply_operator(beta_x, beta_y, beta_z, p, cell_size) -> np.ndarray:
     result = np.empty_like(p)
     multigrid.apply_positive_operator(_as_float_array(beta_x), _as_float_array(beta_y),
                                       _as_float_array(beta_z), inverse_h2, inverse_h2, inverse_h2,
-                                      p, result)
+                                      p, result, bool(periodic_y))
     np.negative(result, out=result)
     return result
 
@@ -158,7 +160,7 @@ def outcome_report(iterations, relative_residual, largest, outcome, dt2, toleran
                                bool(capped))
 
 
-def listed_stencils_of(betas, inverse_h2, cells, red) -> multigrid.ListedCells:
+def listed_stencils_of(betas, inverse_h2, cells, red, periodic_y=False) -> multigrid.ListedCells:
     """The ``multigrid.ListedCells`` of ``cells`` (flat indices, ``red`` of them first) with
     the face coefficients ``betas`` (three arrays) and ``inverse_h2`` (3,) 1/h^2."""
     n = len(cells)
@@ -167,28 +169,36 @@ def listed_stencils_of(betas, inverse_h2, cells, red) -> multigrid.ListedCells:
                                    red=red)
     if n:
         multigrid.listed_stencils(*betas, *inverse_h2, cells, listed.neighbours, listed.couplings,
-                                  listed.inverse_diagonal)
+                                  listed.inverse_diagonal, bool(periodic_y))
     return listed
 
 
-def level_shapes(shape) -> tuple[list, list]:
+def level_shapes(shape, periodic_y: bool = False) -> tuple[list, list]:
     """The cells per axis of every multigrid level of a grid of ``shape``, and the children per
     coarse cell from each level to the next ((1, 1, 1) after the last): each level halves every
-    axis with more than one cell, until a level has at most ``COARSEST_MAXIMUM_CELLS``."""
+    axis with more than one cell, until a level has at most ``COARSEST_MAXIMUM_CELLS``.
+
+    ``periodic_y``: y is halved only while the coarse count stays even (a multiple of 4 halves to
+    an even count), since the red-black sweeps need the cells beside the wrapped face to be of two
+    colours; after that y keeps its cells on the coarser levels."""
     shapes = [tuple(int(n) for n in shape)]
     factors = []
     while math.prod(shapes[-1]) > COARSEST_MAXIMUM_CELLS and max(shapes[-1]) > 1:
         factor = tuple(2 if n > 1 else 1 for n in shapes[-1])
+        if periodic_y and shapes[-1][1] % 4:
+            factor = (factor[0], 1, factor[2])
+        if factor == (1, 1, 1):
+            break
         factors.append(factor)
         shapes.append(tuple(-(-n // f) for n, f in zip(shapes[-1], factor)))
     factors.append((1, 1, 1))
     return shapes, factors
 
 
-def build_hierarchy(shape, spacing) -> multigrid.Hierarchy:
+def build_hierarchy(shape, spacing, periodic_y: bool = False) -> multigrid.Hierarchy:
     """The multigrid levels (``level_shapes``) of a grid of ``shape`` cells of ``spacing`` (3,) m
-    per axis, empty (``build_levels`` fills them)."""
-    shapes, factors = level_shapes(shape)
+    per axis, empty (``build_levels`` fills them); ``periodic_y`` as ``level_shapes``."""
+    shapes, factors = level_shapes(shape, periodic_y)
     spacing = np.asarray(spacing, dtype=np.float64).reshape(3)
     spacings = [spacing.copy()]
     for factor in factors[:-1]:
@@ -216,7 +226,8 @@ def build_hierarchy(shape, spacing) -> multigrid.Hierarchy:
         beta_z=np.zeros(face_offsets[-1, 2]),
         corrections=np.zeros(cell_offsets[-1]),
         residuals=np.zeros(cell_offsets[-1]),
-        coarsest_factor=np.zeros((math.prod(coarsest), coarsest[1] * coarsest[2] + 1)))
+        coarsest_factor=np.zeros((math.prod(coarsest), coarsest[1] * coarsest[2] + 1)),
+        periodic_y=bool(periodic_y))
 
 
 def face_view(hierarchy: multigrid.Hierarchy, level: int, axis: int) -> np.ndarray:
@@ -246,7 +257,7 @@ def build_levels(hierarchy: multigrid.Hierarchy) -> None:
     last = levels - 1
     coarsest = [face_view(hierarchy, last, axis) for axis in range(3)]
     multigrid.factor_coarsest(*coarsest, *hierarchy.inverse_spacing_squared[last],
-                              hierarchy.coarsest_factor)
+                              hierarchy.coarsest_factor, hierarchy.periodic_y)
 
 
 class PressureSolver:
@@ -265,17 +276,21 @@ class PressureSolver:
     volume_tolerance : float
         With ``solve(time_step=dt)``: a solve also stops once no cell's volume changes by more
         than this fraction over the step (dt^2 max|r|); 0 leaves that test out.
+    periodic_y : bool
+        The y faces 0 and ny are one face (module docstring); ny must be even.
 
     The multigrid levels are allocated once, by the first ``solve``; later solves only refill
     them. One instance is not safe to use from two threads at the same time.
     """
 
     def __init__(self, shape, cell_size, *, tolerance: float = 1e-8, max_iterations: int = 200,
-                 volume_tolerance: float = 0.0):
+                 volume_tolerance: float = 0.0, periodic_y: bool = False):
         shape = tuple(int(n) for n in shape)
         if len(shape) != 3 or min(shape) < 1:
             raise CaseFileError(f"PressureSolver: shape must be (nx, ny, nz) with every size >= 1, "
                                 f"got {shape}")
+        if periodic_y and shape[1] % 2:
+            raise CaseFileError(f"PressureSolver: a periodic y needs an even ny, got {shape[1]}")
         if not (cell_size > 0.0 and math.isfinite(cell_size)):
             raise CaseFileError(f"PressureSolver: cell_size must be a positive length (m), got "
                                 f"{cell_size}")
@@ -291,8 +306,9 @@ class PressureSolver:
         self.tolerance = float(tolerance)
         self.max_iterations = int(max_iterations)
         self.volume_tolerance = float(volume_tolerance)
+        self.periodic_y = bool(periodic_y)
 
-        self.levels = [tuple(int(n) for n in row) for row in level_shapes(shape)[0]]
+        self.levels = [tuple(int(n) for n in row) for row in level_shapes(shape, periodic_y)[0]]
         self._hierarchy = None             # allocated by the first solve (_allocate)
 
     def _allocate(self) -> None:
@@ -300,7 +316,7 @@ class PressureSolver:
         that never solves (the whole grid's, when a run is split over processes and each solves
         its slab) holds none of them."""
         shape = self.shape
-        self._hierarchy = build_hierarchy(shape, np.full(3, self.cell_size))
+        self._hierarchy = build_hierarchy(shape, np.full(3, self.cell_size), self.periodic_y)
         self._system_rhs = np.zeros(shape)
         self._direction = np.zeros(shape)
         self._product = np.zeros(shape)
@@ -316,7 +332,8 @@ class PressureSolver:
     def _listed_stencils(self, cells, red):
         """The ``multigrid.ListedCells`` of ``cells`` with level 0's present coefficients."""
         return listed_stencils_of([self._face_view(0, axis) for axis in range(3)],
-                                  self._hierarchy.inverse_spacing_squared[0], cells, red)
+                                  self._hierarchy.inverse_spacing_squared[0], cells, red,
+                                  self.periodic_y)
 
     def solve(self, beta_x, beta_y, beta_z, rhs, p_initial=None, listed_cells=None,
               time_step=None):
@@ -356,8 +373,10 @@ class PressureSolver:
             return np.zeros(self.shape), PressureSolveReport(0, 0.0)
         self._build_levels()
         listed = self._listed_stencils(listed_flat, red)
-        singular = not (beta_x[0].any() or beta_x[-1].any() or beta_y[:, 0].any()
-                        or beta_y[:, -1].any() or beta_z[:, :, 0].any() or beta_z[:, :, -1].any())
+        # (a periodic y's faces 0 and ny are inside faces, not Dirichlet ones)
+        y_sides = not self.periodic_y and (beta_y[:, 0].any() or beta_y[:, -1].any())
+        singular = not (beta_x[0].any() or beta_x[-1].any() or y_sides
+                        or beta_z[:, :, 0].any() or beta_z[:, :, -1].any())
         if singular:
             view = self._face_view
             multigrid.subtract_on_active(view(0, 0), view(0, 1), view(0, 2), self._system_rhs,

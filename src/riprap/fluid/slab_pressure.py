@@ -79,8 +79,10 @@ class SlabPressureSolver:
 
     def __init__(self, shape, cell_size, cut, communicator, *, tolerance: float = 1e-8,
                  max_iterations: int = 200, volume_tolerance: float = 0.0,
-                 distributed_levels: int = DISTRIBUTED_LEVELS):
+                 distributed_levels: int = DISTRIBUTED_LEVELS, periodic_y: bool = False):
         self.shape = tuple(int(n) for n in shape)
+        #: the y faces 0 and ny one face (``PressureSolver``'s ``periodic_y``): within each slab
+        self.periodic_y = bool(periodic_y)
         self.cell_size = float(cell_size)
         self.tolerance = float(tolerance)
         self.max_iterations = int(max_iterations)
@@ -92,7 +94,7 @@ class SlabPressureSolver:
             raise CaseFileError(f"slab pressure solve: a cut of {cut.cells} planes into "
                                 f"{cut.processes} slabs for {size} processes and {self.shape[0]} "
                                 "planes")
-        shapes, factors = level_shapes(self.shape)
+        shapes, factors = level_shapes(self.shape, self.periodic_y)
         split = 0
         while (split < min(distributed_levels, len(shapes) - 1) and factors[split][0] == 2
                and cut.alignment % (2 ** (split + 1)) == 0):
@@ -117,7 +119,7 @@ class SlabPressureSolver:
         self.gathered_stop = -(-cut.stop(rank) // scale)
         self.factors = factors
         # the levels below the split, whole on every process
-        self.gathered = build_hierarchy(shapes[split], spacing)
+        self.gathered = build_hierarchy(shapes[split], spacing, self.periodic_y)
         if [tuple(int(n) for n in row) for row in self.gathered.shapes] != list(shapes[split:]):
             raise AssertionError("the gathered levels differ from the whole grid's")
         owned = self.gathered_stop - self.gathered_first
@@ -178,13 +180,13 @@ class SlabPressureSolver:
 
     def _listed_stencils(self, cells, red):
         fine = self.levels[0]
-        return listed_stencils_of(fine.beta, fine.inverse_h2, cells, red)
+        return listed_stencils_of(fine.beta, fine.inverse_h2, cells, red, self.periodic_y)
 
     # ------------------------------------------------------------------ the V-cycle
     def _smooth(self, level: _Level, colour: int) -> None:
         self._exchange(level, level.x)
         multigrid.smooth(*level.beta, *level.inverse_h2, level.rhs, level.x, level.colour(colour),
-                         level.begin, level.end)
+                         level.begin, level.end, self.periodic_y)
 
     def _smooth_listed(self, listed, first, stop) -> None:
         fine = self.levels[0]
@@ -207,7 +209,8 @@ class SlabPressureSolver:
             for sweep in range(multigrid.level_sweeps(sweeps, number)):
                 if sweep == 0 and first_from_zero:
                     multigrid.smooth_first_red(*level.beta, *level.inverse_h2, level.rhs, level.x,
-                                               level.begin, level.end, level.parity)
+                                               level.begin, level.end, level.parity,
+                                               self.periodic_y)
                 else:
                     self._smooth(level, 0)
                 self._smooth(level, 1)
@@ -217,12 +220,13 @@ class SlabPressureSolver:
                 coarse = self.levels[number + 1]
                 multigrid.restrict_red_residual(*level.beta, *level.inverse_h2, level.rhs, level.x,
                                                 coarse.rhs, *factors, level.begin, level.end,
-                                                coarse.begin, coarse.end, level.parity)
+                                                coarse.begin, coarse.end, level.parity,
+                                                self.periodic_y)
             else:
                 owned = self.gathered_stop - self.gathered_first
                 multigrid.restrict_red_residual(*level.beta, *level.inverse_h2, level.rhs, level.x,
                                                 self._coarse_rhs, *factors, level.begin, level.end,
-                                                0, owned, level.parity)
+                                                0, owned, level.parity, self.periodic_y)
         whole = self.gathered
         cell_view(whole.residuals, whole, 0)[...] = self.comm.gather_planes(
             self._coarse_rhs, self.counts[self.split_levels])
@@ -287,7 +291,7 @@ class SlabPressureSolver:
         self._build_levels()
         listed = self._listed_stencils(listed_flat, red)
         self._any_listed = self.comm.any(len(listed_flat) > 0)
-        singular = not self.comm.any(_has_dirichlet_face(fine, self.comm))
+        singular = not self.comm.any(_has_dirichlet_face(fine, self.comm, self.periodic_y))
         if singular:
             multigrid.subtract_on_active(*fine.beta, self._system_rhs, rhs_sum / active_cells)
             multigrid.subtract_on_active(*fine.beta, pressure, pressure_sum / active_cells)
@@ -316,7 +320,8 @@ class SlabPressureSolver:
 
         def true_residual():
             self._exchange(fine, pressure)
-            multigrid.compute_residual(*beta, *h2, system_rhs, pressure, residual, self._row_sums)
+            multigrid.compute_residual(*beta, *h2, system_rhs, pressure, residual, self._row_sums,
+                                       self.periodic_y)
             return self._sums(2)
 
         squared, largest = true_residual()
@@ -341,7 +346,8 @@ class SlabPressureSolver:
                                            new_product / curvature_product)
             curvature_product = new_product
             self._exchange(fine, direction)
-            multigrid.apply_operator_and_dot(*beta, *h2, direction, product, self._row_sums)
+            multigrid.apply_operator_and_dot(*beta, *h2, direction, product, self._row_sums,
+                                             self.periodic_y)
             curvature = self._sums()
             if not np.isfinite(curvature):
                 return iterations, relative, largest, multigrid.NON_FINITE
@@ -366,12 +372,13 @@ class SlabPressureSolver:
         return iterations, relative, largest, multigrid.NOT_CONVERGED
 
 
-def _has_dirichlet_face(fine: _Level, comm) -> bool:
-    """True if this slab holds a boundary face with a positive coefficient (an open boundary)."""
+def _has_dirichlet_face(fine: _Level, comm, periodic_y: bool) -> bool:
+    """True if this slab holds a boundary face with a positive coefficient (an open boundary;
+    a periodic y's faces are inside ones)."""
     beta_x, beta_y, beta_z = fine.beta
     b, e = fine.begin, fine.end
-    found = bool(beta_y[b:e, 0].any() or beta_y[b:e, -1].any() or beta_z[b:e, :, 0].any()
-                 or beta_z[b:e, :, -1].any())
+    y_sides = not periodic_y and bool(beta_y[b:e, 0].any() or beta_y[b:e, -1].any())
+    found = bool(y_sides or beta_z[b:e, :, 0].any() or beta_z[b:e, :, -1].any())
     if comm.rank == 0:
         found = found or bool(beta_x[0].any())
     if comm.rank == comm.size - 1:

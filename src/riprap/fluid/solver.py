@@ -17,6 +17,10 @@ One step of length dt (all explicit but the pressure):
    which the smeared surface force must share to stay balanced;
 5. correction: u = u* - dt (1/rho) grad p on every face, so that div u = 0 to the solver tolerance.
 
+A periodic y (``FluidGrid.periodic_y``, a strip standing for a wide flume): every kernel's y
+neighbours wrap around the strip, the pressure's too (``riprap/fluid/pressure.py``), and the face
+ny of ``v`` is kept equal to face 0 (``docs/fluid.md``, Periodic strip).
+
 Gravity enters the momentum of the faces (step 2) and is balanced by the pressure gradient of step
 4: water at rest stays at rest to the solver tolerance, and without surface tension its cell
 pressures are exactly hydrostatic wherever the interface lies in its cells.
@@ -53,7 +57,8 @@ from riprap.work_estimate import check_fluid_grid
 __all__ = ["FluidSolver", "StepReport"]
 
 _STEP_GROWTH = 1.2
-_BOUNDARY_CODE = {"no_slip": momentum.NO_SLIP, "free_slip": momentum.FREE_SLIP, "open": momentum.OPEN}
+_BOUNDARY_CODE = {"no_slip": momentum.NO_SLIP, "free_slip": momentum.FREE_SLIP, "open": momentum.OPEN,
+                  "periodic": momentum.PERIODIC}
 
 
 @dataclass
@@ -99,6 +104,10 @@ def _box_overlap_fractions(grid: FluidGrid, lower, upper) -> list[np.ndarray]:
         fractions.append(np.maximum(high - low, 0.0) / np.diff(faces))
     return fractions
 
+
+# Planes of the strip's other side padded on each side of a periodic y for the surface force: the
+# height functions and their neighbour means read 3 cells away, the face force 1 more.
+_SURFACE_PADDING = 6
 
 # x-planes filled at a time: a box's water is added without whole-grid temporaries.
 _FILL_PLANES = 16
@@ -193,6 +202,8 @@ class FluidSolver:
         self.water_added = 0.0
         self.boundary_code = np.array([_BOUNDARY_CODE[grid.boundaries[side]] for side in SIDES],
                                       dtype=np.int64)
+        #: the y sides are one periodic boundary (``FluidGrid.periodic_y``)
+        self.periodic_y = grid.periodic_y
         self.pressure_solver = self._new_pressure_solver((nx, ny, nz), self.h, pressure_tolerance,
                                                          pressure_volume_tolerance)
         self.last_report = None
@@ -215,7 +226,7 @@ class FluidSolver:
     def _new_pressure_solver(self, shape, cell_size, tolerance, volume_tolerance):
         """The pressure solve of this grid (a split grid's blocks take their slab's instead)."""
         return PressureSolver(shape, cell_size, tolerance=tolerance,
-                              volume_tolerance=volume_tolerance)
+                              volume_tolerance=volume_tolerance, periodic_y=self.periodic_y)
 
     # ------------------------------------------------------------------ set-up
     def add_water_box(self, lower, upper) -> None:
@@ -325,7 +336,8 @@ class FluidSolver:
         """Largest speed the water moves at: on each face |u| / n of the cells beside it (the
         pore velocity in a porous zone); with ``limit_air_speed`` only on faces that touch water
         (``kernels/face_speeds.py``)."""
-        return max(largest_pore_speed(self.fraction, q, axis, self._open_part, self.limit_air_speed)
+        return max(largest_pore_speed(self.fraction, q, axis, self._open_part, self.limit_air_speed,
+                                      self.periodic_y)
                    for axis, q in enumerate((self.u, self.v, self.w)))
 
     def air_speed_limit(self, dt: float) -> float:
@@ -345,7 +357,8 @@ class FluidSolver:
         limit = self.air_speed_limit(dt)
         clipped, largest = 0, 0.0
         for axis, q in enumerate((self.u, self.v, self.w)):
-            count, fastest = limit_air_faces(self.fraction, q, axis, self._open_part, limit)
+            count, fastest = limit_air_faces(self.fraction, q, axis, self._open_part, limit,
+                                             self.periodic_y)
             clipped += int(count)
             largest = max(largest, float(fastest))
         self.last_air_limit = (clipped, largest)
@@ -394,7 +407,8 @@ class FluidSolver:
     def _advect_water(self, dt: float, velocities=None):
         u, v, w = velocities or (self.u, self.v, self.w)
         return plic.advect(self.fraction, u, v, w, dt, self.h, self.step_count,
-                           porosity=self._open_part, water_inflow_x_low=self.wave_maker is not None)
+                           porosity=self._open_part, water_inflow_x_low=self.wave_maker is not None,
+                           periodic_y=self.periodic_y)
 
     def _face_coefficients(self, densities):
         """1/rho on every face: transported densities inside, walls 0, the open top 1/rho of the
@@ -409,6 +423,10 @@ class FluidSolver:
             betas.append(beta)
         if self.grid.open_top:
             betas[2][:, :, -1] = 1.0 / rho[:, :, -1]
+        if self.periodic_y:
+            # the strip's faces 0 and ny: one inside face, its density computed at both
+            betas[1][:, 0] = 1.0 / densities[1][:, 0]
+            betas[1][:, -1] = betas[1][:, 0]
         if self.grid.two_dimensional:
             betas[1][:] = 0.0
         if self._porous_factors is not None:
@@ -509,13 +527,13 @@ class FluidSolver:
     def _sharp_face_densities(self) -> list:
         if self._planes is None:
             self._planes = np.zeros(self.fraction.shape + (4,))
-        cell_planes(self.fraction, self._planes)
+        cell_planes(self.fraction, self._planes, self.periodic_y)
         out = []
         for axis, shape in enumerate((self.u.shape, self.v.shape, self.w.shape)):
             density = np.ones(shape)
             if not (axis == 1 and self.grid.two_dimensional):
                 face_densities(self.fraction, self._planes, axis, self.water.density,
-                               self.air.density, density)
+                               self.air.density, density, self.periodic_y)
             out.append(density)
         return out
 
@@ -532,7 +550,7 @@ class FluidSolver:
                 continue
             face_speed, face_viscosity = np.empty(faces.size), np.empty(faces.size)
             face_speeds_and_viscosities(self.u, self.v, self.w, viscosity, axis, faces, face_speed,
-                                        face_viscosity)
+                                        face_viscosity, self.periodic_y)
             density = densities[axis].reshape(-1)[faces]
             scale = porous.scale[axis].reshape(-1)[faces]
             friction = scale * (porous.linear_coefficient[axis].reshape(-1)[faces] * face_viscosity
@@ -585,14 +603,38 @@ class FluidSolver:
     def _add_surface_tension(self, u, v, w, densities, dt) -> None:
         """u* += dt F / rho on the faces, F = sigma kappa grad f (continuum surface force with the
         same face gradient as the pressure: balanced force)."""
-        forces = [np.zeros_like(u), np.zeros_like(v), np.zeros_like(w)]
-        face_forces(self.fraction, self.h, self.surface_tension, self.grid.two_dimensional,
-                    forces[0], forces[1], forces[2])
+        if self.periodic_y:
+            forces = self._periodic_surface_forces()
+        else:
+            forces = [np.zeros_like(u), np.zeros_like(v), np.zeros_like(w)]
+            face_forces(self.fraction, self.h, self.surface_tension, self.grid.two_dimensional,
+                        forces[0], forces[1], forces[2])
         for axis, (q, force) in enumerate(zip((u, v, w), forces)):
             interior = [slice(None)] * 3
             interior[axis] = slice(1, -1)
+            if axis == 1 and self.periodic_y:
+                interior[axis] = slice(None)        # the strip's y faces are all inside ones
             index = tuple(interior)
             q[index] += dt * force[index] / densities[axis][index]
+
+    def _periodic_surface_forces(self) -> list:
+        """The surface force on the faces of a periodic y: the height-function kernels run on
+        the fractions padded with ``_SURFACE_PADDING`` planes from the strip's other side, and
+        the strip's own faces are taken out (its faces 0 and ny then see the same cells). Why
+        padded rather than wrapped inside the kernels: the curvature reads cells up to 3 away
+        through several helpers, and surface tension is off in most flume cases (cost: the
+        padding's planes, only with surface tension)."""
+        pad = min(_SURFACE_PADDING, self.fraction.shape[1])
+        padded = np.ascontiguousarray(np.pad(self.fraction, ((0, 0), (pad, pad), (0, 0)),
+                                             mode="wrap"))
+        nx, wide, nz = padded.shape
+        out = [np.zeros((nx + 1, wide, nz)), np.zeros((nx, wide + 1, nz)),
+               np.zeros((nx, wide, nz + 1))]
+        face_forces(padded, self.h, self.surface_tension, False, out[0], out[1], out[2])
+        ny = self.fraction.shape[1]
+        return [np.ascontiguousarray(out[0][:, pad:pad + ny]),
+                np.ascontiguousarray(out[1][:, pad:pad + ny + 1]),
+                np.ascontiguousarray(out[2][:, pad:pad + ny])]
 
     def _zero_solid_faces(self, u, v, w) -> None:
         if not self.solid.any():
@@ -611,6 +653,9 @@ class FluidSolver:
         u[1:-1] -= dt * betas[0][1:-1] * (pressure[1:] - pressure[:-1]) / h
         if not self.grid.two_dimensional:
             v[:, 1:-1] -= dt * betas[1][:, 1:-1] * (pressure[:, 1:] - pressure[:, :-1]) / h
+            if self.periodic_y:
+                v[:, 0] -= dt * betas[1][:, 0] * (pressure[:, 0] - pressure[:, -1]) / h
+                v[:, -1] = v[:, 0]
         w[:, :, 1:-1] -= dt * betas[2][:, :, 1:-1] * (pressure[:, :, 1:] - pressure[:, :, :-1]) / h
         if self.grid.open_top:
             w[:, :, -1] -= dt * betas[2][:, :, -1] * (0.0 - pressure[:, :, -1]) / (0.5 * h)

@@ -27,11 +27,14 @@ WET_FRACTION = 1e-2
 
 
 @kernel
-def _beside(cells, axis, i, j, k):
+def _beside(cells, axis, i, j, k, periodic_y):
     """(value of the cell before the face or -1.0, value of the cell after it or -1.0) for
-    non-negative cell fields."""
+    non-negative cell fields; on a ``periodic_y`` the y faces 0 and ny lie between the cells
+    ny - 1 and 0, so that the two stay alike."""
     n = cells.shape[axis]
     index = i if axis == 0 else (j if axis == 1 else k)
+    if periodic_y and axis == 1:
+        return cells[i, (j - 1 + n) % n, k], cells[i, j % n, k]
     after = cells[i, j, k] if index < n else -1.0
     before = -1.0
     if index > 0:
@@ -45,15 +48,15 @@ def _beside(cells, axis, i, j, k):
 
 
 @kernel
-def _touches_water(f, axis, i, j, k):
-    before, after = _beside(f, axis, i, j, k)
+def _touches_water(f, axis, i, j, k, periodic_y):
+    before, after = _beside(f, axis, i, j, k, periodic_y)
     return before > WET_FRACTION or after > WET_FRACTION
 
 
 @kernel
-def _open_part(porosity, axis, i, j, k):
+def _open_part(porosity, axis, i, j, k, periodic_y):
     """The smaller porosity of the cells beside the face."""
-    before, after = _beside(porosity, axis, i, j, k)
+    before, after = _beside(porosity, axis, i, j, k, periodic_y)
     if before < 0.0:
         return after
     if after < 0.0:
@@ -62,7 +65,7 @@ def _open_part(porosity, axis, i, j, k):
 
 
 @parallel_kernel
-def largest_pore_speed(f, q, axis, porosity, water_only):
+def largest_pore_speed(f, q, axis, porosity, water_only, periodic_y=False):
     """Largest |q| / n_face over the faces of ``axis`` (only those that touch water if
     ``water_only``); 0.0 if none."""
     nx, ny, nz = q.shape
@@ -75,9 +78,9 @@ def largest_pore_speed(f, q, axis, porosity, water_only):
                 speed = abs(q[i, j, k])
                 if speed == 0.0 or speed <= best:
                     continue
-                if water_only and not _touches_water(f, axis, i, j, k):
+                if water_only and not _touches_water(f, axis, i, j, k, periodic_y):
                     continue
-                speed /= _open_part(porosity, axis, i, j, k)
+                speed /= _open_part(porosity, axis, i, j, k, periodic_y)
                 if speed > best:
                     best = speed
         largest[i] = best
@@ -85,7 +88,7 @@ def largest_pore_speed(f, q, axis, porosity, water_only):
 
 
 @parallel_kernel
-def limit_air_faces(f, q, axis, porosity, pore_speed_limit):
+def limit_air_faces(f, q, axis, porosity, pore_speed_limit, periodic_y=False):
     """Clip the pore speed |q| / n_face to ``pore_speed_limit`` (m/s) on the faces of ``axis``
     that touch no water, in place. Returns (faces clipped, largest |q| among them before)."""
     nx, ny, nz = q.shape
@@ -98,9 +101,10 @@ def limit_air_faces(f, q, axis, porosity, pore_speed_limit):
         for j in range(ny):
             for k in range(nz):
                 value = q[i, j, k]
-                if abs(value) <= pore_speed_limit * 1e-3 or _touches_water(f, axis, i, j, k):
+                if (abs(value) <= pore_speed_limit * 1e-3
+                        or _touches_water(f, axis, i, j, k, periodic_y)):
                     continue
-                limit = pore_speed_limit * _open_part(porosity, axis, i, j, k)
+                limit = pore_speed_limit * _open_part(porosity, axis, i, j, k, periodic_y)
                 if abs(value) > limit:
                     count += 1
                     best = max(best, abs(value))
@@ -111,27 +115,28 @@ def limit_air_faces(f, q, axis, porosity, pore_speed_limit):
 
 
 @kernel
-def listed_pore_speed(f, face_axis, face_index, values, porosity, water_only):
+def listed_pore_speed(f, face_axis, face_index, values, porosity, water_only, periodic_y=False):
     """``largest_pore_speed`` over listed faces (axis ``face_axis[n]``, (i, j, k)
     ``face_index[n]``, velocity ``values[n]``)."""
     best = 0.0
     for n in range(values.size):
         axis, i, j, k = face_axis[n], face_index[n, 0], face_index[n, 1], face_index[n, 2]
-        if water_only and not _touches_water(f, axis, i, j, k):
+        if water_only and not _touches_water(f, axis, i, j, k, periodic_y):
             continue
-        best = max(best, abs(values[n]) / _open_part(porosity, axis, i, j, k))
+        best = max(best, abs(values[n]) / _open_part(porosity, axis, i, j, k, periodic_y))
     return best
 
 
 @kernel
-def limit_listed_faces(f, face_axis, face_index, values, porosity, pore_speed_limit):
+def limit_listed_faces(f, face_axis, face_index, values, porosity, pore_speed_limit,
+                       periodic_y=False):
     """``limit_air_faces`` over listed faces, in place; returns the number clipped."""
     count = 0
     for n in range(values.size):
         axis, i, j, k = face_axis[n], face_index[n, 0], face_index[n, 1], face_index[n, 2]
-        if _touches_water(f, axis, i, j, k):
+        if _touches_water(f, axis, i, j, k, periodic_y):
             continue
-        limit = pore_speed_limit * _open_part(porosity, axis, i, j, k)
+        limit = pore_speed_limit * _open_part(porosity, axis, i, j, k, periodic_y)
         if abs(values[n]) > limit:
             values[n] = limit if values[n] > 0.0 else -limit
             count += 1

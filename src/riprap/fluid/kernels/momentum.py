@@ -20,7 +20,9 @@ momentum over the new density.
 
 Boundaries, per side (``boundary_kind[side]``, sides x_low, x_high, y_low, y_high, z_low, z_high):
 0 wall with no slip (the tangential velocity is zero at the wall, half a cell from the node), 1 wall
-with free slip (no shear), 2 open (zero gradient; no shear; mass may cross).
+with free slip (no shear), 2 open (zero gradient; no shear; mass may cross), 3 periodic (the y
+sides only, both: cell ny - 1 is cell 0's neighbour, face ny of v is face 0, which is computed
+and copied to face ny).
 
 Arrays are indexed [i, j, k]; a velocity component along ``axis`` has one more entry along that
 axis than the cells. Masses are in kg per step, densities kg/m^3, velocities m/s.
@@ -34,6 +36,14 @@ from riprap._jit import kernel, parallel_kernel, prange
 NO_SLIP = 0
 FREE_SLIP = 1
 OPEN = 2
+PERIODIC = 3
+
+
+@kernel
+def wrapped_step(index, step, n):
+    """The offset that takes ``index`` ``step`` places along a periodic axis of ``n`` entries
+    (cells, or faces with face n being face 0): ((index + step) mod n) - index."""
+    return (index + step + 2 * n) % n - index
 
 
 @kernel
@@ -106,6 +116,9 @@ def _transport_flat(component, faces, cells_bundle, boundary_kind, h, dt, gravit
     a_q = q_stride[axis]
     a_c = cell_stride[axis]
     n_along = cells[axis]
+    periodic_y = boundary_kind[2] == PERIODIC
+    # v on a periodic y: node 0 is computed like an inside node, node ny copied from it
+    periodic_along = periodic_y and axis == 1
     for outer in prange(shape[0]):
         i = np.int64(outer)          # prange counts in uint64; mixed with int64 it would be float
         for j in range(shape[1]):
@@ -114,11 +127,17 @@ def _transport_flat(component, faces, cells_bundle, boundary_kind, h, dt, gravit
                 s = i if axis == 0 else (j if axis == 1 else k)
                 q_out[node] = q[node]
                 density_out[node] = 0.0
-                if s == 0 or s == n_along:
+                if periodic_along and s == n_along:
+                    q_out[node] = q_out[node - n_along * a_q]     # face 0, done before it
+                    density_out[node] = density_out[node - n_along * a_q]
+                    continue
+                if (s == 0 and not periodic_along) or s == n_along:
                     continue
                 # The cells after (c1) and before (c0) the node along the axis.
                 c1 = i * cell_stride[0] + j * cell_stride[1] + k * cell_stride[2]
                 c0 = c1 - a_c
+                if periodic_along and s == 0:
+                    c0 = c1 + (n_along - 1) * a_c
                 density_old = 0.5 * (cell_density[c0] + cell_density[c1])
                 q_here = q[node]
                 mass_change = 0.0
@@ -135,13 +154,19 @@ def _transport_flat(component, faces, cells_bundle, boundary_kind, h, dt, gravit
                     sign = 1.0 if side == 1 else -1.0
                     lower = node + (side - 1) * a_q          # the two nodes beside the face
                     upper = lower + a_q
+                    if periodic_along:
+                        lower = node + wrapped_step(s, side - 1, n_along) * a_q
                     flux = 0.5 * (mass_a[lower] + mass_a[upper])
                     if flux >= 0.0:
                         upwind, downwind = lower, upper
                         far = lower - a_q if s + side - 2 >= 0 else lower
+                        if periodic_along:
+                            far = node + wrapped_step(s, side - 2, n_along) * a_q
                     else:
                         upwind, downwind = upper, lower
                         far = upper + a_q if s + side + 1 <= n_along else upper
+                        if periodic_along:
+                            far = node + wrapped_step(s, side + 1, n_along) * a_q
                     q_face = _van_leer_face(q[far], q[upwind], q[downwind])
                     cell = c0 if side == 0 else c1
                     stress = 2.0 * cell_viscosity[cell] * (q[upper] - q[lower]) / h
@@ -166,14 +191,48 @@ def _transport_flat(component, faces, cells_bundle, boundary_kind, h, dt, gravit
                     d_c = cell_stride[d]
                     d_f = face_stride[d, d]
                     a_f = face_stride[d, axis]
+                    # the d-faces of the cell before the node along the axis (around the strip
+                    # for v's node 0 on a periodic y)
+                    back_f = a_f
+                    if periodic_along and s == 0:
+                        back_f = -(n_along - 1) * a_f
                     # The d-face of cell s (along the axis) below the node.
                     face_base = i * face_stride[d, 0] + j * face_stride[d, 1] + k * face_stride[d, 2]
+                    periodic_d = periodic_y and d == 1
                     for side in range(2):
                         sign = 1.0 if side == 1 else -1.0
                         face = t + side
                         f1 = face_base + side * d_f
-                        flux = 0.5 * (mass_d[f1 - a_f] + mass_d[f1])
-                        if face == 0 or face == n_d:
+                        flux = 0.5 * (mass_d[f1 - back_f] + mass_d[f1])
+                        if periodic_d:
+                            # across the periodic y: the neighbours wrap (the walled code below
+                            # with its offsets taken around the strip)
+                            ahead = 1 if side == 1 else -1
+                            q_there = q[node + wrapped_step(t, ahead, n_d) * d_q]
+                            if flux >= 0.0:
+                                if side == 1:
+                                    q_up, q_down = q_here, q_there
+                                    q_far = q[node + wrapped_step(t, -1, n_d) * d_q]
+                                else:
+                                    q_up, q_down = q_there, q_here
+                                    q_far = q[node + wrapped_step(t, -2, n_d) * d_q]
+                            else:
+                                if side == 1:
+                                    q_up, q_down = q_there, q_here
+                                    q_far = q[node + wrapped_step(t, 2, n_d) * d_q]
+                                else:
+                                    q_up, q_down = q_here, q_there
+                                    q_far = q[node + wrapped_step(t, 1, n_d) * d_q]
+                            q_face = _van_leer_face(q_far, q_up, q_down)
+                            low = 0 if side == 1 else wrapped_step(t, -1, n_d) * d_c
+                            high = wrapped_step(t, 1, n_d) * d_c if side == 1 else 0
+                            mu_edge = 0.25 * (cell_viscosity[c0 + low] + cell_viscosity[c1 + low]
+                                              + cell_viscosity[c0 + high]
+                                              + cell_viscosity[c1 + high])
+                            dq = sign * (q_there - q_here) / h
+                            cross = (velocity_d[f1] - velocity_d[f1 - back_f]) / h
+                            stress = mu_edge * (dq + cross)
+                        elif face == 0 or face == n_d:
                             kind = boundary_kind[2 * d + (1 if face == n_d else 0)]
                             q_face = q_here
                             if kind == NO_SLIP:
@@ -206,7 +265,7 @@ def _transport_flat(component, faces, cells_bundle, boundary_kind, h, dt, gravit
                                               + cell_viscosity[c0 + shift + d_c]
                                               + cell_viscosity[c1 + shift + d_c])
                             dq = sign * (q_there - q_here) / h
-                            cross = (velocity_d[f1] - velocity_d[f1 - a_f]) / h
+                            cross = (velocity_d[f1] - velocity_d[f1 - back_f]) / h
                             stress = mu_edge * (dq + cross)
                         mass_change -= sign * flux
                         momentum_change -= sign * flux * q_face
@@ -244,5 +303,5 @@ def mass_fluxes(water_volume, face_velocity, dt, face_area, water_density, air_d
     return water_density * water_volume + air_density * (total - water_volume)
 
 
-__all__ = ["transport_component", "divergence", "mass_fluxes", "max_abs", "NO_SLIP", "FREE_SLIP",
-           "OPEN"]
+__all__ = ["transport_component", "divergence", "mass_fluxes", "max_abs", "wrapped_step",
+           "NO_SLIP", "FREE_SLIP", "OPEN", "PERIODIC"]

@@ -116,10 +116,12 @@ BREAKDOWN = 3
 #: per coarse cell along each axis from level l to l + 1 (last row unused);
 #: beta_x, beta_y, beta_z flat face coefficients (m^3/kg); corrections, residuals flat cell arrays
 #: (the V-cycle's x and right-hand side on each level); coarsest_factor (n_coarsest, bandwidth + 1)
-#: banded Cholesky factor, coarsest_factor[r, t] = L[r, r - t].
+#: banded Cholesky factor, coarsest_factor[r, t] = L[r, r - t]; periodic_y (bool) the y axis
+#: periodic on every level (its faces 0 and ny one face, cells ny - 1 and 0 neighbours).
 Hierarchy = namedtuple("Hierarchy", ["shapes", "cell_offsets", "face_offsets",
                                      "inverse_spacing_squared", "factors", "beta_x", "beta_y",
-                                     "beta_z", "corrections", "residuals", "coarsest_factor"])
+                                     "beta_z", "corrections", "residuals", "coarsest_factor",
+                                     "periodic_y"])
 
 
 # --------------------------------------------------------------------------------------------------
@@ -157,11 +159,12 @@ def face_array(flat, hierarchy, level, axis):
 
 @kernel
 def diagonal_and_neighbour_sum(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x,
-                               i, j, k):
+                               i, j, k, periodic_y=False):
     """(d_c, sum_f g_f x_n(f)) of the positive form L at cell (i, j, k): (L x)_c = d_c x_c - sum.
 
     A boundary face enters the diagonal twice (Dirichlet face half a cell away) and no neighbour;
-    with beta = 0 it is a wall and enters nothing.
+    with beta = 0 it is a wall and enters nothing. On a ``periodic_y`` the y faces 0 and ny are
+    the one face between cells ny - 1 and 0 (an even ny keeps them of two colours).
     """
     nx, ny, nz = x.shape
     diagonal = 0.0
@@ -182,12 +185,18 @@ def diagonal_and_neighbour_sum(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2,
     if j > 0:
         diagonal += g
         neighbours += g * x[i, j - 1, k]
+    elif periodic_y:
+        diagonal += g
+        neighbours += g * x[i, ny - 1, k]
     else:
         diagonal += 2.0 * g
     g = beta_y[i, j + 1, k] * inverse_hy2
     if j < ny - 1:
         diagonal += g
         neighbours += g * x[i, j + 1, k]
+    elif periodic_y:
+        diagonal += g
+        neighbours += g * x[i, 0, k]
     else:
         diagonal += 2.0 * g
     g = beta_z[i, j, k] * inverse_hz2
@@ -250,7 +259,7 @@ def is_active(beta_x, beta_y, beta_z, i, j, k):
 
 @parallel_kernel
 def apply_positive_operator(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x,
-                            result):
+                            result, periodic_y=False):
     """result = L x = -div(beta grad x) (1/m^2 times the units of beta x)."""
     nx, ny, nz = x.shape
     two_dimensional = ny == 1
@@ -264,7 +273,8 @@ def apply_positive_operator(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, in
                         two_dimensional)
                 else:
                     diagonal, neighbours = diagonal_and_neighbour_sum(
-                        beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x, i, j, k)
+                        beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x, i, j, k,
+                        periodic_y)
                 result[i, j, k] = diagonal * x[i, j, k] - neighbours
 
 
@@ -376,7 +386,7 @@ def dot(a, b, row_sums):
 
 @parallel_kernel
 def compute_residual(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x,
-                     residual, row_sums):
+                     residual, row_sums, periodic_y=False):
     """residual = rhs - L x; returns (||residual||_2^2, max |residual|)."""
     nx, ny, nz = x.shape
     two_dimensional = ny == 1
@@ -392,7 +402,8 @@ def compute_residual(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_h
                         two_dimensional)
                 else:
                     diagonal, neighbours = diagonal_and_neighbour_sum(
-                        beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x, i, j, k)
+                        beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x, i, j, k,
+                        periodic_y)
                 value = rhs[i, j, k] - (diagonal * x[i, j, k] - neighbours)
                 residual[i, j, k] = value
                 total += value * value
@@ -404,7 +415,7 @@ def compute_residual(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_h
 
 @parallel_kernel
 def apply_operator_and_dot(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2,
-                           direction, product, row_sums):
+                           direction, product, row_sums, periodic_y=False):
     """product = L direction; returns direction . product (the CG curvature)."""
     nx, ny, nz = direction.shape
     two_dimensional = ny == 1
@@ -419,7 +430,8 @@ def apply_operator_and_dot(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inv
                         two_dimensional)
                 else:
                     diagonal, neighbours = diagonal_and_neighbour_sum(
-                        beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, direction, i, j, k)
+                        beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, direction, i, j,
+                        k, periodic_y)
                 value = diagonal * direction[i, j, k] - neighbours
                 product[i, j, k] = value
                 total += value * direction[i, j, k]
@@ -542,7 +554,7 @@ def coarsen_coefficients(fine_beta_x, fine_beta_y, fine_beta_z, coarse_beta_x, c
 
 @kernel
 def _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour, i,
-                 from_zero):
+                 from_zero, periodic_y):
     """Gauss-Seidel on the cells of colour ``colour`` in the x-slab i (from x = 0 there when
     ``from_zero``: rhs / d, without reading the neighbours).
 
@@ -560,7 +572,8 @@ def _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, 
                     two_dimensional)
             else:
                 diagonal, neighbours = diagonal_and_neighbour_sum(
-                    beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x, i, j, k)
+                    beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x, i, j, k,
+                    periodic_y)
             if from_zero:
                 x[i, j, k] = rhs[i, j, k] / diagonal if diagonal > 0.0 else 0.0
             else:
@@ -569,7 +582,7 @@ def _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, 
 
 @parallel_kernel
 def smooth_first_red(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, first,
-                     stop, parity):
+                     stop, parity, periodic_y=False):
     """The first red sweep from x = 0: red cells rhs / d, black cells 0 (saves zeroing x), on the
     x-slabs first..stop-1; ``parity`` is the global x index of slab 0 mod 2 (0 for a whole grid)."""
     nx, ny, nz = x.shape
@@ -580,46 +593,46 @@ def smooth_first_red(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_h
                     x[i, j, k] = 0.0
     for i in prange(first, stop):
         _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, parity,
-                     i, True)
+                     i, True, periodic_y)
 
 
 @parallel_kernel
 def smooth_colour(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour,
-                  first, stop):
+                  first, stop, periodic_y=False):
     """One Gauss-Seidel sweep over the cells of x-slabs first..stop-1 with (i + j + k) mod 2 ==
     colour (0 red, 1 black; a slab of a split grid passes its colour shifted by its parity)."""
     for i in prange(first, stop):
         _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour,
-                     i, False)
+                     i, False, periodic_y)
 
 
 @kernel
 def smooth_colour_serial(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x,
-                         colour, first, stop):
+                         colour, first, stop, periodic_y=False):
     """``smooth_colour`` on one thread: on the small coarse levels a parallel launch costs more
     than the sweep (the same result: cells of one colour do not read each other)."""
     for i in range(first, stop):
         _smooth_slab(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour,
-                     i, False)
+                     i, False, periodic_y)
 
 
 @kernel
 def smooth(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour, first,
-           stop):
+           stop, periodic_y=False):
     """One colour's sweep over x-slabs first..stop-1, in parallel on levels of at least
     ``PARALLEL_SWEEP_CELLS`` cells."""
     if x.size >= PARALLEL_SWEEP_CELLS:
         smooth_colour(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x, colour,
-                      first, stop)
+                      first, stop, periodic_y)
     else:
         smooth_colour_serial(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x,
-                             colour, first, stop)
+                             colour, first, stop, periodic_y)
 
 
 @parallel_kernel
 def restrict_red_residual(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, rhs, x,
                           coarse_rhs, factor_x, factor_y, factor_z, fine_first, fine_stop,
-                          coarse_first, coarse_stop, parity):
+                          coarse_first, coarse_stop, parity, periodic_y=False):
     """coarse_rhs = c P^T (rhs - L x), c = 1 / (factor_x factor_y factor_z), after a black sweep.
 
     The last smoothing sweep solved every black cell's equation, so the black residuals are zero
@@ -645,7 +658,8 @@ def restrict_red_residual(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inve
                             two_dimensional)
                     else:
                         diagonal, neighbours = diagonal_and_neighbour_sum(
-                            beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x, i, j, k)
+                            beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, x, i, j, k,
+                            periodic_y)
                     coarse_rhs[ci, cj, k // factor_z] += rhs[i, j, k] - (diagonal * x[i, j, k]
                                                                          - neighbours)
         coarse_rhs[ci, :, :] *= scale
@@ -666,7 +680,8 @@ def prolong_correction(coarse_x, x, factor_x, factor_y, factor_z, fine_first, fi
 
 
 @kernel
-def factor_coarsest(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, factor):
+def factor_coarsest(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, factor,
+                    periodic_y=False):
     """Banded Cholesky L = F F^T of the coarsest operator, natural order r = (i ny + j) nz + k.
 
     ``factor`` (n, bandwidth + 1), bandwidth = ny nz: factor[r, t] = F[r, r - t]. Dependent or
@@ -687,13 +702,18 @@ def factor_coarsest(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz
             for k in range(nz):
                 r = (i * ny + j) * nz + k
                 diagonal, _ = diagonal_and_neighbour_sum(beta_x, beta_y, beta_z, inverse_hx2,
-                                                         inverse_hy2, inverse_hz2, dummy, i, j, k)
+                                                         inverse_hy2, inverse_hz2, dummy, i, j, k,
+                                                         periodic_y)
                 factor[r, 0] = diagonal
                 largest = max(largest, diagonal)
                 if k > 0:
                     factor[r, 1] = -beta_z[i, j, k] * inverse_hz2
                 if j > 0:
                     factor[r, nz] = -beta_y[i, j, k] * inverse_hy2
+                if periodic_y and j == ny - 1 and ny > 1:
+                    # the face ny (face 0) to cell (i, 0, k), (ny - 1) nz rows back: inside the
+                    # band (added: with ny = 2 it is the j - 1 neighbour's slot again)
+                    factor[r, (ny - 1) * nz] += -beta_y[i, ny, k] * inverse_hy2
                 if i > 0:
                     factor[r, bandwidth] = -beta_x[i, j, k] * inverse_hx2
     threshold = PIVOT_TOLERANCE * largest
@@ -753,7 +773,7 @@ ListedCells = namedtuple("ListedCells", ["cells", "neighbours", "couplings", "in
 
 @parallel_kernel
 def listed_stencils(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz2, cells,
-                    neighbours, couplings, inverse_diagonal):
+                    neighbours, couplings, inverse_diagonal, periodic_y=False):
     """Fill the stencils of ``ListedCells`` for ``cells`` (flat indices) from level 0's faces.
 
     Why stored: a sweep over a list of scattered cells that derives every stencil from the faces
@@ -775,7 +795,12 @@ def listed_stencils(beta_x, beta_y, beta_z, inverse_hx2, inverse_hy2, inverse_hz
         steps = (-ny * nz, ny * nz, -nz, nz, -1, 1)
         diagonal = 0.0
         for f in range(6):
-            if inside[f]:
+            if periodic_y and (f == 2 or f == 3) and not inside[f]:
+                # across the periodic y: the cell at the strip's other side
+                diagonal += faces[f]
+                couplings[m, f] = faces[f]
+                neighbours[m, f] = cell + (ny - 1) * nz * (1 if f == 2 else -1)
+            elif inside[f]:
                 diagonal += faces[f]
                 couplings[m, f] = faces[f]
                 neighbours[m, f] = cell + steps[f]
@@ -823,6 +848,7 @@ def apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps, first_level):
     """
     n_levels = hierarchy.shapes.shape[0]
     spacing = hierarchy.inverse_spacing_squared
+    periodic = hierarchy.periodic_y
     local = listed_sweeps > 0 and listed.cells.shape[0] > 0
     red, stop = listed.red, listed.cells.shape[0]
     for level in range(n_levels - 1):
@@ -842,14 +868,15 @@ def apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps, first_level):
         nx = x.shape[0]
         for sweep in range(level_sweeps(sweeps, level + first_level)):
             if sweep == 0 and first_from_zero:
-                smooth_first_red(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0, nx, 0)
+                smooth_first_red(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0, nx, 0, periodic)
             else:
-                smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0, 0, nx)
-            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 1, 0, nx)
+                smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0, 0, nx, periodic)
+            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 1, 0, nx, periodic)
         factors = hierarchy.factors[level]
         coarse_rhs = cell_array(hierarchy.residuals, hierarchy, level + 1)
         restrict_red_residual(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, coarse_rhs,
-                              factors[0], factors[1], factors[2], 0, nx, 0, coarse_rhs.shape[0], 0)
+                              factors[0], factors[1], factors[2], 0, nx, 0, coarse_rhs.shape[0], 0,
+                              periodic)
     last = n_levels - 1
     solve_coarsest(hierarchy.coarsest_factor, cell_array(hierarchy.residuals, hierarchy, last),
                    cell_array(hierarchy.corrections, hierarchy, last))
@@ -865,8 +892,8 @@ def apply_v_cycle(hierarchy, sweeps, listed, listed_sweeps, first_level):
         prolong_correction(cell_array(hierarchy.corrections, hierarchy, level + 1), x,
                            factors[0], factors[1], factors[2], 0, nx, 0)
         for sweep in range(level_sweeps(sweeps, level + first_level)):
-            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 1, 0, nx)
-            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0, 0, nx)
+            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 1, 0, nx, periodic)
+            smooth(beta_x, beta_y, beta_z, hx2, hy2, hz2, rhs, x, 0, 0, nx, periodic)
         if level == 0 and local:
             for _ in range(listed_sweeps):
                 smooth_listed_cells(listed, rhs, x, red, stop)
@@ -907,6 +934,7 @@ def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tol
     hz2 = hierarchy.inverse_spacing_squared[0, 2]
     residual = cell_array(hierarchy.residuals, hierarchy, 0)
     preconditioned = cell_array(hierarchy.corrections, hierarchy, 0)
+    periodic = hierarchy.periodic_y
 
     rhs_norm = np.sqrt(dot(system_rhs, system_rhs, row_sums))
     if not np.isfinite(rhs_norm):
@@ -915,7 +943,7 @@ def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tol
         pressure[:, :, :] = 0.0
         return 0, 0.0, 0.0, CONVERGED
     squared, largest = compute_residual(beta_x, beta_y, beta_z, hx2, hy2, hz2, system_rhs,
-                                        pressure, residual, row_sums)
+                                        pressure, residual, row_sums, periodic)
     relative = np.sqrt(squared) / rhs_norm
     if not np.isfinite(relative):
         return 0, relative, largest, NON_FINITE
@@ -936,7 +964,7 @@ def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tol
             update_direction(direction, preconditioned, new_product / curvature_product)
         curvature_product = new_product
         curvature = apply_operator_and_dot(beta_x, beta_y, beta_z, hx2, hy2, hz2, direction,
-                                           product, row_sums)
+                                           product, row_sums, periodic)
         if not np.isfinite(curvature):
             return iterations, relative, largest, NON_FINITE
         if curvature <= 0.0 or curvature_product <= 0.0:
@@ -950,7 +978,7 @@ def solve_pcg(hierarchy, system_rhs, pressure, direction, product, row_sums, tol
         if relative <= tolerance or largest <= largest_residual:
             # Confirm with the true residual; restart from it if the recurrence has drifted.
             squared, largest = compute_residual(beta_x, beta_y, beta_z, hx2, hy2, hz2,
-                                                system_rhs, pressure, residual, row_sums)
+                                                system_rhs, pressure, residual, row_sums, periodic)
             relative = np.sqrt(squared) / rhs_norm
             restart = True
     if singular:

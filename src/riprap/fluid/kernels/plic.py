@@ -229,7 +229,15 @@ def clamp_index(index, size):
 
 
 @kernel
-def interface_normal(f, i, j, k):
+def neighbour_index(index, size, periodic):
+    """``clamp_index``, or around the axis when it is ``periodic``."""
+    if periodic:
+        return (index + size) % size
+    return clamp_index(index, size)
+
+
+@kernel
+def interface_normal(f, i, j, k, periodic_y=False):
     """Normal (n1, n2, n3) of the interface in cell (i, j, k), pointing from water to air, with
     |n1| + |n2| + |n3| = 1; (0, 0, 0) where the neighbourhood shows no gradient at all.
 
@@ -244,7 +252,8 @@ def interface_normal(f, i, j, k):
     short by the 3-cell stencil (thin films, corners) flatten the heights and make the column
     normal too aligned with the axis. On exact plane data this choice gives a mean error of
     0.1 degree against Youngs' 1.3 (the opposite choice: 1.5). ``ny == 1``: the same with the
-    3x3 x-z stencil and two candidates.
+    3x3 x-z stencil and two candidates. ``periodic_y``: the stencil wraps around y (a periodic
+    strip), else it continues the edge cells.
     """
     nx, ny, nz = f.shape
     if ny == 1:
@@ -263,7 +272,7 @@ def interface_normal(f, i, j, k):
         ia = clamp_index(i + a, nx)
         wa = 2.0 - abs(a)
         for b in range(-1, 2):
-            jb = clamp_index(j + b, ny)
+            jb = neighbour_index(j + b, ny, periodic_y)
             wb = 2.0 - abs(b)
             for c in range(-1, 2):
                 value = f[ia, jb, clamp_index(k + c, nz)]
@@ -369,12 +378,12 @@ def _interface_normal_2d(f, i, k):
 # --------------------------------------------------------------------------------------------
 
 @kernel
-def _slab_water_fraction(f, i, j, k, direction, courant, velocity_positive):
+def _slab_water_fraction(f, i, j, k, direction, courant, velocity_positive, periodic_y):
     """Water in the slab of cell (i, j, k) next to its face along ``direction`` (high face if the
     velocity is positive, low face otherwise), ``courant`` cell widths thick, as a fraction of the
     cell volume; for a mixed cell (0 < f < 1, empty and full cells are handled by the caller)."""
     fraction = f[i, j, k]
-    n1, n2, n3 = interface_normal(f, i, j, k)
+    n1, n2, n3 = interface_normal(f, i, j, k, periodic_y)
     if n1 == 0.0 and n2 == 0.0 and n3 == 0.0:
         # no gradient in the neighbourhood: the water is spread evenly over the cell
         return courant * fraction
@@ -392,7 +401,7 @@ def _slab_water_fraction(f, i, j, k, direction, courant, velocity_positive):
 
 @parallel_kernel
 def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_flux_out, porosity,
-                 water_inflow_x_low):
+                 water_inflow_x_low, periodic_y=False):
     """One direction-split sweep of Weymouth & Yue (2010) along axis ``direction`` (0 x, 1 y, 2 z).
 
     Arguments: ``f`` (nx, ny, nz) water fractions, updated in place; ``face_velocity`` the normal
@@ -406,6 +415,8 @@ def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_f
     (Darcy) velocity, the slab of a mixed upwind cell |u| dt / (n h) thick (the pore velocity's)
     and each update divided by n. Requires |u| dt / (n h) <= 1/2 (checked by ``advect``).
     ``water_inflow_x_low``: what enters through the x = lower boundary is water (else air).
+    ``periodic_y``: y is periodic, the face ny is face 0 (the same velocity and upwind cell, so
+    the same flux) and the upwind cell of an inflow through it is the one at the other side.
 
     Returns the largest distance of any updated fraction outside [0, 1] before clipping (0.0 if
     none); values within ``CLIP_TOLERANCE`` of the range are clipped, larger ones are left.
@@ -441,6 +452,8 @@ def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_f
                 positive = velocity > 0.0
                 # upwind cell: before the face if the flow is positive, after it otherwise
                 upwind = face_index - 1 if positive else face_index
+                if periodic_y and direction == 1:
+                    upwind = (upwind + n_along) % n_along
                 if upwind < 0 or upwind >= n_along:
                     if water_inflow_x_low and direction == 0 and upwind < 0:
                         water_flux_out[i, j, k] = velocity * swept_per_velocity
@@ -462,7 +475,8 @@ def advect_sweep(f, face_velocity, dilation_indicator, dt, h, direction, water_f
                 else:
                     open_part = porosity[ci, cj, ck]
                     courant = abs(velocity) * courant_per_velocity / open_part
-                    slab = _slab_water_fraction(f, ci, cj, ck, direction, courant, positive) * open_part
+                    slab = _slab_water_fraction(f, ci, cj, ck, direction, courant, positive,
+                                                periodic_y) * open_part
                     water_flux_out[i, j, k] = slab * cell_volume if positive else -slab * cell_volume
     overshoots = np.zeros(nx)
     for outer in prange(nx):
@@ -530,7 +544,8 @@ def sweep_order(step_index: int, two_dimensional: bool) -> tuple:
 
 
 def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
-           water_flux_z=None, porosity=None, water_inflow_x_low=False) -> AdvectionFluxes:
+           water_flux_z=None, porosity=None, water_inflow_x_low=False,
+           periodic_y=False) -> AdvectionFluxes:
     """Move the water fraction ``f`` (nx, ny, nz, in place) by the face velocities ``u``, ``v``,
     ``w`` (m/s, MAC layout of the module docstring) over ``dt`` (s) on cubic cells of side ``h``
     (m): all sweeps of one step, in the order ``sweep_order(step_index, ny == 1)``.
@@ -544,6 +559,7 @@ def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
     ``porosity`` (nx, ny, nz, optional; default 1): porous zones (``advect_sweep``), where f is
     the pore space's water fraction. ``water_inflow_x_low``: what flows in through the x = lower
     boundary faces is water (a wave maker's boundary); elsewhere inflow through a boundary is air.
+    ``periodic_y``: the y sides are one periodic boundary (``v[:, 0] == v[:, ny]`` required).
 
     Raises ``InstabilityError`` if the Courant number max |u| dt / (n h) exceeds 1/2 (the
     scheme's bound; n the smaller porosity of the cells beside each face), ``ValueError`` for
@@ -586,6 +602,7 @@ def advect(f, u, v, w, dt, h, step_index, water_flux_x=None, water_flux_y=None,
     largest_overshoot = 0.0
     for axis in sweep_order(step_index, two_dimensional):
         overshoot = advect_sweep(f, velocities["uvw"[axis]], dilation_indicator, float(dt),
-                                 float(h), axis, fluxes[axis], porosity, bool(water_inflow_x_low))
+                                 float(h), axis, fluxes[axis], porosity, bool(water_inflow_x_low),
+                                 bool(periodic_y))
         largest_overshoot = max(largest_overshoot, float(overshoot))
     return AdvectionFluxes(fluxes[0], fluxes[1], fluxes[2], largest_overshoot)

@@ -5,7 +5,8 @@ and viscosities. Taken over the whole grid and then picked out (as ``porous.face
 cost a ninth of examples/10's fluid step, while the core holds a few percent of the faces.
 
 Faces are flat indices into the face array of ``axis`` (``PorousMedium.faces``); a boundary face
-takes its one cell's value, as ``porous.face_means``.
+takes its one cell's value, as ``porous.face_means``; on a periodic y its two cells are the
+strip's last and first.
 """
 import math
 
@@ -22,7 +23,8 @@ def _cell_speed(u, v, w, i, j, k):
 
 
 @parallel_kernel
-def face_speeds_and_viscosities(u, v, w, viscosity, axis, faces, speed_out, viscosity_out):
+def face_speeds_and_viscosities(u, v, w, viscosity, axis, faces, speed_out, viscosity_out,
+                                periodic_y=False):
     """``speed_out[n]``, ``viscosity_out[n]``: the means of the two cells beside face ``faces[n]``
     of the speed |U| at the cell centres (from the face velocities u, v, w) and of ``viscosity``."""
     nx, ny, nz = viscosity.shape
@@ -34,7 +36,7 @@ def face_speeds_and_viscosities(u, v, w, viscosity, axis, faces, speed_out, visc
         i = flat // (face_ny * face_nz)
         j = (flat // face_nz) % face_ny
         k = flat % face_nz
-        il, jl, kl, ih, jh, kh = cells_beside_face(axis, i, j, k, n_along)
+        il, jl, kl, ih, jh, kh = cells_beside_face(axis, i, j, k, n_along, periodic_y)
         speed_out[n] = 0.5 * (_cell_speed(u, v, w, il, jl, kl) + _cell_speed(u, v, w, ih, jh, kh))
         viscosity_out[n] = 0.5 * (viscosity[il, jl, kl] + viscosity[ih, jh, kh])
 

@@ -27,7 +27,7 @@ from riprap.fluid.kernels.plic import interface_normal, plane_constant
 
 
 @parallel_kernel
-def cell_planes(f, planes):
+def cell_planes(f, planes, periodic_y=False):
     """``planes[i, j, k] = (n1, n2, n3, alpha)``, the PLIC plane of every mixed cell (0 < f < 1;
     a zero normal where the neighbourhood shows no gradient); other cells are left as they are
     (never read). Why once per step: each mixed cell's plane serves its six half segments on the
@@ -41,7 +41,7 @@ def cell_planes(f, planes):
             for k in range(nz):
                 fraction = f[i, j, k]
                 if 0.0 < fraction < 1.0:
-                    n1, n2, n3 = interface_normal(f, i, j, k)
+                    n1, n2, n3 = interface_normal(f, i, j, k, periodic_y)
                     planes[i, j, k, 0] = n1
                     planes[i, j, k, 1] = n2
                     planes[i, j, k, 2] = n3
@@ -74,10 +74,12 @@ def _half_segment_water(f, planes, i, j, k, axis, toward_high):
 
 
 @parallel_kernel
-def face_densities(f, planes, axis, water_density, air_density, out):
+def face_densities(f, planes, axis, water_density, air_density, out, periodic_y=False):
     """``out`` (the face array of ``axis``): the segment density of every interior face; the
-    boundary faces along ``axis`` get the density of their one cell's half segment. ``planes``:
-    ``cell_planes(f, planes)`` of the same ``f``."""
+    boundary faces along ``axis`` get the density of their one cell's half segment (on a
+    ``periodic_y``, the y faces 0 and ny are interior faces between cells ny - 1 and 0).
+    ``planes``: ``cell_planes(f, planes)`` of the same ``f``."""
+    inside_only = periodic_y and axis == 1
     n_along = f.shape[axis]
     face_nx, face_ny, face_nz = out.shape
     for outer in prange(face_nx):
@@ -85,8 +87,11 @@ def face_densities(f, planes, axis, water_density, air_density, out):
         for j in range(face_ny):
             for k in range(face_nz):
                 s = i if axis == 0 else (j if axis == 1 else k)
-                il, jl, kl, ih, jh, kh = cells_beside_face(axis, i, j, k, n_along)
-                if s == 0:
+                il, jl, kl, ih, jh, kh = cells_beside_face(axis, i, j, k, n_along, periodic_y)
+                if inside_only:
+                    theta = 0.5 * (_half_segment_water(f, planes, il, jl, kl, axis, True)
+                                   + _half_segment_water(f, planes, ih, jh, kh, axis, False))
+                elif s == 0:
                     theta = _half_segment_water(f, planes, ih, jh, kh, axis, False)
                 elif s == n_along:
                     theta = _half_segment_water(f, planes, il, jl, kl, axis, True)
