@@ -621,10 +621,14 @@ KEYS: tuple[Key, ...] = (
         default="no_slip", choices=("no_slip", "free_slip")),
     Key("fluid", "x_high", "string", "-", "Side x = upper.", default="no_slip",
         choices=("no_slip", "free_slip")),
-    Key("fluid", "y_low", "string", "-", "Side y = lower.", default="no_slip",
-        choices=("no_slip", "free_slip")),
-    Key("fluid", "y_high", "string", "-", "Side y = upper.", default="no_slip",
-        choices=("no_slip", "free_slip")),
+    Key("fluid", "y_low", "string", "-",
+        "Side y = lower: a wall, or \"periodic\" with y_high (a strip across the flume that "
+        "stands for a wide one: what leaves at one side comes in at the other; ny even, a "
+        "multiple of 4 for the pressure's multigrid; the bodies and obstacles see the strip's "
+        "images: docs/fluid.md, Periodic strip).", default="no_slip",
+        choices=("no_slip", "free_slip", "periodic")),
+    Key("fluid", "y_high", "string", "-", "Side y = upper; \"periodic\" with y_low.",
+        default="no_slip", choices=("no_slip", "free_slip", "periodic")),
     Key("fluid", "z_low", "string", "-", "The bottom.", default="no_slip",
         choices=("no_slip", "free_slip")),
     Key("fluid", "z_high", "string", "-",

@@ -159,6 +159,18 @@ def test_porous_flume_with_boundary_waves_and_every_gauge_over_two_processes():
     assert "bit for bit" in result.stdout, result.stdout
 
 
+def test_periodic_strip_over_two_processes():
+    """A periodic strip (tests/parallel/cases/periodic_flume.toml: y_low = y_high = "periodic", a
+    mound of water spilling across the periodic boundary, a porous core, boundary waves, gauges),
+    300 steps on two slabs of x: the whole grid and the gauges bit for bit those of one process,
+    compared every 50 steps (the strip's wrap lies inside each slab; the split pressure solve
+    wraps on its distributed and gathered levels alike)."""
+    case = HERE / "cases" / "periodic_flume.toml"
+    result = launch(2, sys.executable, str(HERE / "slab_fluid_check.py"), str(case), "300", "8",
+                    "50", timeout=600)
+    assert "bit for bit" in result.stdout, result.stdout
+
+
 def test_a_killed_process_ends_the_run(tmp_path):
     """One process of two killed mid-run: the launcher ends the other, within 30 s."""
     longer = tmp_path / "long.toml"

@@ -176,3 +176,54 @@ def test_a_periodic_y_that_cannot_hold_is_refused(boundaries, cells, words):
     with pytest.raises(CaseFileError, match=words):
         FluidGrid(lower=(0.0, 0.0, 0.0), upper=tuple(0.1 * n for n in cells), cells=cells,
                   boundaries=boundaries)
+
+
+_STRIP_CASE = """format_version = 1
+[simulation]
+end_time = 0.1
+[fluid]
+lower = [0.0, 0.0, 0.0]
+upper = [0.8, 0.2, 0.4]
+cells = [{nx}, {ny}, 16]
+y_low = "{y_low}"
+y_high = "periodic"
+surface_tension = 0.0
+[[water_regions]]
+type = "level"
+level = 0.2
+{extra}
+"""
+
+
+@pytest.mark.parametrize("y_low, ny, extra, words", [
+    ("free_slip", 8, "", "needs the other y side periodic"),
+    ("periodic", 7, "", "even number of cells"),
+    ("periodic", 8, "[[obstacles]]\ntype = \"box\"\nlower = [0.3, 0.0, 0.0]\n"
+     "upper = [0.4, 0.1, 0.1]", "does not span the periodic strip"),
+    ("periodic", 8, "[[porous_zones]]\ntype = \"box\"\nporosity = 0.4\nstone_diameter = 0.01\n"
+     "lower = [0.3, 0.05, 0.0]\nupper = [0.6, 0.2, 0.1]", "does not span the periodic strip"),
+])
+def test_riprap_check_names_each_refusal_of_a_strip(tmp_path, capsys, y_low, ny, extra, words):
+    """``riprap check`` on a periodic strip that cannot hold: exit 2 and one line naming the
+    case file, the table and why."""
+    from riprap.cli import main
+    path = tmp_path / "strip.toml"
+    path.write_text(_STRIP_CASE.format(nx=32, ny=ny, y_low=y_low, extra=extra))
+    if ny % 2:     # cells must stay cubes: the strip's width follows its cells
+        path.write_text(path.read_text().replace("upper = [0.8, 0.2, 0.4]",
+                                                 "upper = [0.8, 0.175, 0.4]"))
+    assert main(["check", str(path)]) == 2
+    error = capsys.readouterr().err
+    assert words in error and "strip.toml" in error, error
+
+
+def test_riprap_check_takes_a_strip(tmp_path, capsys):
+    """The same strip with both sides periodic, an obstacle and a porous box across its whole
+    width: ``riprap check`` passes it."""
+    from riprap.cli import main
+    path = tmp_path / "strip.toml"
+    extra = ("[[obstacles]]\ntype = \"box\"\nlower = [0.3, 0.0, 0.0]\nupper = [0.4, 0.2, 0.1]\n"
+             "[[porous_zones]]\ntype = \"box\"\nporosity = 0.4\nstone_diameter = 0.01\n"
+             "lower = [0.5, 0.0, 0.0]\nupper = [0.7, 0.2, 0.1]")
+    path.write_text(_STRIP_CASE.format(nx=32, ny=8, y_low="periodic", extra=extra))
+    assert main(["check", str(path)]) == 0, capsys.readouterr().err

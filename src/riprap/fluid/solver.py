@@ -285,6 +285,11 @@ class FluidSolver:
             return inside
 
         inside = inside_along(whole)
+        if self.periodic_y and not inside[1].all():
+            raise CaseFileError(
+                f"fluid obstacle {list(lower)} .. {list(upper)} does not span the periodic strip's "
+                f"width (y {whole.lower[1]:g} .. {whole.upper[1]:g} m): on a periodic y an "
+                "obstacle must be uniform across the flume, or it stands for a row of obstacles")
         if not all(along.any() for along in inside):
             raise CaseFileError(f"fluid obstacle {list(lower)} .. {list(upper)} holds no cell "
                                 f"centre (cells are {self.h:g} m)")
@@ -304,6 +309,16 @@ class FluidSolver:
     def add_porous_zones(self, zones) -> None:
         """Porous zones (``riprap.fluid.porous.PorousZone``: a core, filter layers) in the flow;
         ``fraction`` becomes the water fraction of their pore space. Replaces earlier zones."""
+        if self.periodic_y:
+            whole = self.grid.whole_grid
+            for zone in zones:
+                if zone.lower is not None and (zone.lower[1] > whole.lower[1]
+                                               or zone.upper[1] < whole.upper[1]):
+                    raise CaseFileError(
+                        f"{zone.name}: the box y {zone.lower[1]:g} .. {zone.upper[1]:g} m does "
+                        f"not span the periodic strip's width ({whole.lower[1]:g} .. "
+                        f"{whole.upper[1]:g} m): on a periodic y a porous zone must be uniform "
+                        "across the flume (or give a polygon, which spans it)")
         self.porous = PorousMedium(self.grid, zones)
         self._open_part = self.porous.porosity
         self.initial_water_volume = None
