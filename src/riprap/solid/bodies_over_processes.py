@@ -13,6 +13,10 @@ processes join on a step where any body changed owner.
 Bit for bit: the pairs are listed in (i, j) order on one process as on each of many, so every
 body's forces are added in the same order; the joined forces are each one process's sum.
 
+A periodic direction (``SolidSolver.set_periodic``) changes nothing here: every process wraps the
+centres and takes the pairs by minimum image as one process does; with x periodic the first and
+last slabs are neighbours through the strip's ends (``owned_step.local_candidates``).
+
 Why the slabs of the contacts are not the fluid's: the slabs are cut afresh at each ``advance``
 (a fluid step) so that each holds about the same number of pairs (each body weighted by the
 pairs it was first in at the last evaluation), since the fluid's cut balances the cells, and an

@@ -15,7 +15,7 @@ import numpy as np
 from riprap.errors import CaseFileError, InstabilityError, KernelOverflowError, OverlapError
 from riprap.schema import default_of
 from riprap.solid.bodies_over_processes import BodiesOverProcesses
-from riprap.solid.kernels import integrate, interactions, stepper
+from riprap.solid.kernels import integrate, interactions, periodic, stepper
 from riprap.solid.kernels.bundles import (Bodies, History, Motion, PairLaws, RigidSystem,
                                           StepSettings, Walls)
 from riprap.solid.kernels.geometry_ops import rotation_matrices, rotation_matrix
@@ -34,6 +34,10 @@ _SKIN_OVER_SUBTET_HEIGHT = 0.1
 _ACCEPTED_DEPTH_SLACK = 1e-3
 # Centroids closer than this fraction of the smaller bounding radius: the bodies coincide.
 _COINCIDENT_FRACTION = 0.05
+# A wall whose unit normal has a component larger than this along a periodic axis is a wall
+# across that axis (the slope's face and the bed have exactly 0 there).
+_WALL_ACROSS_PERIODIC = 1e-12
+_AXIS_NAMES = "xyz"
 
 
 @dataclass
@@ -41,7 +45,9 @@ class ContactRecords:
     """Contacts of the last force evaluation, one row per touching pair.
 
     ``body_j`` is -1 - w for a contact with wall w. Forces act on ``body_i`` (N); body j receives the
-    opposite. ``points`` is the force-weighted contact point (m).
+    opposite. ``points`` is the force-weighted contact point (m); across a periodic boundary it
+    lies beside body i (``SolidSolver.set_periodic``), and body j's lever arm to it is taken by
+    minimum image (``SolidSolver.minimum_image``).
     """
 
     body_i: np.ndarray
@@ -91,6 +97,8 @@ class SolidSolver:
         self._ready = False
         # (body_i, body_j, springs) of the contacts the bodies start in (a pack's history).
         self.initial_contact_history = None
+        # (axis, lower, upper) of the periodic direction (``set_periodic``), or None
+        self._periodic = None
 
     # ------------------------------------------------------------------ building
     def add_shape(self, shape: RigidShape) -> int:
@@ -129,8 +137,116 @@ class SolidSolver:
     def add_walls(self, walls) -> None:
         for wall in walls:
             self.material_index(wall.material)
+            self._refuse_wall_across_period(len(self.walls), wall)
             self.walls.append(wall)
         self._ready = False
+
+    def set_periodic(self, axis: int, lower: float, upper: float) -> None:
+        """Make direction ``axis`` (0: x, 1: y) periodic with period ``upper - lower`` (m): a
+        centre leaving the strip [lower, upper) comes back at its other end, and every pair of
+        bodies is seen by minimum image (``solid/kernels/periodic.py``). Walls across that
+        direction are refused (the strip needs none), and so is a period too short for a pair of
+        bodies to touch in one image only (checked again when the solver is built, when every
+        body and wall is known). Given before the run starts, as the other parts of the system;
+        a restart gives it again (it is configuration, the checkpoint holds the wrapped
+        positions)."""
+        if (isinstance(axis, (bool, np.bool_)) or not isinstance(axis, (int, np.integer))
+                or not 0 <= axis <= 2):
+            raise CaseFileError(f"periodic axis {axis!r} is out of range: give 0 (x) or 1 (y)")
+        if axis == 2:
+            raise CaseFileError("periodic axis 2 (z) refused: z is the vertical of riprap "
+                                "(gravity, the bed, the free surface); give 0 (x) or 1 (y)")
+        lower, upper = float(lower), float(upper)
+        name = _AXIS_NAMES[axis]
+        if not (math.isfinite(lower) and math.isfinite(upper)) or not lower < upper:
+            raise CaseFileError(f"periodic {name}: lower = {lower!r} m must be below upper = "
+                                f"{upper!r} m (both finite)")
+        if self._periodic is not None and self._periodic[0] != axis:
+            raise CaseFileError(f"periodic {name} asked while {_AXIS_NAMES[self._periodic[0]]} is "
+                                "periodic already: one periodic direction at a time")
+        before, self._periodic = self._periodic, (int(axis), lower, upper)
+        try:
+            self._check_periodic()
+        except CaseFileError:
+            self._periodic = before     # a refused strip leaves the solver as it was
+            raise
+        self._ready = False
+
+    @property
+    def periodic(self) -> tuple[int, float, float] | None:
+        """(axis, lower, upper) of the periodic direction, or None."""
+        return self._periodic
+
+    def _check_periodic(self) -> None:
+        """Refuse walls across the periodic direction and a period too short for the bodies."""
+        if self._periodic is None:
+            return
+        axis, lower, upper = self._periodic
+        name = _AXIS_NAMES[axis]
+        for w, wall in enumerate(self.walls):
+            self._refuse_wall_across_period(w, wall)
+        rows = self._body_rows
+        moving = [b for b, row in enumerate(rows) if not row[6]]
+        if not moving:
+            return      # pairs of fixed bodies are never evaluated
+        radius = [self.shapes[row[0]].bounding_radius for row in rows]
+        body = max(moving, key=lambda b: radius[b])
+        other = max(range(len(rows)), key=lambda b: radius[b])
+        if radius[other] <= radius[body]:
+            other = body
+        reach = radius[body] + radius[other]
+        length = upper - lower
+        if length >= 2.0 * reach:
+            return
+
+        def named(b):
+            shape = rows[b][0]
+            return (f"body {b} (shape {shape} '{self.shapes[shape].name}', "
+                    f"{'fixed' if rows[b][6] else 'moving'}, bounding radius "
+                    f"{radius[b]:.4g} m)")
+        if other == body:
+            what = (f"twice the bounding diameter {2.0 * radius[body]:.4g} m of {named(body)}, "
+                    "the largest moving body")
+        else:
+            what = (f"twice the reach {reach:.4g} m (the two bounding radii) of {named(body)}, the "
+                    f"largest moving body, and {named(other)}")
+        raise CaseFileError(
+            f"periodic {name}: the period {length:.4g} m (upper - lower) is shorter than {what}: "
+            f"a pair of bodies could touch through both ends of the strip. Make the strip at least "
+            f"{2.0 * reach:.4g} m wide.")
+
+    def _period_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per axis the strip's lower end (m) and its period (m; 0: not periodic), as the
+        kernels take them (``StepSettings``)."""
+        lower, period = np.zeros(3), np.zeros(3)
+        if self._periodic is not None:
+            axis, low, high = self._periodic
+            lower[axis], period[axis] = low, high - low
+        return lower, period
+
+    def _refuse_wall_across_period(self, index: int, wall: Wall) -> None:
+        """Refuse wall ``index`` when its normal has a component along the periodic direction:
+        the strip needs no walls there, and one across it would cut the periodic flow."""
+        if self._periodic is None:
+            return
+        axis, lower, upper = self._periodic
+        name = _AXIS_NAMES[axis]
+        if abs(wall.normal[axis]) > _WALL_ACROSS_PERIODIC:
+            raise CaseFileError(
+                f"wall {index} (point {wall.point}, normal {wall.normal}) faces along {name}, the "
+                f"periodic direction (period [{lower:.6g}, {upper:.6g}) m): a periodic "
+                f"direction needs no walls; leave out the walls across {name}")
+
+    def minimum_image(self, separations) -> np.ndarray:
+        """``separations`` (..., 3) m between two places, each shifted by the whole number of
+        periods that makes it shortest along the periodic direction (a copy; unchanged without
+        one)."""
+        d = np.array(separations, dtype=np.float64)
+        if self._periodic is not None:
+            axis, lower, upper = self._periodic
+            length = upper - lower
+            d[..., axis] -= length * np.floor(d[..., axis] / length + 0.5)
+        return d
 
     def add_body(self, *, shape: int, material: int | str, position, orientation=(1.0, 0.0, 0.0, 0.0),
                  velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0), fixed: bool = False,
@@ -278,6 +394,8 @@ class SolidSolver:
             self.angular_momenta[b] = r @ (self.principal_inertia[b] * (r.T @ omegas[b]))
         self.forces = np.zeros((n, 3))
         self.torques = np.zeros((n, 3))
+        self._check_periodic()
+        periodic.wrap_positions(self.positions, *self._period_arrays())
         self.table = ShapeTable.build(self.shapes)
         self._shapes = self.table.kernel_arrays()
         self.bounding_radius = self._shapes.lookup.bounding_radius
@@ -389,7 +507,7 @@ class SolidSolver:
         motion = Motion(self.positions, self.quaternions, self.velocities, self.angular_momenta,
                         self.forces, self.torques)
         settings = StepSettings(self.gravity, self.external_loads, self._margin, step,
-                                self.local_damping, self._skin)
+                                self.local_damping, self._skin, *self._period_arrays())
         return system, motion, History(self.history_keys, self.history_springs), settings
 
     def _compute_forces(self, step: float) -> None:
@@ -577,11 +695,27 @@ class SolidSolver:
         from scipy.spatial import cKDTree
 
         radius = self.bounding_radius[self.shape_index]
-        pairs = cKDTree(self.positions).query_pairs(_COINCIDENT_FRACTION * float(radius.max()),
-                                                    output_type="ndarray")
+        reach = _COINCIDENT_FRACTION * float(radius.max())
+        places, bodies = self.positions, np.arange(len(self.positions))
+        if self._periodic is not None:
+            # the centres within reach of either end also a period beyond the other, so that
+            # a pair across the boundary is found as one inside the strip
+            axis, lower, upper = self._periodic
+            low = np.flatnonzero(self.positions[:, axis] < lower + reach)
+            high = np.flatnonzero(self.positions[:, axis] >= upper - reach)
+            up, down = self.positions[low].copy(), self.positions[high].copy()
+            up[:, axis] += upper - lower
+            down[:, axis] -= upper - lower
+            places = np.concatenate([places, up, down])
+            bodies = np.concatenate([bodies, low, high])
+        pairs = cKDTree(places).query_pairs(reach, output_type="ndarray")
+        if self._periodic is not None and len(pairs):
+            pairs = np.unique(np.sort(bodies[pairs], axis=1), axis=0)
+            pairs = pairs[pairs[:, 0] != pairs[:, 1]]
         if len(pairs) == 0:
             return
-        gaps = np.linalg.norm(self.positions[pairs[:, 0]] - self.positions[pairs[:, 1]], axis=1)
+        gaps = np.linalg.norm(self.minimum_image(self.positions[pairs[:, 0]]
+                                                 - self.positions[pairs[:, 1]]), axis=1)
         close = gaps < _COINCIDENT_FRACTION * np.minimum(radius[pairs[:, 0]], radius[pairs[:, 1]])
         pairs = pairs[close]
         if len(pairs):

@@ -56,7 +56,8 @@ def _contact_rates(solver) -> np.ndarray:
     materials = solver.material_index_of_body
 
     def along_normal(bodies):
-        arm = np.cross(c.points - solver.positions[bodies], normals)
+        # by minimum image: across a periodic boundary the point lies beside body i only
+        arm = np.cross(solver.minimum_image(c.points - solver.positions[bodies]), normals)
         local = np.einsum("bji,bj->bi", rotations[bodies], arm)      # R^T (r x n)
         turn = np.sum(local ** 2 * solver.inverse_principal_inertia[bodies], axis=1)
         # a contact of zero force (just touching) has no normal: its lever arm at worst

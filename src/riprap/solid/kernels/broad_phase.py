@@ -3,11 +3,17 @@
 Sweep and prune along the axis with the largest spread of body centres. In a heap of bodies of
 similar size each body overlaps a bounded number of others along that axis, so the cost grows about
 linearly with the number of bodies (plus an N log N sort that is negligible at 1e4 bodies).
+
+A periodic axis (``periodic.py``) is never swept: the sorted order along it breaks at the strip's
+ends, where a pair across the boundary lies at the two ends of the list. The sweep takes the
+widest of the other axes, and the boxes and spheres are compared with body j in its image
+nearest body i.
 """
 import numpy as np
 
 from riprap._jit import kernel
 from riprap.solid.kernels.geometry_ops import rotation_matrix
+from riprap.solid.kernels.periodic import image_coordinate
 
 
 @kernel
@@ -33,18 +39,29 @@ def world_boxes(positions, quaternions, shape_index, local_box_min, local_box_ma
 
 
 @kernel
-def overlapping_pairs(lo, hi, fixed, positions, radii):
+def overlapping_pairs(lo, hi, fixed, positions, radii, period):
     """Pairs (i < j) whose boxes overlap and whose bounding spheres (centre ``positions``, radius
     ``radii`` including the margin) overlap, skipping pairs of two fixed bodies. (k, 2) int64.
+    ``period`` (3,): per axis the period (m) or 0; along a periodic axis body j's box and centre
+    are taken in its image nearest body i.
 
     The sphere test rejects about two thirds of the box overlaps of elongated rocks in a heap."""
     n = lo.shape[0]
     if n < 2:
         return np.zeros((0, 2), dtype=np.int64)
-    spread = np.zeros(3)
+    axis = -1
+    widest = -1.0
     for a in range(3):
-        spread[a] = np.var(lo[:, a] + hi[:, a])
-    axis = int(np.argmax(spread))
+        if period[a] > 0.0:
+            continue
+        spread = np.var(lo[:, a] + hi[:, a])
+        # the first of equal spreads, as argmax took it
+        if spread > widest:
+            widest = spread
+            axis = a
+    swept = axis >= 0
+    if not swept:
+        axis = 0        # every axis periodic: no sweep, every pair is tested
     order = np.argsort(lo[:, axis])
     capacity = 8 * n
     pairs = np.empty((capacity, 2), dtype=np.int64)
@@ -53,13 +70,17 @@ def overlapping_pairs(lo, hi, fixed, positions, radii):
         i = order[oi]
         for oj in range(oi + 1, n):
             j = order[oj]
-            if lo[j, axis] > hi[i, axis]:
+            if swept and lo[j, axis] > hi[i, axis]:
                 break
             if fixed[i] and fixed[j]:
                 continue
             overlap = True
             for a in range(3):
-                if lo[i, a] > hi[j, a] or lo[j, a] > hi[i, a]:
+                shift = 0.0
+                if period[a] > 0.0:
+                    shift = (image_coordinate(positions[i, a], positions[j, a], period[a])
+                             - positions[j, a])
+                if lo[i, a] > hi[j, a] + shift or lo[j, a] + shift > hi[i, a]:
                     overlap = False
                     break
             if not overlap:
@@ -67,7 +88,7 @@ def overlapping_pairs(lo, hi, fixed, positions, radii):
             reach = radii[i] + radii[j]
             d2 = 0.0
             for a in range(3):
-                d = positions[i, a] - positions[j, a]
+                d = positions[i, a] - image_coordinate(positions[i, a], positions[j, a], period[a])
                 d2 += d * d
             if d2 > reach * reach:
                 continue

@@ -65,9 +65,10 @@ History = namedtuple("History", ["keys", "springs"])
 
 #: Everything outside the bodies that a step needs: gravity (3,) m/s^2, the external loads (n, 6)
 #: held on each free body (force, torque; a fluid's), the broad-phase margin (m), the time step
-#: (s), the local damping factor and the piece lists' skin (m).
+#: (s), the local damping factor, the piece lists' skin (m), and the periodic directions: per
+#: axis the lower end of the strip (m) and its period (m; 0: not periodic) (``periodic.py``).
 StepSettings = namedtuple("StepSettings", ["gravity", "external_loads", "margin", "step",
-                                           "local_damping", "skin"])
+                                           "local_damping", "skin", "period_lower", "period"])
 
 #: The (triangle, tet) piece lists kept from the last step (``interactions.evaluate_candidates``):
 #: sorted pair keys (n,), the relative pose each list was made at (n, 12), its rows [start, split,

@@ -31,6 +31,7 @@ from riprap.solid.kernels.contact import (OUT_SIZE, collect_pair_pieces, make_sc
                                           pair_force_from_pieces, relative_pose,
                                           wall_potential_force)
 from riprap.solid.kernels.geometry_ops import rotation_matrix
+from riprap.solid.kernels.periodic import image_of
 
 # Below this many candidate pairs the evaluation stays on one thread.
 PARALLEL_MIN_CANDIDATES = 32
@@ -61,7 +62,7 @@ def evaluate_candidates(body_pairs, wall_pairs, system, motion, omegas, history,
     """Evaluate every candidate body-body and body-wall pair of ``system``
     (:class:`~riprap.solid.kernels.bundles.RigidSystem`) at ``motion`` (``Motion``) with angular
     velocities ``omegas``, the contacts' spring ``history`` (``History``) and the step's
-    ``settings`` (``StepSettings``: the time step and the skin are read).
+    ``settings`` (``StepSettings``: the time step, the skin and the periods are read).
 
     Returns (results (n_candidates, C_SIZE), the piece cache for the next step).
 
@@ -196,12 +197,16 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, system, motion, 
     positions, quaternions, velocities, _, _, _ = motion
     wall_points, wall_normals, wall_materials = walls
     pair_penalty = laws.penalty
-    _, _, _, step, _, skin = settings
+    _, _, _, step, _, skin, _, period = settings
     results, fresh, capacity, source, bounds, poses = outputs
     scratch = make_scratch(mesh.tets.shape[0])
     work = scratch.work
     key_stride = positions.shape[0] + wall_points.shape[0]
     out = np.zeros(OUT_SIZE)
+    # body j's centre in its image nearest body i (``periodic.py``): the pair's pose, contact
+    # point and both torques are taken from it, so a pair across a periodic boundary is the pair
+    # it would be inside the strip; without a periodic axis it is j's centre, to the bit
+    position_j = np.empty(3)
     n_body_pairs = body_pairs.shape[0]
     cache_keys, cache_poses, cache_bounds, cache_pieces = piece_cache
     buffer_start = batch * capacity
@@ -218,12 +223,13 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, system, motion, 
             shape_i = shape_index[i]
             shape_j = shape_index[j]
             penalty = pair_penalty[mi, mj]
-            rotation_1, translation_1, _, _ = relative_pose(positions[i], r_i, positions[j], r_j)
+            image_of(positions[i], positions[j], period, position_j)
+            rotation_1, translation_1, _, _ = relative_pose(positions[i], r_i, position_j, r_j)
             idx = np.searchsorted(cache_keys, key)
             if (skin > 0.0 and idx < cache_keys.shape[0] and cache_keys[idx] == key
                     and _within_skin(rotation_1, translation_1, cache_poses[idx],
                                      bounding_radius[shape_i], bounding_radius[shape_j], skin)):
-                pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, positions[j], r_j,
+                pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, position_j, r_j,
                                        penalty, mesh, work, cache_pieces, cache_bounds[idx, 0],
                                        cache_bounds[idx, 1], cache_bounds[idx, 2], out)
                 source[k] = SOURCE_OLD
@@ -234,9 +240,9 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, system, motion, 
             else:
                 pieces = scratch.pieces
                 split, end, overflow = collect_pair_pieces(shape_i, shape_j, positions[i], r_i,
-                                                           positions[j], r_j, skin, shapes,
+                                                           position_j, r_j, skin, shapes,
                                                            scratch, pieces, 0)
-                pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, positions[j], r_j,
+                pair_force_from_pieces(shape_i, shape_j, positions[i], r_i, position_j, r_j,
                                        penalty, mesh, work, pieces, 0, split, end, out)
                 if skin > 0.0 and overflow == 0.0 and used + end <= capacity:
                     row = buffer_start + used
@@ -267,8 +273,8 @@ def _evaluate_range(batch, first, last, body_pairs, wall_pairs, system, motion, 
             inv_j = 0.0
             overflow = out[13]
         results[k, C_OVERFLOW] = overflow
-        _contact_law(Candidate(k, i, j, key, inv_j, mi, mj), positions, velocities, omegas,
-                     inverse_masses, laws, history, step, out, results)
+        _contact_law(Candidate(k, i, j, key, inv_j, mi, mj), positions, position_j, velocities,
+                     omegas, inverse_masses, laws, history, step, out, results)
 
 
 @kernel
@@ -301,13 +307,15 @@ def _within_skin(rotation, translation, pose, radius_a, radius_b, skin):
 
 
 @kernel
-def _contact_law(candidate, positions, velocities, omegas, inverse_masses, laws, history, step,
-                 out, results):
+def _contact_law(candidate, positions, position_j, velocities, omegas, inverse_masses, laws,
+                 history, step, out, results):
     """Normal damping, tangential and twisting friction of ``candidate``
     (:class:`~riprap.solid.kernels.bundles.Candidate`) from its potential force ``out``, with the
     pair laws ``laws`` (``PairLaws``) and the springs of ``history`` (``History``); writes the
-    candidate's row of ``results``. Takes the few arrays it reads rather than the whole bundles:
-    it runs once per pair, and every array it is given costs a reference count each way."""
+    candidate's row of ``results``. ``position_j``: body j's centre in its image nearest body i
+    (the contact point lies in body i's image; not read for a wall). Takes the few arrays it
+    reads rather than the whole bundles: it runs once per pair, and every array it is given
+    costs a reference count each way."""
     k, i, j, key, inv_j, mi, mj = candidate
     pair_friction = laws.friction
     pair_damping_ratio = laws.damping_ratio
@@ -322,7 +330,7 @@ def _contact_law(candidate, positions, velocities, omegas, inverse_masses, laws,
     arm_i = point - positions[i]
     v_rel = velocities[i] + np.cross(omegas[i], arm_i)
     if j >= 0:
-        arm_j = point - positions[j]
+        arm_j = point - position_j
         v_rel = v_rel - (velocities[j] + np.cross(omegas[j], arm_j))
     v_n = v_rel[0] * normal[0] + v_rel[1] * normal[1] + v_rel[2] * normal[2]
     v_t = v_rel - v_n * normal
@@ -394,7 +402,7 @@ def _contact_law(candidate, positions, velocities, omegas, inverse_masses, laws,
     results[k, C_FORCE_I:C_FORCE_I + 3] = force_i
     results[k, C_TORQUE_I:C_TORQUE_I + 3] = torque_i
     if j >= 0:
-        results[k, C_TORQUE_J:C_TORQUE_J + 3] = (out[6:9] - np.cross(point - positions[j], extra)
+        results[k, C_TORQUE_J:C_TORQUE_J + 3] = (out[6:9] - np.cross(point - position_j, extra)
                                                  - twist_torque * normal)
     results[k, C_POINT:C_POINT + 3] = point
     results[k, C_NORMAL_FORCE:C_NORMAL_FORCE + 3] = normal_magnitude * normal

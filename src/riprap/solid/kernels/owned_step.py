@@ -11,7 +11,7 @@ order, bit for bit.
 import numpy as np
 
 from riprap._jit import kernel
-from riprap.solid.kernels import broad_phase, integrate
+from riprap.solid.kernels import broad_phase, integrate, periodic
 
 
 @kernel
@@ -29,14 +29,16 @@ def owners_of(positions, cuts):
 
 @kernel
 def first_half(system, motion, omegas, settings):
-    """Half kick and drift of every body (the forces of the last evaluation, joined)."""
+    """Half kick and drift of every body (the forces of the last evaluation, joined), the centres
+    brought back into the periodic strip as one process does."""
     positions, quaternions, velocities, angular_momenta, forces, torques = motion
     _, inverse_masses, inverse_principal_inertia, _, _, _ = system.bodies
-    _, _, _, step, local_damping, _ = settings
+    _, _, _, step, local_damping, _, period_lower, period = settings
     integrate.kick(velocities, angular_momenta, omegas, forces, torques, inverse_masses,
                    0.5 * step, local_damping)
     integrate.drift(positions, quaternions, velocities, angular_momenta, inverse_masses,
                     inverse_principal_inertia, step)
+    periodic.wrap_positions(positions, period_lower, period)
 
 
 @kernel
@@ -48,14 +50,17 @@ def local_candidates(system, motion, settings, owners, rank, lower, upper):
 
     Only the bodies whose centre lies within twice the largest reach (bounding radius and margin)
     of the slab can pair with one of its bodies (the broad phase keeps a pair only when the
-    bounding spheres overlap), so only they are boxed and swept. Each pair is tested on exactly
+    bounding spheres overlap), so only they are boxed and swept; with x periodic, also through
+    the strip's ends (a y period needs nothing more: the slabs are cut in x, and the pairs
+    are taken by minimum image as on one process). Each pair is tested on exactly
     the numbers one process tests it on, so the pairs kept are one process's."""
     positions, quaternions, _, angular_momenta, _, _ = motion
     _, _, inverse_principal_inertia, fixed, shape_index, _ = system.bodies
     lookup = system.shapes.lookup
     bounding_radius = lookup.bounding_radius
     wall_points, wall_normals, _ = system.walls
-    margin = settings[2]
+    margin = settings.margin
+    period = settings.period
     n = positions.shape[0]
     reach = 0.0
     for s in range(bounding_radius.shape[0]):
@@ -65,8 +70,7 @@ def local_candidates(system, motion, settings, owners, rank, lower, upper):
     near = np.empty(n, dtype=np.int64)
     n_near = 0
     for b in range(n):
-        x = positions[b, 0]
-        if x >= lower - reach and x <= upper + reach:
+        if _near_slab(positions[b, 0], lower, upper, reach, period[0]):
             near[n_near] = b
             n_near += 1
     near = near[:n_near]
@@ -84,7 +88,7 @@ def local_candidates(system, motion, settings, owners, rank, lower, upper):
         radii[k] = bounding_radius[shape_index[b]] + margin
     lo, hi = broad_phase.world_boxes(near_positions, near_quaternions, near_shapes,
                                      lookup.local_box_min, lookup.local_box_max, margin)
-    found = broad_phase.overlapping_pairs(lo, hi, near_fixed, near_positions, radii)
+    found = broad_phase.overlapping_pairs(lo, hi, near_fixed, near_positions, radii, period)
     kept = np.empty((found.shape[0], 2), dtype=np.int64)
     count = 0
     for k in range(found.shape[0]):
@@ -112,12 +116,26 @@ def local_candidates(system, motion, settings, owners, rank, lower, upper):
 
 
 @kernel
+def _near_slab(x, lower, upper, reach, period):
+    """Whether a centre at ``x`` lies within ``reach`` of the slab [``lower``, ``upper``), also
+    through the strip's ends when x is periodic (``period`` > 0): the slab at one end pairs with
+    the bodies at the other."""
+    if x >= lower - reach and x <= upper + reach:
+        return True
+    if period > 0.0:
+        for image in (x - period, x + period):
+            if image >= lower - reach and image <= upper + reach:
+                return True
+    return False
+
+
+@kernel
 def second_half(system, motion, omegas, settings, joined_forces, joined_torques):
     """Every body's joined forces into ``motion``, the second half kick of every body. Returns
     whether every body's state is finite."""
     positions, _, velocities, angular_momenta, forces, torques = motion
     _, inverse_masses, _, _, _, _ = system.bodies
-    _, _, _, step, local_damping, _ = settings
+    _, _, _, step, local_damping, _, _, _ = settings
     forces[:] = joined_forces
     torques[:] = joined_torques
     integrate.kick(velocities, angular_momenta, omegas, forces, torques, inverse_masses,

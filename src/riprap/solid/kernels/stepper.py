@@ -3,7 +3,7 @@ per kernel. The solver (``solid/solver.py``) checks the returned status and rais
 import numpy as np
 
 from riprap._jit import kernel
-from riprap.solid.kernels import broad_phase, integrate, interactions
+from riprap.solid.kernels import broad_phase, integrate, interactions, periodic
 from riprap.solid.kernels.bundles import History
 
 STATUS_OK = 0
@@ -20,7 +20,7 @@ def candidate_pairs(system, motion, settings):
     lookup = system.shapes.lookup
     bounding_radius = lookup.bounding_radius
     wall_points, wall_normals, _ = system.walls
-    margin = settings[2]
+    margin = settings.margin
     n = positions.shape[0]
     lo, hi = broad_phase.world_boxes(positions, quaternions, shape_index, lookup.local_box_min,
                                      lookup.local_box_max, margin)
@@ -28,7 +28,7 @@ def candidate_pairs(system, motion, settings):
     for b in range(n):
         radii[b] = bounding_radius[shape_index[b]] + margin
     body_pairs = broad_phase.in_key_order(broad_phase.overlapping_pairs(lo, hi, fixed, positions,
-                                                                        radii))
+                                                                        radii, settings.period))
     wall_pairs = broad_phase.near_wall_pairs(positions, shape_index, bounding_radius, fixed,
                                              wall_points, wall_normals, margin)
     omegas = integrate.angular_velocities(quaternions, angular_momenta, inverse_principal_inertia)
@@ -42,7 +42,7 @@ def forces_of_contacts(system, motion, settings, body_pairs, wall_pairs, results
     pairs' order. Returns (the contacts' springs as a ``History``, whether a buffer overflowed)."""
     _, _, _, _, forces, torques = motion
     masses, _, _, fixed, _, _ = system.bodies
-    gravity, external_loads, _, _, _, _ = settings
+    gravity, external_loads, _, _, _, _, _, _ = settings
     n = forces.shape[0]
     overflow = False
     for b in range(n):
@@ -100,7 +100,7 @@ def advance(n_steps, system, motion, omegas, history, settings, piece_cache):
     omegas, piece_cache) of the last force evaluation."""
     positions, quaternions, velocities, angular_momenta, forces, torques = motion
     _, inverse_masses, inverse_principal_inertia, _, _, _ = system.bodies
-    _, _, _, step, local_damping, _ = settings
+    _, _, _, step, local_damping, _, period_lower, period = settings
     results = np.zeros((0, interactions.C_SIZE))
     body_pairs = np.zeros((0, 2), dtype=np.int64)
     wall_pairs = np.zeros((0, 2), dtype=np.int64)
@@ -109,6 +109,7 @@ def advance(n_steps, system, motion, omegas, history, settings, piece_cache):
                        0.5 * step, local_damping)
         integrate.drift(positions, quaternions, velocities, angular_momenta, inverse_masses,
                         inverse_principal_inertia, step)
+        periodic.wrap_positions(positions, period_lower, period)
         history, results, body_pairs, wall_pairs, omegas, overflow, piece_cache = compute_forces(
             system, motion, history, settings, piece_cache)
         integrate.kick(velocities, angular_momenta, omegas, forces, torques, inverse_masses,
