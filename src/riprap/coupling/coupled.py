@@ -32,7 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from riprap.coupling.kernels import rigid_coupling
-from riprap.coupling.solid_volumes import merge_blocks, rigid_body_half_cell_volumes
+from riprap.coupling.solid_volumes import (add_block, merge_blocks, rigid_body_half_cell_volumes,
+                                           widened_strip)
 from riprap.errors import CaseFileError, InstabilityError
 from riprap.fluid.kernels.face_speeds import limit_listed_faces, listed_pore_speed
 from riprap.fluid.solver import FluidSolver
@@ -125,11 +126,14 @@ def check_substeps(substeps: int, fluid_step: float, contact_step: float) -> Non
 
 
 def fluid_box_walls(grid, material: str) -> list:
-    """The sides of the fluid box as walls for the bodies (an open top is not a wall)."""
+    """The sides of the fluid box as walls for the bodies (an open top is not a wall, nor are a
+    periodic strip's y sides)."""
     walls = []
     for axis in range(3):
         for side, (point, sign) in enumerate(((grid.lower, 1.0), (grid.upper, -1.0))):
             if axis == 2 and side == 1 and grid.open_top:
+                continue
+            if axis == 1 and grid.periodic_y:
                 continue
             normal = [0.0, 0.0, 0.0]
             normal[axis] = sign
@@ -217,6 +221,18 @@ class CoupledSolver:
         #: Momentum after the last exchange less before less the walls' pressure impulse (N s),
         #: with ``check_momentum``; None otherwise.
         self.last_exchange_balance = None
+        if fluid.periodic_y:
+            # the bodies live on the fluid's strip: they wrap and meet across its sides too
+            strip = fluid.grid.whole_grid
+            if solids.periodic is None:
+                solids.set_periodic(1, strip.lower[1], strip.upper[1])
+            elif solids.periodic != (1, strip.lower[1], strip.upper[1]):
+                raise CaseFileError(f"coupling: the bodies are periodic as {solids.periodic}, the "
+                                    f"fluid's strip is y {strip.lower[1]:g} .. "
+                                    f"{strip.upper[1]:g} m")
+        elif solids.periodic is not None:
+            raise CaseFileError(f"coupling: the bodies are periodic ({solids.periodic}) in a fluid "
+                                "box with walls: make the fluid's y sides periodic too")
         if wall_material is not None:
             # A side that is already a wall (a pack's flume walls, its bed) is not added twice:
             # two coincident walls would push twice.
@@ -240,6 +256,12 @@ class CoupledSolver:
         grid = fluid.grid
         self._lower = np.asarray(grid.lower, dtype=np.float64)
         self._cells = np.asarray(grid.cells, dtype=np.int64)
+        #: the strip's period along each axis (m; 0: not periodic): the arms of the bodies' faces
+        #: are taken to the image nearest each body (``rigid_coupling.BodyFaces``)
+        self._period = np.zeros(3)
+        if fluid.periodic_y:
+            whole = grid.whole_grid
+            self._period[1] = whole.upper[1] - whole.lower[1]
         self._densities = self._body_densities()
         self._blocks = None
         self._block_poses = None
@@ -446,9 +468,18 @@ class CoupledSolver:
         return self._clip_on(self.fluid.grid, stale)
 
     def _clip_on(self, grid, stale) -> list:
-        """``_clip`` on the cells of ``grid``."""
-        return rigid_body_half_cell_volumes(grid, self.solids, bodies=stale,
-                                            poses=self._block_poses[stale])
+        """``_clip`` on the cells of ``grid``. On a periodic y the bodies are clipped on the grid
+        widened by a body's reach on either side, so that a body across the boundary keeps all
+        of itself: its block's y cells then run past 0 or ny, and its users take them modulo ny
+        (the strip's other side: both images of the body)."""
+        if not grid.periodic_y:
+            return rigid_body_half_cell_volumes(grid, self.solids, bodies=stale,
+                                                poses=self._block_poses[stale])
+        widened, margin = widened_strip(grid, self.solids)
+        blocks = rigid_body_half_cell_volumes(widened, self.solids, bodies=stale,
+                                              poses=self._block_poses[stale])
+        return [(origin - np.array([0, margin, 0]), volumes, halves)
+                for origin, volumes, halves in blocks]
 
     def _cell_list(self, block):
         """(flat grid index of every cell of a body's block that holds solid and is not an
@@ -459,6 +490,8 @@ class CoupledSolver:
         if not len(local):
             return np.zeros(0, dtype=np.int64), np.zeros((0, 6))
         p, q, r = np.unravel_index(local, volumes.shape)
+        if self.fluid.periodic_y:
+            q = (q + j) % int(self._cells[1]) - j        # the strip's other side
         flat = np.ravel_multi_index((p + i, q + j, r + k), tuple(int(n) for n in self._cells))
         keep = ~self.fluid.solid.reshape(-1)[flat]
         return flat[keep], halves.reshape(-1, 6)[local[keep]]
@@ -481,11 +514,13 @@ class CoupledSolver:
         cells = tuple(int(n) for n in self._cells)
         filled = np.zeros(cells)
         for body in fixed:
-            (i, j, k), block = volumes.block(body)
-            bi, bj, bk = block.shape
-            filled[i:i + bi, j:j + bj, k:k + bk] += block
+            add_block(filled, *volumes.block(body), self.fluid.periodic_y)
         full = filled >= (1.0 - _FULL_SLACK) * self.fluid.h ** 3
-        deep = binary_erosion(full, structure=_FACE_NEIGHBOURS, border_value=1)
+        if self.fluid.periodic_y:     # the strip's sides are each other's neighbours
+            padded = np.pad(full, ((0, 0), (1, 1), (0, 0)), mode="wrap")
+            deep = binary_erosion(padded, structure=_FACE_NEIGHBOURS, border_value=1)[:, 1:-1]
+        else:
+            deep = binary_erosion(full, structure=_FACE_NEIGHBOURS, border_value=1)
         if deep.any():
             self.fluid.add_obstacle_mask(deep | self.fluid.solid)
             self._shut_faces_of(fixed, volumes, deep)
@@ -501,6 +536,7 @@ class CoupledSolver:
         axis, index, values = self._carried
         carriers = (self.fluid.u.copy(), self.fluid.v.copy(), self.fluid.w.copy())
         rigid_coupling.scatter(axis, index, values, *carriers)
+        self.fluid.copy_periodic_faces(carriers[1])
         return carriers
 
     def _shut_faces_of(self, fixed, volumes, deep) -> None:
@@ -521,6 +557,9 @@ class CoupledSolver:
                     cell = where + (i, j, k)
                     other = cell.copy()
                     other[:, axis] += 1 if side else -1
+                    if self.fluid.periodic_y:
+                        cell[:, 1] %= cells[1]
+                        other[:, 1] %= cells[1]
                     inside = (other[:, axis] >= 0) & (other[:, axis] < cells[axis])
                     cell, other, where = cell[inside], other[inside], where[inside]
                     across = deep[tuple(cell.T)] != deep[tuple(other.T)]
@@ -545,7 +584,10 @@ class CoupledSolver:
         centre[np.arange(len(centre)), axis] -= 0.5 * self.fluid.h
         vectors = np.zeros((len(force), 3))
         vectors[np.arange(len(force)), axis] = force
-        moments = np.cross(centre - self.solids.positions[body], vectors)
+        arms = centre - self.solids.positions[body]
+        if self._period[1] > 0.0:        # to the face's image nearest the body
+            arms[:, 1] -= self._period[1] * np.floor(arms[:, 1] / self._period[1] + 0.5)
+        moments = np.cross(arms, vectors)
         loads = np.zeros((self.solids.n_bodies, 6))
         for a in range(3):
             loads[:, a] = np.bincount(body, vectors[:, a], minlength=len(loads))
@@ -567,6 +609,8 @@ class CoupledSolver:
             nodes = (table.nodes[table.node_offset[s]:table.node_offset[s + 1]] @ rotations[b].T
                      + solids.positions[b])
             low, high = nodes.min(axis=0), nodes.max(axis=0)
+            if grid.periodic_y:       # across the strip's sides is inside it
+                low[1], high[1] = lower[1], upper[1]
             if np.any(low < lower - 1e-12) or np.any(high > upper + 1e-12):
                 raise CaseFileError(
                     f"coupling: body {b} reaches {low.round(4).tolist()} .. {high.round(4).tolist()} m, "
@@ -608,7 +652,8 @@ class CoupledSolver:
         (axis, index, phi, interior, entry_start, entry_face,
          entry_half) = rigid_coupling.touched_faces(cell_start, cell_index, cell_halves,
                                                     self.fluid.h ** 3, self._cells,
-                                                    self._slots, self.fluid.solid.reshape(-1))
+                                                    self._slots, self.fluid.solid.reshape(-1),
+                                                    self.fluid.periodic_y)
         self._faces = _FaceSet(axis=axis, index=index, phi=phi, capped=np.minimum(phi, 1.0),
                                interior=interior, entries=(entry_start, entry_face, entry_half))
         return self._faces
@@ -711,6 +756,7 @@ class CoupledSolver:
         # n / (1 + c) / (1 + dt K); a body's share is not.
         inverse_mixture = fluid_share * inverse_fluid * porous + inverse_solid
         faces.scatter(blended, (u, v, w))
+        fluid.copy_periodic_faces(v)
         # The fluid's pressure densities of this step are not read again (the fluid's share was
         # gathered above): the touched faces take the shares' in place. (The fluid's face
         # coefficients scale porous faces by the zone's factor once more.)
@@ -777,6 +823,7 @@ class CoupledSolver:
                                             self._ones(faces), rigid)
             after = fluid_share * fluid_after + rigid
         faces.scatter(after, (u, v, w))
+        fluid.copy_periodic_faces(v)
         # The projected field is divergence free; the water and the mass of the next step move
         # with it (FluidSolver.predict's advecting), not with the rigid motion written above.
         self._carried = (faces.axis.copy(), faces.index.copy(), projected.copy())
@@ -842,7 +889,7 @@ class CoupledSolver:
                                              vectors)
         pattern = faces.empty()
         rigid_coupling.moving_pattern(faces.axis, faces.index, vectors, fluid.u, fluid.v, fluid.w,
-                                      fluid.h, dt, pattern)
+                                      fluid.h, dt, pattern, fluid.periodic_y)
         # (a face the bodies fill has no fluid share to take it: left as it is; nor one they
         # all but fill, whose share would take the bodies' change over the round-off of phi)
         open_share = 1.0 - faces.capped
@@ -910,14 +957,14 @@ class CoupledSolver:
         bodies_on_face = np.bincount(pairs // len(entry_start), minlength=len(faces.axis))
         area, distance = faces.empty(), faces.empty()
         rigid_coupling.wall_geometry(faces.axis, faces.index, faces.phi, bodies_on_face, *dense,
-                                     area, distance)
+                                     area, distance, fluid.periodic_y)
         self._wall = (faces, (area, distance))
         return area, distance
 
     def _body_faces(self, faces) -> rigid_coupling.BodyFaces:
         """The face set as the coupling kernels take it."""
         return rigid_coupling.BodyFaces(*faces.entries, faces.axis, faces.index, self._lower,
-                                        self.fluid.h)
+                                        self.fluid.h, self._period)
 
     # The hooks of a coupling over several processes (riprap.coupling.slab_coupled): which faces
     # each body's sums run over, and how the sums of all processes are added.

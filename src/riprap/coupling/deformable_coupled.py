@@ -406,6 +406,10 @@ class DeformableCoupledSolver(CoupledSolver):
         if getattr(fluid, "obstacle_boxes", None):
             raise CaseFileError("deformable bodies in a flow with [[fluid.obstacles]] are not "
                                 "available yet: give the obstacles as walls or leave them out")
+        if fluid.periodic_y:
+            raise CaseFileError("deformable bodies on a periodic strip (y_low = y_high = "
+                                "\"periodic\") are not available yet: their nodes do not wrap; "
+                                "give the fluid's y sides as walls")
         super().__init__(fluid, bodies, wall_material=None, check_momentum=check_momentum,
                          cut_faces="mixture")   # (the own velocity is for rigid bodies only)
         #: Deformable steps in the last fluid step.

@@ -155,7 +155,7 @@ class SlabCoupledSolver(CoupledSolver):
     def _summed_faces(self, faces) -> rigid_coupling.BodyFaces:
         _, _, entries = self._summed_entries(faces)
         return rigid_coupling.BodyFaces(*entries, faces.axis, faces.index, self._lower,
-                                        self.fluid.h)
+                                        self.fluid.h, self._period)
 
     def _summed_face_mask(self, faces) -> np.ndarray:
         return self._summed_entries(faces)[1]

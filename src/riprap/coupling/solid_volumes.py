@@ -25,7 +25,8 @@ from riprap.fluid.grid import FluidGrid
 from riprap.solid.kernels.geometry_ops import rotation_matrix
 
 __all__ = ["BodyCellVolumes", "body_cell_volumes", "surface_cell_volumes", "rigid_body_cell_volumes",
-           "rigid_body_half_cell_volumes", "half_cell_volumes", "merge_blocks"]
+           "rigid_body_half_cell_volumes", "half_cell_volumes", "merge_blocks", "add_block",
+           "widened_strip"]
 
 
 @dataclass(frozen=True)
@@ -63,15 +64,40 @@ class BodyCellVolumes:
         """Solid volume in every cell (nx, ny, nz), all bodies together (m^3)."""
         total = np.zeros(tuple(self.grid.cells))
         for body in range(self.n_bodies):
-            (i, j, k), volumes = self.block(body)
-            bi, bj, bk = volumes.shape
-            total[i:i + bi, j:j + bj, k:k + bk] += volumes
+            add_block(total, *self.block(body), self.grid.periodic_y)
         return total
 
     def solid_fraction(self) -> np.ndarray:
         """Share of every cell's volume taken by solid, 0..1 (bodies pressed into each other by
         contact can overlap by a little; the share is capped at 1)."""
         return np.minimum(self.solid_volume() / self.grid.cell_size ** 3, 1.0)
+
+
+def add_block(target, origin, block, periodic_y: bool = False) -> None:
+    """``target`` (the grid's cells) += a body's ``block`` of cells from ``origin``; on a
+    periodic y the block's cells past 0 or ny are the strip's other side (a block is never
+    wider than the strip, so no cell is met twice)."""
+    i, j, k = (int(n) for n in origin)
+    bi, bj, bk = block.shape
+    if periodic_y and (j < 0 or j + bj > target.shape[1]):
+        target[i:i + bi, (j + np.arange(bj)) % target.shape[1], k:k + bk] += block
+    else:
+        target[i:i + bi, j:j + bj, k:k + bk] += block
+
+
+def widened_strip(grid: FluidGrid, solids) -> tuple[FluidGrid, int]:
+    """A periodic strip's grid widened in y by the bodies' reach on either side (cells), and that
+    reach: clipped on it, a body across the strip's side keeps all its cells (``add_block``
+    folds them back). Its cells lie where the strip's do, to round-off."""
+    h = grid.cell_size
+    solids.finalize()
+    reach = float(solids.bounding_radius[solids.shape_index].max(initial=0.0))
+    margin = int(np.ceil(reach / h)) + 2
+    lower, upper = list(grid.lower), list(grid.upper)
+    lower[1] -= margin * h
+    upper[1] += margin * h
+    cells = (grid.cells[0], grid.cells[1] + 2 * margin, grid.cells[2])
+    return FluidGrid(lower=tuple(lower), upper=tuple(upper), cells=cells), margin
 
 
 def _checked_cells(nodes, cells, cell_start, corners: int, what: str):

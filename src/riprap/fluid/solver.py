@@ -651,6 +651,12 @@ class FluidSolver:
                 np.ascontiguousarray(out[1][:, pad:pad + ny + 1]),
                 np.ascontiguousarray(out[2][:, pad:pad + ny])]
 
+    def copy_periodic_faces(self, v) -> None:
+        """On a periodic y: face ny of ``v`` (a y-face array) = face 0, the same face, after a
+        caller wrote face 0 (the coupling's face set holds face 0 only); nothing otherwise."""
+        if self.periodic_y:
+            v[:, -1] = v[:, 0]
+
     def _zero_solid_faces(self, u, v, w) -> None:
         if not self.solid.any():
             return

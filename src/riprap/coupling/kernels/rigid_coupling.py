@@ -19,6 +19,11 @@ Body entries are interior faces only: wall faces keep their boundary velocity.
 Face set arrays: ``face_axis`` (F,), ``face_index`` (F, 3) the face's index in its axis's face
 array, ``entry_start`` (bodies + 1,), ``entry_face`` (E,) slots into the face set, ``entry_half``
 (E,) the half cell fraction a body's cell gives that face (once per cell and face).
+
+A periodic y (``periodic_y``; ``period`` (3,) of ``BodyFaces``, 0 along an axis that is not
+periodic): the y face ny is face 0 (the set holds face 0 only; the caller copies it to face ny
+after writing), cells ny - 1 and 0 are neighbours, and a face's arm from a body's centre is taken
+to the face's image nearest the body (a body straddling the boundary has faces at both sides).
 """
 from collections import namedtuple
 
@@ -50,22 +55,27 @@ def face_count(cells) -> int:
 
 
 @kernel
-def _solid_cell(solid, i, j, k, cells):
-    """Whether cell (i, j, k) is an obstacle cell of the fluid (outside the grid is not)."""
+def _solid_cell(solid, i, j, k, cells, periodic_y):
+    """Whether cell (i, j, k) is an obstacle cell of the fluid (outside the grid is not; on a
+    ``periodic_y`` the cells beyond y are the strip's other side)."""
+    if periodic_y:
+        j = (j + cells[1]) % cells[1]
     if i < 0 or j < 0 or k < 0 or i >= cells[0] or j >= cells[1] or k >= cells[2]:
         return False
     return solid[(i * cells[1] + j) * cells[2] + k]
 
 
 @kernel
-def _shut(solid, axis, i, j, k, cells):
+def _shut(solid, axis, i, j, k, cells, periodic_y):
     """Whether face (axis, i, j, k) has an obstacle cell on either side (the fluid holds it shut)."""
-    return (_solid_cell(solid, i, j, k, cells)
-            or _solid_cell(solid, i - (axis == 0), j - (axis == 1), k - (axis == 2), cells))
+    return (_solid_cell(solid, i, j, k, cells, periodic_y)
+            or _solid_cell(solid, i - (axis == 0), j - (axis == 1), k - (axis == 2), cells,
+                           periodic_y))
 
 
 @kernel
-def touched_faces(cell_start, cell_index, cell_halves, cell_volume, cells, slots, solid):
+def touched_faces(cell_start, cell_index, cell_halves, cell_volume, cells, slots, solid,
+                  periodic_y=False):
     """The faces that any body's cells touch, and per body its entries.
 
     Per body b its cells holding solid: ``cell_index[cell_start[b]:cell_start[b + 1]]`` (flat
@@ -102,7 +112,7 @@ def touched_faces(cell_start, cell_index, cell_halves, cell_volume, cells, slots
             ci = flat // plane
             cj = (flat // cells[2]) % cells[1]
             ck = flat % cells[2]
-            if _solid_cell(solid, ci, cj, ck, cells):
+            if _solid_cell(solid, ci, cj, ck, cells, periodic_y):
                 continue
             for axis in range(3):
                 for side in range(2):
@@ -112,7 +122,9 @@ def touched_faces(cell_start, cell_index, cell_halves, cell_volume, cells, slots
                     i = ci + (side if axis == 0 else 0)
                     j = cj + (side if axis == 1 else 0)
                     k = ck + (side if axis == 2 else 0)
-                    if _shut(solid, axis, i, j, k, cells):
+                    if periodic_y and axis == 1 and j == cells[1]:
+                        j = 0                   # the strip's face ny is its face 0
+                    if _shut(solid, axis, i, j, k, cells, periodic_y):
                         continue
                     key = _face_key(axis, i, j, k, cells)
                     slot = slots[key]
@@ -125,7 +137,8 @@ def touched_faces(cell_start, cell_index, cell_halves, cell_volume, cells, slots
                         face_index[slot, 2] = k
                         face_key[slot] = key
                         along = i if axis == 0 else (j if axis == 1 else k)
-                        interior[slot] = 0 < along < cells[axis]
+                        interior[slot] = (0 < along < cells[axis]
+                                          or (periodic_y and axis == 1))
                         n_faces += 1
                     phi[slot] += half
                     if interior[slot]:
@@ -206,11 +219,31 @@ def face_pressure_force(face_axis, face_index, interior, pressure, h, out):
 
 
 @kernel
-def _face_jacobian(axis, index, lower, h, centre, jac):
+def nearest_image(offset, period):
+    """``offset`` (m) shifted by whole periods to lie within half a period of 0 (unchanged where
+    ``period`` is 0: not periodic)."""
+    if period > 0.0:
+        return offset - period * np.floor(offset / period + 0.5)
+    return offset
+
+
+@kernel
+def _face_arm(axis, index, lower, h, centre, period):
+    """rho (3 numbers, m) from ``centre`` to face (axis, index), to its image nearest the centre
+    along a periodic axis."""
+    rho_x = nearest_image(lower[0] + (index[0] + (0.0 if axis == 0 else 0.5)) * h - centre[0],
+                          period[0])
+    rho_y = nearest_image(lower[1] + (index[1] + (0.0 if axis == 1 else 0.5)) * h - centre[1],
+                          period[1])
+    rho_z = nearest_image(lower[2] + (index[2] + (0.0 if axis == 2 else 0.5)) * h - centre[2],
+                          period[2])
+    return rho_x, rho_y, rho_z
+
+
+@kernel
+def _face_jacobian(axis, index, lower, h, centre, jac, period):
     """J = [e_a, rho x e_a] (6,) of the face (axis, index) for a body centred at ``centre``."""
-    rho_x = lower[0] + (index[0] + (0.0 if axis == 0 else 0.5)) * h - centre[0]
-    rho_y = lower[1] + (index[1] + (0.0 if axis == 1 else 0.5)) * h - centre[1]
-    rho_z = lower[2] + (index[2] + (0.0 if axis == 2 else 0.5)) * h - centre[2]
+    rho_x, rho_y, rho_z = _face_arm(axis, index, lower, h, centre, period)
     for m in range(6):
         jac[m] = 0.0
     jac[axis] = 1.0
@@ -227,9 +260,10 @@ def _face_jacobian(axis, index, lower, h, centre, jac):
 
 #: The faces the bodies' cells touch: per body its entries (``entry_start`` (bodies + 1,) into
 #: ``entry_face`` (E,), the face of each entry, and ``entry_half`` (E,), the body's share of it),
-#: each face's axis and (i, j, k) index, and the grid's lower corner (m) and cell size ``h`` (m).
+#: each face's axis and (i, j, k) index, the grid's lower corner (m) and cell size ``h`` (m), and
+#: its ``period`` (3,) m along each axis (0: not periodic).
 BodyFaces = namedtuple("BodyFaces", ["entry_start", "entry_face", "entry_half", "face_axis",
-                                     "face_index", "lower", "h"])
+                                     "face_index", "lower", "h", "period"])
 
 
 @kernel
@@ -239,7 +273,7 @@ def accumulate_rigid(faces, centres, motions, phi, weights, out):
     rigid part of a blended velocity; with the faces' grip (``cut_face_grip``) the part of the
     fluid's share that moves with the bodies after the step. A body at rest (x_b = 0: a fixed one
     after the projection) adds nothing and is skipped."""
-    entry_start, entry_face, entry_half, face_axis, face_index, lower, h = faces
+    entry_start, entry_face, entry_half, face_axis, face_index, lower, h, period = faces
     jac = np.empty(6)
     for b in range(entry_start.shape[0] - 1):
         moving = False
@@ -251,7 +285,7 @@ def accumulate_rigid(faces, centres, motions, phi, weights, out):
         for e in range(entry_start[b], entry_start[b + 1]):
             f = entry_face[e]
             share = entry_half[e] / max(1.0, phi[f])
-            _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac)
+            _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac, period)
             value = 0.0
             for m in range(6):
                 value += jac[m] * motions[b, m]
@@ -276,7 +310,7 @@ def own_momentum_rhs(faces, centres, motions, densities, phi, fluid_density, pre
     ``rhs`` (bodies, 6); only bodies with ``chosen[b]``, the others left 0. ``faces``:
     :class:`BodyFaces`, taken apart here, outside the parallel loop.
     """
-    entry_start, entry_face, entry_half, face_axis, face_index, lower, h = faces
+    entry_start, entry_face, entry_half, face_axis, face_index, lower, h, period = faces
     volume = h * h * h
     for b in prange(entry_start.shape[0] - 1):
         jac = np.empty(6)
@@ -289,7 +323,7 @@ def own_momentum_rhs(faces, centres, motions, densities, phi, fluid_density, pre
             share = entry_half[e] / max(1.0, phi[f])
             capped = min(phi[f], 1.0)
             own = fluid_density[f] if densities[b] < 0.0 else densities[b]
-            _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac)
+            _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac, period)
             rigid = 0.0
             for m in range(6):
                 rigid += jac[m] * motions[b, m]
@@ -336,7 +370,7 @@ def momentum_systems(faces, centres, densities, phi, grip, fluid_density, veloci
  ``faces``: :class:`BodyFaces`, taken apart
     here, outside the parallel loop.
     """
-    entry_start, entry_face, entry_half, face_axis, face_index, lower, h = faces
+    entry_start, entry_face, entry_half, face_axis, face_index, lower, h, period = faces
     volume = h * h * h
     n_rhs = velocities.shape[0]
     for b in prange(entry_start.shape[0] - 1):
@@ -360,7 +394,7 @@ def momentum_systems(faces, centres, densities, phi, grip, fluid_density, veloci
             own = rho_f if densities[b] < 0.0 else densities[b]
             weight = share * ((1.0 - capped) * rho_f * grip[f] + own) * volume
             own_weight = share * own * volume
-            _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac)
+            _face_jacobian(face_axis[f], face_index[f], lower, h, centres[b], jac, period)
             for r in range(n_rhs):
                 source = weight * velocities[r, f] - unaccounted[r, f] * volume * share / capped
                 for m in range(6):
@@ -445,13 +479,15 @@ def _cube_cut(m0, m1, m2, level, power):
 
 
 @parallel_kernel
-def wall_geometry(face_axis, face_index, phi, bodies_on_face, on_x, on_y, on_z, area, distance):
+def wall_geometry(face_axis, face_index, phi, bodies_on_face, on_x, on_y, on_z, area, distance,
+                  periodic_y=False):
     """The wall inside each cut face's control volume as a plane (PLIC): its area (in h^2) and
     the mean distance of the face's fluid from it (in h), from the face's solid fraction and
     the normal of its neighbours' fractions along the three axes (central differences of the
     same axis's face array, ``on_x``.. holding phi on the set's faces and 0 elsewhere). A face
     that no single plane describes, with two bodies or more (a film between them), or no
-    gradient, gets area -1: ``cut_face_grip`` treats it as a film across the whole face."""
+    gradient, gets area -1: ``cut_face_grip`` treats it as a film across the whole face. On a
+    ``periodic_y`` the neighbours along y wrap around the strip."""
     for f in prange(face_axis.shape[0]):
         area[f] = -1.0
         distance[f] = 0.0
@@ -464,8 +500,14 @@ def wall_geometry(face_axis, face_index, phi, bodies_on_face, on_x, on_y, on_z, 
         g = np.zeros(3)
         g[0] = (min(field[min(i + 1, field.shape[0] - 1), j, k], 1.0)
                 - min(field[max(i - 1, 0), j, k], 1.0))
-        g[1] = (min(field[i, min(j + 1, field.shape[1] - 1), k], 1.0)
-                - min(field[i, max(j - 1, 0), k], 1.0))
+        if periodic_y:
+            # y entries of the strip: cells, or faces without face ny (face 0 again)
+            n_y = field.shape[1] - (1 if axis == 1 else 0)
+            g[1] = (min(field[i, (j + 1) % n_y, k], 1.0)
+                    - min(field[i, (j - 1 + n_y) % n_y, k], 1.0))
+        else:
+            g[1] = (min(field[i, min(j + 1, field.shape[1] - 1), k], 1.0)
+                    - min(field[i, max(j - 1, 0), k], 1.0))
         g[2] = (min(field[i, j, min(k + 1, field.shape[2] - 1)], 1.0)
                 - min(field[i, j, max(k - 1, 0)], 1.0))
         norm = abs(g[0]) + abs(g[1]) + abs(g[2])
@@ -500,7 +542,7 @@ def wall_geometry(face_axis, face_index, phi, bodies_on_face, on_x, on_y, on_z, 
 def body_velocity_vectors(faces, centres, motions, phi, out):
     """out[f] (F, 3) = the bodies' rigid velocity U + omega x rho at face f, each body weighted
     by its share phi_b' over phi (0 on faces of no body)."""
-    entry_start, entry_face, entry_half, face_axis, face_index, lower, h = faces
+    entry_start, entry_face, entry_half, face_axis, face_index, lower, h, period = faces
     for f in range(out.shape[0]):
         for c in range(3):
             out[f, c] = 0.0
@@ -508,11 +550,7 @@ def body_velocity_vectors(faces, centres, motions, phi, out):
         for e in range(entry_start[b], entry_start[b + 1]):
             f = entry_face[e]
             weight = entry_half[e] / max(1.0, phi[f]) / max(min(phi[f], 1.0), 1e-300)
-            axis = face_axis[f]
-            i, j, k = face_index[f, 0], face_index[f, 1], face_index[f, 2]
-            rx = lower[0] + (i + (0.0 if axis == 0 else 0.5)) * h - centres[b, 0]
-            ry = lower[1] + (j + (0.0 if axis == 1 else 0.5)) * h - centres[b, 1]
-            rz = lower[2] + (k + (0.0 if axis == 2 else 0.5)) * h - centres[b, 2]
+            rx, ry, rz = _face_arm(face_axis[f], face_index[f], lower, h, centres[b], period)
             wx, wy, wz = motions[b, 3], motions[b, 4], motions[b, 5]
             out[f, 0] += weight * (motions[b, 0] + wy * rz - wz * ry)
             out[f, 1] += weight * (motions[b, 1] + wz * rx - wx * rz)
@@ -520,10 +558,12 @@ def body_velocity_vectors(faces, centres, motions, phi, out):
 
 
 @parallel_kernel
-def moving_pattern(face_axis, face_index, velocity, on_x, on_y, on_z, h, dt, out):
+def moving_pattern(face_axis, face_index, velocity, on_x, on_y, on_z, h, dt, out,
+                   periodic_y=False):
     """out[f] = dt (V . grad) u_a at face f of axis a, the upwind differences of the face array
     of its own axis along V (``velocity`` (F, 3)): the change a field that moves rigidly with V
-    shows at a fixed face over dt, which the grid-frame predictor puts on a moving body's faces."""
+    shows at a fixed face over dt, which the grid-frame predictor puts on a moving body's faces.
+    On a ``periodic_y`` the differences along y wrap around the strip."""
     for f in prange(face_axis.shape[0]):
         axis = face_axis[f]
         field = on_x if axis == 0 else (on_y if axis == 1 else on_z)
@@ -537,6 +577,13 @@ def moving_pattern(face_axis, face_index, velocity, on_x, on_y, on_z, h, dt, out
             dj = 1 if c == 1 else 0
             dk = 1 if c == 2 else 0
             here = field[i, j, k]
+            if periodic_y and c == 1:
+                n_y = field.shape[1] - (1 if axis == 1 else 0)
+                if speed > 0.0:
+                    total += speed * (here - field[i, (j - 1 + n_y) % n_y, k])
+                else:
+                    total += speed * (field[i, (j + 1) % n_y, k] - here)
+                continue
             if speed > 0.0:
                 ii, jj, kk = i - di, j - dj, k - dk
                 if ii < 0 or jj < 0 or kk < 0:
