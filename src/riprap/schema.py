@@ -374,6 +374,14 @@ KEYS: tuple[Key, ...] = (
     Key("simulation", "seed", "integer", "-",
         "Seed of the random orientations, shape choices and jitter of body grids.",
         default=0, valid_range=_NON_NEGATIVE),
+    Key("simulation", "periodic_y_low", "number", "m",
+        "The bodies' periodic strip across the flume, its side y = periodic_y_low (with "
+        "periodic_y_high): a body leaving at one side comes back at the other and bodies meet "
+        "across them (`riprap place` writes it into the pack of a [slope] with sides = "
+        "\"periodic\"). Both 0: no strip. With a [fluid] whose y sides are periodic, the strip "
+        "is the fluid box's y range and must be that if given.", default=0.0),
+    Key("simulation", "periodic_y_high", "number", "m",
+        "The strip's other side, y = periodic_y_high > periodic_y_low.", default=0.0),
     Key("simulation", "contact_history", "path", "-",
         "Contacts the bodies start in (written by `riprap place` beside `pack.toml`): their "
         "friction carries over and the overlaps listed there are accepted at the start; "
@@ -511,6 +519,13 @@ KEYS: tuple[Key, ...] = (
         "Material of the face and the bed (the core's surface).", references="materials"),
     Key("slope", "side_wall_material", "string", "-", "Material of the flume's side walls.",
         references="materials"),
+    Key("slope", "sides", "string", "-",
+        "The flume's sides at y = 0 and y = width: glass walls (side_wall_material), or a "
+        "periodic strip standing for a wide flume (the rock lattice and the units' rows continue "
+        "across it, units settle against their neighbours' images; the pack runs periodic: "
+        "[simulation] periodic_y_low/high, and a [fluid] run needs y_low = y_high = "
+        "\"periodic\"). A strip must be at least twice as wide as a unit's bounding diameter.",
+        default="walls", choices=("walls", "periodic")),
     # [underlayer]
     Key("underlayer", "material", "string", "-", "Material of the rocks.", references="materials"),
     Key("underlayer", "dn50", "number", "m",

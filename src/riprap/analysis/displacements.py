@@ -5,6 +5,10 @@ nominal diameters D_n (the measure used for armour damage, e.g. a unit "displace
 about one D_n), and its component along the slope (positive up the face). Rotation: the angle of
 the rotation that carries the unit's orientation in the reference state onto the present one,
 R_now R_ref^T, in degrees (0..180), whatever the axis.
+
+On a periodic strip (``slope.periodic``) a unit that left at one side is back at the other: its
+move across the flume is taken to the nearest image (a unit is not carried half the strip's width
+across the flume between two surveys).
 """
 from __future__ import annotations
 
@@ -32,7 +36,8 @@ def unit_displacements(positions, rotations, reference_positions, reference_rota
     nominal_diameter : float
         D_n of a unit (m), for ``displacement_over_dn``.
     slope : riprap.placement.slope.Slope or None
-        The face, for ``displacement_along_slope_m`` (NaN without one).
+        The face, for ``displacement_along_slope_m`` (NaN without one); a periodic strip's moves
+        across it are unwrapped.
 
     Returns
     -------
@@ -54,6 +59,8 @@ def unit_displacements(positions, rotations, reference_positions, reference_rota
     rotations = np.asarray(rotations, dtype=float).reshape(-1, 3, 3)
     reference_rotations = np.asarray(reference_rotations, dtype=float).reshape(-1, 3, 3)
     move = positions - reference_positions
+    if slope is not None and slope.periodic:
+        move[:, 1] -= slope.width * np.round(move[:, 1] / slope.width)
     distance = np.linalg.norm(move, axis=1)
     if len(positions):
         relative = rotations @ np.transpose(reference_rotations, (0, 2, 1))

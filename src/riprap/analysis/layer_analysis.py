@@ -292,7 +292,9 @@ def _profile_damage(state) -> dict:
     and this state: profiles of the bodies' upper surface, lowered onto every body's surface
     triangles at each pose on a plan grid of D_n / 4 over the slope (a D_n beyond its toe and top)
     and averaged across the width, the slope's face read where no body covers a point
-    (``riprap.analysis.damage.profile_from_surfaces``)."""
+    (``riprap.analysis.damage.profile_from_surfaces``). On a periodic strip every surface is
+    also laid at its images a strip's width to either side: a unit across the strip's side
+    covers the points at both."""
     layer = state.layer
     slope, dn = layer.slope, layer.nominal_diameter
     spacing = dn / PROFILE_SAMPLES_PER_DN
@@ -310,8 +312,13 @@ def _profile_damage(state) -> dict:
                        + np.asarray(state.reference_positions)[body])[faces])
     along = np.clip((xs - slope.toe[0]) / slope.tangent[0], 0.0, slope.length)
     face = slope.toe[2] + along * slope.tangent[2]
-    profile_before = profile_from_surfaces(np.concatenate(before), xs, ys, face)
-    profile_now = profile_from_surfaces(np.concatenate(now), xs, ys, face)
+    before, now = np.concatenate(before), np.concatenate(now)
+    if slope.periodic:
+        shifts = [np.array([0.0, dy, 0.0]) for dy in (-slope.width, slope.width)]
+        before = np.concatenate([before] + [before + shift for shift in shifts])
+        now = np.concatenate([now] + [now + shift for shift in shifts])
+    profile_before = profile_from_surfaces(before, xs, ys, face)
+    profile_now = profile_from_surfaces(now, xs, ys, face)
     eroded = eroded_area(profile_before, profile_now, spacing)
     # the profiles themselves, for the report's picture of S (and for a reader's own checks)
     return {"eroded_area_m2": eroded, "damage_level_s": damage_level_s(eroded, dn),

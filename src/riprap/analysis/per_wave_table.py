@@ -60,7 +60,8 @@ class UnitTracks:
     """The units' recorded states (rows of ``body_forces.csv`` for the free units): per row the
     unit, the time (s), the centroid (m, (n, 3)) and the peak fluid force since the last row (N).
     ``reference``: where each unit started (m, indexed by unit: a test series' start), or None
-    for each unit's first row."""
+    for each unit's first row. ``period_y``: the width of a periodic strip (m; 0: walls): a unit's
+    track across its side is unwrapped row by row."""
 
     unit: np.ndarray
     time: np.ndarray
@@ -69,6 +70,7 @@ class UnitTracks:
     nominal_diameter: float       # m
     section_width: float          # m, for N_od
     reference: np.ndarray | None = None
+    period_y: float = 0.0
 
 
 def _shifted(waves, layout, x):
@@ -136,7 +138,13 @@ def _unit_columns(table, waves, layout, tracks, threshold_dn):
         rows = rows[np.argsort(tracks.time[rows], kind="stable")]
         start = (tracks.position[rows[0]] if tracks.reference is None
                  else np.asarray(tracks.reference)[int(unit)])
-        moved = np.linalg.norm(tracks.position[rows] - start, axis=1)
+        path = tracks.position[rows] - start
+        if tracks.period_y > 0.0:
+            # from the start to the first row, then from row to row, each to the nearest image
+            steps = np.diff(path[:, 1], prepend=0.0)
+            steps -= tracks.period_y * np.round(steps / tracks.period_y)
+            path[:, 1] = np.cumsum(steps)
+        moved = np.linalg.norm(path, axis=1)
         # the last record at or before each window's end (the last wave: the last record)
         last = np.searchsorted(tracks.time[rows], end, side="right") - 1
         known = last >= 0

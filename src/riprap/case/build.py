@@ -16,7 +16,7 @@ from riprap.case.run_record import RunDefinition
 from riprap.case.specs import keywords_for
 from riprap.deformable import ElasticMaterial
 from riprap.deformable.joints import JointMaterial
-from riprap.errors import RiprapError
+from riprap.errors import CaseFileError, RiprapError
 from riprap.geometry import shapes as builtin_shapes
 from riprap.geometry.armour_units import armour_unit
 from riprap.geometry.meshing import check_body_length
@@ -126,6 +126,7 @@ def build_simulation(case, *, output_directory: str | Path | None = None,
         add_body_grid(sim, grid, rng, place=place)
     place.check_selection()
     add_case_walls(sim, case)
+    add_case_strip(sim, case)
     if settings.contact_history:
         history = read_contact_history(settings.contact_history, n_bodies=place.count,
                                        n_walls=len(sim.solver.walls))
@@ -149,6 +150,32 @@ def add_case_walls(sim: Simulation, case) -> None:
             sim.add_walls(wall_builders.box(min=lo, max=hi, material=wall.material,
                                             open_top=wall.parameters["open_top"]),
                           container_box=(tuple(lo), tuple(hi)))
+
+
+def add_case_strip(sim: Simulation, case) -> None:
+    """``[simulation] periodic_y_low`` .. ``periodic_y_high``: the bodies' periodic strip (a
+    [fluid] with periodic y sides sets its own when the coupling starts)."""
+    low, high = case.simulation.periodic_y_low, case.simulation.periodic_y_high
+    if low == 0.0 and high == 0.0:
+        return
+    where = f"{case.source} [simulation]"
+    if not high > low:
+        raise CaseFileError(f"{where}: periodic_y_high = {high!r} m must exceed periodic_y_low = "
+                            f"{low!r} m (both 0: no strip)")
+    fluid = case.fluid
+    if fluid is not None:
+        if not (fluid.y_low == fluid.y_high == "periodic"):
+            raise CaseFileError(f"{where}: periodic_y_low/high make the bodies a periodic strip, "
+                                "but the [fluid] box has walls at its y sides; give it y_low = "
+                                "y_high = \"periodic\"")
+        if (low, high) != (float(fluid.lower[1]), float(fluid.upper[1])):
+            raise CaseFileError(f"{where}: the bodies' strip y {low:g} .. {high:g} m is not the "
+                                f"[fluid] box's y range {fluid.lower[1]:g} .. "
+                                f"{fluid.upper[1]:g} m")
+    try:
+        sim.solver.set_periodic(1, low, high)
+    except CaseFileError as error:
+        raise CaseFileError(f"{where}: {error}") from None
 
 
 class _BodyPlacer:

@@ -51,7 +51,8 @@ _FIELDS = {
     "unit_volume_m3": ("number", "volume of a unit"),
     "unit_height_m": ("number", "height H of a unit"),
     "unit_axes": ("axes", "named unit vectors in the unit mesh's frame, 'nose' at least"),
-    "slope": ("slope", "cotangent, width, length, toe_x, toe_level, toe_stop_distance"),
+    "slope": ("slope", "cotangent, width, length, toe_x, toe_level, toe_stop_distance (and "
+                       "periodic: true on a periodic strip; absent: false)"),
     "underlayer_top_m": ("number", "underlayer top above the face"),
     "unit_bodies": ("integers", "body index of each unit"),
     "rows": ("integers", "placement row of each unit"),
@@ -77,7 +78,8 @@ def write_layer_file(directory, layer) -> Path:
         "unit_volume_m3": float(layer.unit_volume),
         "unit_height_m": float(layer.unit_height),
         "unit_axes": {name: _finite_list(axis) for name, axis in layer.unit_axes.items()},
-        "slope": {name: float(getattr(slope, name)) for name in _SLOPE_FIELDS},
+        "slope": {**{name: float(getattr(slope, name)) for name in _SLOPE_FIELDS},
+                  "periodic": bool(slope.periodic)},
         "underlayer_top_m": float(layer.underlayer_top),
         "unit_bodies": [int(b) for b in layer.unit_bodies],
         "rows": [int(r) for r in layer.rows],
@@ -156,6 +158,8 @@ def _check_field(name, value, kind, problems) -> None:
         for field in _SLOPE_FIELDS:
             if field in value and not _is_number(value[field]):
                 bad(f"'slope': '{field}' must be a finite number, got {value[field]!r}")
+        if not isinstance(value.get("periodic", False), bool):
+            bad(f"'slope': 'periodic' must be true or false, got {value['periodic']!r}")
     elif kind == "mapping":
         if not isinstance(value, dict):
             bad(f"'{name}' must be a table of numbers, got {value!r}")
@@ -241,7 +245,8 @@ def read_layer_file(directory, n_bodies: int | None = None) -> dict:
         nominal_diameter=float(data["nominal_diameter_m"]), unit_volume=float(data["unit_volume_m3"]),
         unit_height=float(data["unit_height_m"]),
         unit_axes={name: np.asarray(axis, dtype=float) for name, axis in data["unit_axes"].items()},
-        slope={name: float(data["slope"][name]) for name in _SLOPE_FIELDS},
+        slope={**{name: float(data["slope"][name]) for name in _SLOPE_FIELDS},
+               "periodic": bool(data["slope"].get("periodic", False))},
         slope_source=f"{path}{f':{slope_line}' if slope_line else ''}",
         underlayer_top=float(data["underlayer_top_m"]),
         unit_bodies=np.asarray(data["unit_bodies"], dtype=np.int64),

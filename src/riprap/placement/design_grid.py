@@ -9,6 +9,10 @@ dy = D_n^2 (n1 + n2) / (2 phi width), so that the grid itself has the target pac
 (a pair of rows holds n1 + n2 units on 2 dy x width of face; with dx dy instead, the short rows
 would leave a 12-row flume's grid 1/24 and a 4-row one's 1/8 below its target). The seed paper's
 Core-Loc layer is 21 rows alternating 12 and 11 units.
+
+On a periodic strip (``slope.periodic``) every row holds the same number of units, dx = width / n
+apart, and every other row is shifted by dx / 2 across the strip's side (taken back into the strip):
+the staggered pattern of a wide flume, continued across the boundary.
 """
 from __future__ import annotations
 
@@ -47,6 +51,11 @@ def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12,
         raise CaseFileError(f"design grid: packing_density_coefficient = "
                             f"{packing_density_coefficient!r} must be > 0")
     widest = max(counts)
+    if slope.periodic and len(set(counts)) > 1:
+        raise CaseFileError(f"design grid: units_per_row = {units_per_row!r}: on a periodic strip "
+                            "every row holds the same number of units (the stagger is a shift "
+                            "of half a spacing across the strip's side); leave "
+                            "units_per_alternate_row out or equal")
     dx = slope.width / widest
     mean_count = 0.5 * (counts[0] + counts[-1])
     dy = nominal_diameter ** 2 * mean_count / (packing_density_coefficient * slope.width)
@@ -54,6 +63,8 @@ def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12,
     for r in range(rows):
         n = counts[r % len(counts)]
         y0 = 0.5 * (slope.width - (n - 1) * dx)
+        if slope.periodic:
+            y0 = 0.5 * dx * (1 + r % 2)
         for i in range(n):
             s_list.append(first_row_s + r * dy)
             y_list.append(y0 + i * dx)
@@ -64,7 +75,7 @@ def design_grid(slope, *, nominal_diameter: float, rows: int, units_per_row=(12,
             f"design grid: {rows} rows {dy:.3f} m apart from s = {first_row_s:g} m reach "
             f"s = {s.max():.3f} m along the face, beyond its length {slope.length:g} m; "
             "use fewer rows, a longer slope or a lower first row")
-    y = np.array(y_list)
+    y = slope.wrapped(np.array(y_list))
     # Straight above (not along the face normal from) the design centroids: a unit let go or
     # lowered from there comes down on its own place rather than one row further down the face.
     design = slope.to_world(s, y, np.full(len(s), float(centroid_height)))

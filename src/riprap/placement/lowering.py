@@ -50,16 +50,24 @@ class VerticalLowering:
 
     ``gap``: the clearance (m) a lowered surface keeps from what it lands on, so that it is
     released just touching (within the contact's potential) rather than already overlapping.
+    ``period`` (m, 0: none): a periodic strip across y; every surface in place is also held at
+    its images one period to either side, so that a unit near one side lands on what lies at the
+    other.
     """
 
-    def __init__(self, slope, *, gap: float):
+    def __init__(self, slope, *, gap: float, period: float = 0.0):
         self.slope = slope
         self.gap = float(gap)
+        self.period = float(period)
         self._surfaces: list[Surface] = []
         self._low = np.zeros((0, 3))
         self._high = np.zeros((0, 3))
 
     def add(self, *surfaces: Surface) -> None:
+        if self.period > 0.0:
+            surfaces = tuple(image for surface in surfaces
+                             for image in (surface, _shifted_y(surface, -self.period),
+                                           _shifted_y(surface, self.period)))
         self._surfaces.extend(surfaces)
         self._low = np.vstack([self._low] + [s.low[None] for s in surfaces])
         self._high = np.vstack([self._high] + [s.high[None] for s in surfaces])
@@ -96,6 +104,12 @@ class VerticalLowering:
             drop = min(drop, vertical_gap(raised.points, triangles, False),
                        vertical_gap(points, raised.triangles, True))
         return raise_by - (drop - self.gap)
+
+
+def _shifted_y(surface: Surface, dy: float) -> Surface:
+    shift = np.array([0.0, dy, 0.0])
+    return Surface(triangles=surface.triangles + shift, points=surface.points + shift,
+                   low=surface.low + shift, high=surface.high + shift)
 
 
 __all__ = ["Surface", "VerticalLowering"]

@@ -141,6 +141,7 @@ def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range,
         sim.add_shape(s.name, s)
     sim.add_walls(slope.walls(face_material=materials.face.name,
                               side_material=materials.side_wall.name))
+    _strip(sim, slope)
     choice = rng.choice(len(shapes), size=len(points), p=probability)
     orientations = Rotation.random(len(points), random_state=rng.integers(2**31)).as_quat()
     world = slope.to_world(points[:, 0], points[:, 1], points[:, 2])
@@ -158,6 +159,12 @@ def build_underlayer(slope, rocks, *, materials: PlacementMaterials, s_range,
     return underlayer
 
 
+def _strip(sim: Simulation, slope) -> None:
+    """A periodic strip's sides for the bodies: they wrap and meet across them."""
+    if slope.periodic:
+        sim.solver.set_periodic(1, 0.0, slope.width)
+
+
 def rock_shapes(rocks) -> list[RigidShape]:
     """The rigid shapes of a rock library, named as the underlayer run names them."""
     return [RigidShape.from_mesh(r.mesh, name=f"rock_{k}") for k, r in enumerate(rocks)]
@@ -172,6 +179,11 @@ def rock_lattice(slope, shapes, s_range, layers: int) -> np.ndarray:
     s_low, s_high = (float(v) for v in s_range)
     n_s = int((s_high - s_low) // spacing)
     n_y = int((slope.width - 2.0 * radius) // spacing) + 1
+    spacing_y = spacing
+    if slope.periodic:
+        # the lattice continues across the strip's side: n_y columns fill its width evenly
+        n_y = int(slope.width // spacing)
+        spacing_y = slope.width / max(n_y, 1)
     if n_s < 1 or n_y < 1:
         raise CaseFileError(f"underlayer: the band s = {s_low:g}..{s_high:g} m of a {slope.width:g} m "
                             f"wide face holds no rock of bounding diameter {2 * radius:.3g} m")
@@ -182,14 +194,20 @@ def rock_lattice(slope, shapes, s_range, layers: int) -> np.ndarray:
             f"{MAXIMUM_BODY_COUNT:,} bodies a case may have; use larger rocks (dn50), a narrower "
             "band (from_s, to_s) or fewer layers")
     y0 = 0.5 * (slope.width - (n_y - 1) * spacing)
+    if slope.periodic:
+        y0 = 0.5 * spacing_y
     points = []
     for layer in range(layers):
         shift = 0.5 * spacing * (layer % 2)
+        shift_y = 0.5 * spacing_y * (layer % 2)
+        columns = n_y if slope.periodic else n_y - (layer % 2)
         for i in range(n_s):
-            for j in range(n_y - (layer % 2)):
-                points.append((s_low + (i + 0.5) * spacing + shift, y0 + j * spacing + shift,
+            for j in range(columns):
+                points.append((s_low + (i + 0.5) * spacing + shift,
+                               y0 + j * spacing_y + shift_y,
                                radius * (1.0 + _ROCK_LATTICE_GAP) + layer * spacing))
     points = np.array(points)
+    points[:, 1] = slope.wrapped(points[:, 1])
     if slope.toe_stop_distance > 0:
         # Upper layers of the lattice lean out over the toe: keep them behind the toe stop.
         x = slope.to_world(points[:, 0], points[:, 1], points[:, 2])[:, 0]
@@ -382,7 +400,8 @@ def _lower_onto_layer(slope, unit, unit_shape, rock_surfaces, state, placed, gro
     """Lower the units of ``group`` (lowest first along the face) straight down onto the rocks and
     the units ``placed`` before them; their start positions give the vertical each one travels."""
     faces = unit_shape.mesh.boundary_faces()
-    lowering = VerticalLowering(slope, gap=_RELEASE_GAP * unit.nominal_diameter)
+    lowering = VerticalLowering(slope, gap=_RELEASE_GAP * unit.nominal_diameter,
+                                period=slope.width if slope.periodic else 0.0)
     lowering.add(*rock_surfaces)
     lowering.add(*(Surface.from_nodes(_unit_nodes(unit_shape, state, k), faces) for k in placed))
     along = slope.to_slope(state.positions[np.asarray(group)])
@@ -463,6 +482,7 @@ def _placement_simulation(slope, unit_shape, underlayer, state, members, materia
     sim.add_shape(unit_shape.name, unit_shape)
     sim.add_walls(slope.walls(face_material=materials.face.name,
                               side_material=materials.side_wall.name))
+    _strip(sim, slope)
     for k in range(len(underlayer.positions)):
         sim.add_body(shape=underlayer.shapes[underlayer.shape_of_rock[k]].name,
                      material=materials.rock.name, position=underlayer.positions[k],
@@ -517,6 +537,14 @@ def _shift_inside_walls(slope, unit_shape, positions, orientations) -> None:
             if x.min() < stop_x + gap:
                 positions[k, 0] += stop_x + gap - x.min()
         y = slope.to_slope(_world_nodes(unit_shape, positions[k], orientations[k]))[:, 1]
+        if slope.periodic:
+            # no side walls; a pair of units across the strip's side must touch in one image only
+            if 2.0 * unit_shape.bounding_radius * 2.0 > slope.width:
+                raise CaseFileError(
+                    f"a periodic strip {slope.width:g} m wide is narrower than twice a unit's "
+                    f"bounding diameter ({2.0 * unit_shape.bounding_radius:.3f} m): a unit would "
+                    "meet its own neighbour's two images; widen the strip")
+            continue
         if (1.0 + 2.0 * _SIDE_WALL_GAP) * (y.max() - y.min()) > slope.width:
             raise CaseFileError(f"unit {k} is {y.max() - y.min():.3f} m wide across the flume, more "
                                 f"than its width {slope.width:g} m")
@@ -551,7 +579,7 @@ def _check_inside(slope, unit_shape, positions, orientations, grid_lines, above_
     for k in range(len(positions)):
         coords = slope.to_slope(_world_nodes(unit_shape, positions[k], orientations[k]))
         where = f"unit {k}" + (f" (grid line {grid_lines[k]})" if grid_lines is not None else "")
-        if coords[:, 1].min() < 0.0 or coords[:, 1].max() > slope.width:
+        if not slope.periodic and (coords[:, 1].min() < 0.0 or coords[:, 1].max() > slope.width):
             problems.append(f"  {where} reaches y = {coords[:, 1].min():.3f}..{coords[:, 1].max():.3f} m, "
                             f"outside the side walls at 0 and {slope.width:g} m")
         elif above_face and coords[:, 2].min() < 0.0:
@@ -562,19 +590,15 @@ def _check_inside(slope, unit_shape, positions, orientations, grid_lines, above_
                             + "\n".join(problems[:20]) + more)
 
 
-# Walls of Slope.walls that do not carry a unit: the two side walls (0 is the bed, 1 the face,
-# 4 the toe stop).
-_SIDE_WALLS = (2, 3)
-
-
-def _units_not_on_underlayer(solver, unit_bodies, n_rocks: int) -> np.ndarray:
+def _units_not_on_underlayer(solver, unit_bodies, n_rocks: int, side_walls) -> np.ndarray:
     """For each unit, whether it touches no underlayer rock, nor the face, the bed or the toe
     stop: it rests on other units only (stacked on the layer instead of in it), or on nothing."""
     contacts = solver.contacts
     body_i, body_j = np.asarray(contacts.body_i), np.asarray(contacts.body_j)
     on_ground = np.zeros(solver.n_bodies, dtype=bool)
     wall = body_j < 0
-    ground_wall = wall & ~np.isin(-1 - body_j, _SIDE_WALLS)
+    # the side walls (``Slope.side_wall_indices``) carry no unit
+    ground_wall = wall & ~np.isin(-1 - body_j, side_walls)
     on_ground[body_i[ground_wall]] = True
     rock_pair = ~wall & ((body_i < n_rocks) | (body_j < n_rocks))
     on_ground[body_i[rock_pair]] = True
@@ -603,7 +627,8 @@ def placement_summary(slope, unit, unit_shape, underlayer, sim, unit_bodies, uni
         slope, solver.positions[unit_bodies][on_face], [n for n, ok in zip(node_sets, on_face) if ok],
         rows=np.asarray(unit_rows)[on_face], nominal_diameter=dn, unit_volume=unit.volume,
         underlayer_level=underlayer.top_level)
-    not_on_underlayer = _units_not_on_underlayer(solver, unit_bodies, len(underlayer.positions))
+    not_on_underlayer = _units_not_on_underlayer(solver, unit_bodies, len(underlayer.positions),
+                                                 slope.side_wall_indices)
     overlaps = [depth for i, j, depth in solver.overlaps(0.0)
                 if i in set(unit_bodies.tolist()) or j in set(unit_bodies.tolist())]
     design = unit.design

@@ -10,7 +10,8 @@ Slope coordinates (s, y, h): s along the face from the toe, h along the outward 
 point is toe + s t + y e_y + h n with t = (cos a, 0, sin a) and n = (-sin a, 0, cos a).
 
 Walls are half-spaces: the bed (z < toe_level), the slope body (below the face plane) and the two
-side walls. The union of the bed and the slope body is exactly the concave toe corner. The crest is
+side walls; on a periodic strip (``periodic``) there are no side walls: y = 0 and y = ``width``
+are one periodic boundary, the section a strip of an infinitely wide flume. The union of the bed and the slope body is exactly the concave toe corner. The crest is
 not a surface: the face plane continues above ``length`` (units and rocks are placed below it), a
 convex crest edge would need a bounded wall.
 """
@@ -43,6 +44,8 @@ class Slope:
     toe_stop_distance : float
         If > 0, a vertical wall this far in front of the toe line (m) stands for the toe structure
         (toe berm) that holds the lowest row of a real armour layer; 0: the bed is open.
+    periodic : bool
+        The sides y = 0 and y = ``width`` are a periodic boundary, not walls.
     """
 
     cotangent: float
@@ -51,6 +54,7 @@ class Slope:
     toe_x: float = default_of("slope", "toe_x")
     toe_level: float = default_of("slope", "toe_level")
     toe_stop_distance: float = default_of("slope", "toe_stop_distance")
+    periodic: bool = False
 
     def __post_init__(self):
         for name in ("cotangent", "width", "length"):
@@ -109,15 +113,27 @@ class Slope:
         d = np.asarray(points, dtype=float) - self.toe
         return np.stack([d @ self.tangent, d[..., 1], d @ self.normal], axis=-1)
 
+    @property
+    def side_wall_indices(self) -> tuple[int, ...]:
+        """Which of ``walls()`` are the side walls (none on a periodic strip)."""
+        return () if self.periodic else (2, 3)
+
+    def wrapped(self, y):
+        """``y`` (m) taken into the strip [0, width) on a periodic strip; as it is otherwise."""
+        y = np.asarray(y, dtype=float)
+        return np.mod(y, self.width) if self.periodic else y
+
     def walls(self, *, face_material: str, side_material: str) -> list[Wall]:
-        """Bed, slope face, the two side walls and the toe stop if any, as half-space walls
-        (in that order: walls 0 and 1 are the ground the underlayer rests on)."""
+        """Bed, slope face, the two side walls (not on a periodic strip) and the toe stop if
+        any, as half-space walls (in that order: walls 0 and 1 are the ground the underlayer
+        rests on)."""
         planes = (walls.plane(point=self.toe, normal=(0.0, 0.0, 1.0), material=face_material)
-                  + walls.plane(point=self.toe, normal=self.normal, material=face_material)
-                  + walls.plane(point=(0.0, 0.0, 0.0), normal=(0.0, 1.0, 0.0),
-                                material=side_material)
-                  + walls.plane(point=(0.0, self.width, 0.0), normal=(0.0, -1.0, 0.0),
-                                material=side_material))
+                  + walls.plane(point=self.toe, normal=self.normal, material=face_material))
+        if not self.periodic:
+            planes += (walls.plane(point=(0.0, 0.0, 0.0), normal=(0.0, 1.0, 0.0),
+                                   material=side_material)
+                       + walls.plane(point=(0.0, self.width, 0.0), normal=(0.0, -1.0, 0.0),
+                                     material=side_material))
         if self.toe_stop_distance > 0:
             planes += walls.plane(point=(self.toe_x - self.toe_stop_distance, 0.0, 0.0),
                                   normal=(1.0, 0.0, 0.0), material=face_material)

@@ -71,7 +71,8 @@ def _per_wave(path, analysis, reference_run, threshold_dn) -> dict | None:
         return run_per_wave_table(
             Path(path), case, units=np.asarray(layer.unit_bodies, dtype=np.int64),
             nominal_diameter=float(layer.nominal_diameter), section_width=float(layer.slope.width),
-            threshold_dn=threshold_dn or DISPLACED_THRESHOLD_DN, reference_run=reference_run)
+            threshold_dn=threshold_dn or DISPLACED_THRESHOLD_DN, reference_run=reference_run,
+            periodic=layer.slope.periodic)
     except CaseFileError as error:
         # the gauges cannot give waves at the toe (too short a record, gauges too close for the
         # split): the analysis stands without the table, and says why

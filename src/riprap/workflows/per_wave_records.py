@@ -30,12 +30,13 @@ def read_run_gauges(folder: Path, case) -> tuple[np.ndarray, dict] | None:
 
 def run_per_wave_table(folder: Path, case, *, units, nominal_diameter: float,
                        section_width: float, threshold_dn: float = 1.0,
-                       reference_run: Path | None = None) -> dict | None:
+                       reference_run: Path | None = None, periodic: bool = False) -> dict | None:
     """The per-wave table of the flume run in ``folder`` (run of ``case``; None where it has no
     gauges.csv or fewer than two surface gauges): waves counted at the toe (the run-up gauge's
     start, else the surface gauge nearest the structure), the units' (body indices ``units``)
     displacements counted from the first rows of ``body_forces.csv`` of ``reference_run`` (a test
-    series' first step; default this run's own)."""
+    series' first step; default this run's own); ``periodic``: the section is a periodic strip
+    ``section_width`` wide (the tracks are unwrapped across its side)."""
     gauges = read_run_gauges(folder, case)
     if gauges is None or case.waves is None or case.fluid is None:
         return None
@@ -60,7 +61,7 @@ def run_per_wave_table(folder: Path, case, *, units, nominal_diameter: float,
         tracks = UnitTracks(unit=rows["body"], time=rows["time_s"], position=rows["position_m"],
                             peak_force=rows["peak_fluid_force_N"],
                             nominal_diameter=nominal_diameter, section_width=section_width,
-                            reference=reference)
+                            reference=reference, period_y=section_width if periodic else 0.0)
     armour_x = float(np.mean(tracks.position[:, 0])) if tracks is not None else None
     layout = FlumeLayout(
         gauge_positions=tuple(g.parameters["position"][0] for g in surface), toe_x=toe,

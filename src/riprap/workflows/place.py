@@ -118,7 +118,8 @@ def prepare_placement(case) -> PlacementInputs:
     _require_tables(case)
     sl, ul, pl = case.slope, case.underlayer, case.placement
     slope = Slope(cotangent=sl.cotangent, width=sl.width, length=sl.length, toe_x=sl.toe_x,
-                  toe_level=sl.toe_level, toe_stop_distance=sl.toe_stop_distance)
+                  toe_level=sl.toe_level, toe_stop_distance=sl.toe_stop_distance,
+                  periodic=sl.sides == "periodic")
     materials = placement_materials(case)
     grid = None
     if pl.grid_file:
@@ -311,7 +312,10 @@ def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
                       simulation={"end_time": case.simulation.end_time,
                                   "time_step": case.simulation.time_step,
                                   "time_step_safety": case.simulation.time_step_safety,
-                                  "gravity": list(case.simulation.gravity)},
+                                  "gravity": list(case.simulation.gravity),
+                                  # a strip's pack runs on the strip (dry, or in its fluid)
+                                  **({"periodic_y_low": 0.0, "periodic_y_high": slope.width}
+                                     if slope.periodic else {})},
                       comment=f"armour layer placed by riprap place from {case.source}",
                       contact_history=sim.contact_history(),
                       friction_pairs=materials.friction_pairs)
