@@ -103,3 +103,63 @@ def test_a_strip_run_restarts_bit_for_bit():
         assert np.array_equal(getattr(second.fluid, name), getattr(straight.fluid, name)), name
     for name in ("positions", "quaternions", "velocities", "angular_momenta"):
         assert np.array_equal(getattr(second.solids, name), getattr(straight.solids, name)), name
+
+
+_BODY_IN_STRIP = """format_version = 1
+[simulation]
+end_time = 0.1
+{simulation}
+[[materials]]
+name = "concrete"
+density = 2400.0
+[[shapes]]
+name = "cube"
+type = "cube"
+side = 0.1
+[[bodies]]
+shape = "cube"
+material = "concrete"
+position = [0.2, 0.05, 0.1]
+{rest}
+"""
+_FLUID = """[fluid]
+lower = [0.0, 0.0, 0.0]
+upper = [0.4, {width}, 0.3]
+cells = [16, {ny}, 12]
+y_low = "{sides}"
+y_high = "{sides}"
+surface_tension = 0.0
+[[water_regions]]
+type = "level"
+level = 0.2
+"""
+_WALL = """[[walls]]
+type = "plane"
+material = "concrete"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+"""
+
+
+@pytest.mark.parametrize("simulation, rest, words", [
+    ("", _FLUID.format(width=0.2, ny=8, sides="periodic"), "shorter than twice the bounding"),
+    ("periodic_y_low = 0.0\nperiodic_y_high = 0.4", _FLUID.format(width=0.4, ny=16,
+                                                                     sides="no_slip"),
+     "has walls at its y sides"),
+    ("periodic_y_low = 0.0\nperiodic_y_high = 0.35", _FLUID.format(width=0.4, ny=16,
+                                                                      sides="periodic"),
+     "is not the [fluid] box's y range"),
+    ("periodic_y_low = 0.4\nperiodic_y_high = 0.0", "", "must exceed periodic_y_low"),
+    ("periodic_y_low = 0.0\nperiodic_y_high = 0.4", _WALL, "faces along y, the periodic"),
+])
+def test_riprap_check_names_each_refusal_of_bodies_on_a_strip(tmp_path, capsys, simulation,
+                                                               rest, words):
+    """``riprap check``: a strip narrower than twice a body's bounding diameter, bodies made a
+    strip in a walled fluid box or on another width than its strip, a strip whose sides are
+    swapped, a wall across a dry strip: exit 2, one line naming why."""
+    from riprap.cli import main
+    path = tmp_path / "strip.toml"
+    path.write_text(_BODY_IN_STRIP.format(simulation=simulation, rest=rest))
+    assert main(["check", str(path)]) == 2
+    error = capsys.readouterr().err
+    assert words in error, error

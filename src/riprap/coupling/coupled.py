@@ -225,7 +225,13 @@ class CoupledSolver:
             # the bodies live on the fluid's strip: they wrap and meet across its sides too
             strip = fluid.grid.whole_grid
             if solids.periodic is None:
-                solids.set_periodic(1, strip.lower[1], strip.upper[1])
+                try:
+                    solids.set_periodic(1, strip.lower[1], strip.upper[1])
+                except CaseFileError as error:
+                    raise CaseFileError(f"coupling: the bodies on the fluid's periodic strip "
+                                        f"([fluid] y_low = y_high = \"periodic\", y "
+                                        f"{strip.lower[1]:g} .. {strip.upper[1]:g} m): "
+                                        f"{error}") from None
             elif solids.periodic != (1, strip.lower[1], strip.upper[1]):
                 raise CaseFileError(f"coupling: the bodies are periodic as {solids.periodic}, the "
                                     f"fluid's strip is y {strip.lower[1]:g} .. "
