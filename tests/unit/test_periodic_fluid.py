@@ -227,3 +227,15 @@ def test_riprap_check_takes_a_strip(tmp_path, capsys):
              "lower = [0.5, 0.0, 0.0]\nupper = [0.7, 0.2, 0.1]")
     path.write_text(_STRIP_CASE.format(nx=32, ny=8, y_low="periodic", extra=extra))
     assert main(["check", str(path)]) == 0, capsys.readouterr().err
+
+
+def test_riprap_check_warns_of_a_strip_the_multigrid_cannot_coarsen(tmp_path, capsys):
+    """ny = 10 across a periodic strip runs (even), with a warning naming the key and the counts
+    that would let the multigrid coarsen y (8 or 12)."""
+    from riprap.cli import main
+    path = tmp_path / "strip.toml"
+    path.write_text(_STRIP_CASE.format(nx=32, ny=10, y_low="periodic", extra="").replace(
+        "upper = [0.8, 0.2, 0.4]", "upper = [0.8, 0.25, 0.4]"))
+    assert main(["check", str(path)]) == 0
+    error = capsys.readouterr().err
+    assert "[fluid]: a periodic y of ny = 10" in error and "8 or 12" in error, error

@@ -2,6 +2,7 @@
 :class:`riprap.simulation.Simulation` of the fluid alone, or of the case's bodies in it)."""
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 from riprap.case.body_start import check_coordinates
@@ -36,6 +37,12 @@ def build_fluid_solver(case) -> FluidSolver:
                          boundaries={side: getattr(spec, side) for side in SIDES})
     except CaseFileError as error:
         raise CaseFileError(f"{where}: {error}") from None
+    if grid.periodic_y and grid.cells[1] % 4:
+        ny = grid.cells[1]
+        warnings.warn(f"{where}: a periodic y of ny = {ny} cells (not a multiple of 4): the "
+                      "pressure solve's multigrid cannot coarsen y on a periodic strip (slower "
+                      f"solves on wide grids); {ny - 2} or {ny + 2} cells across would let it",
+                      RiprapWarning, stacklevel=2)
     solver = FluidSolver(grid, water=Phase("water", spec.water_density, spec.water_viscosity),
                          air=Phase("air", spec.air_density, spec.air_viscosity),
                          gravity=case.simulation.gravity,
@@ -131,8 +138,6 @@ def build_fluid_run(case, *, output_directory=None, progress: bool = True):
         _warn_if_too_short_to_analyse(case, simulation)
         return simulation
     if case.fluid.contact_only_below_cells > 0:
-        import warnings
-
         warnings.warn(f"{case.source} [fluid] contact_only_below_cells = "
                       f"{case.fluid.contact_only_below_cells:g}: the case has no bodies, so "
                       "nothing is contact-only; leave the key out", RiprapWarning, stacklevel=2)
@@ -155,8 +160,6 @@ def _choose_contact_only_bodies(case, simulation, fluid) -> None:
     porous filter zone the flow sees in their place (``riprap.coupling.filter_layer``); without
     the key, warn of fixed bodies too small for the grid. ``simulation.filter_layer`` keeps the
     choice for the run's log and ``riprap check``."""
-    import warnings
-
     threshold = case.fluid.contact_only_below_cells
     solver, h = simulation.solver, fluid.grid.cell_size
     simulation.filter_layer = None
@@ -197,8 +200,6 @@ def _choose_contact_only_bodies(case, simulation, fluid) -> None:
 def _warn_if_too_short_to_analyse(case, simulation) -> None:
     """Say before the run (``riprap check`` and ``riprap run`` both build it here) when it ends
     before the wave analysis can give its results; the run goes on."""
-    import warnings
-
     fluid = simulation.fluid
     text = short_run_warning(flume_windows(fluid.wave_source, fluid.gauges), simulation.end_time,
                              case_end_time=case.simulation.end_time,
