@@ -138,6 +138,10 @@ class DeformableBodies:
 
     def __init__(self, system, rigid=None):
         n_rigid = rigid.n_bodies if rigid is not None else 0
+        if rigid is not None and rigid.periodic is not None:
+            raise CaseFileError("deformable bodies with rigid ones on a periodic strip "
+                                "([simulation] periodic_y_low/high) are not available yet: the "
+                                "deformable nodes do not wrap")
         if system.n_rigid != n_rigid:
             raise CaseFileError(f"the deformable system has {system.n_rigid} rigid surfaces, the rigid "
                                 f"solver {n_rigid} bodies")
@@ -171,6 +175,12 @@ class DeformableBodies:
         #: Force and torque of the deformable bodies' contacts on each rigid body, last step.
         self.rigid_contact_loads = np.zeros((n_rigid, 6))
         self.refresh()
+
+    @property
+    def periodic(self) -> None:
+        """Deformable bodies never live on a periodic strip (their nodes do not wrap): None, as
+        ``SolidSolver.periodic`` of bodies between walls."""
+        return None
 
     def _build_surfaces(self) -> None:
         """The surfaces the water sees: every deformable body's outward boundary triangles (the
