@@ -294,8 +294,12 @@ def test_units_resting_on_units_only_are_listed():
     solver = SimpleNamespace(contacts=contacts, n_bodies=6)
     # unit 0 (body 2) on a rock, unit 1 (body 3) under a rock's contact, unit 2 (body 4) on the
     # face, unit 3 (body 5) on unit 2 and against a side wall only
-    flags = _units_not_on_underlayer(solver, np.array([2, 3, 4, 5]), n_rocks=2)
+    flags = _units_not_on_underlayer(solver, np.array([2, 3, 4, 5]), n_rocks=2,
+                                     side_walls=(2, 3))
     assert flags.tolist() == [False, False, False, True]
+    # on a periodic strip there are no side walls: wall 2 is the toe stop, which carries a unit
+    flags = _units_not_on_underlayer(solver, np.array([2, 3, 4, 5]), n_rocks=2, side_walls=())
+    assert flags.tolist() == [False, False, False, False]
 
 
 @pytest.mark.parametrize("case", ["rigid", "fluid"])
