@@ -886,6 +886,18 @@ KEYS: tuple[Key, ...] = (
         "How long each step runs on after its sea ends, for the last waves to reach the "
         "structure and run down; 0: three peak periods plus the travel time from the wave maker "
         "to the structure.", default=0.0, valid_range=_NON_NEGATIVE),
+    Key("series", "wave_calibration", "string", "-",
+        "The wave maker's calibration before the steps (docs/campaign.md, Calibrated seas): "
+        "none (the wave maker makes the asked sea; the toe sees what the flume lets through) "
+        "or without_structure (each step's sea is first run in the flume without the bodies, "
+        "the incident Hm0 and Tp measured at the toe, and the wave maker's gain corrected "
+        "until they are within 3 % and 5 % of the asked ones; kept and reused by every member "
+        "and seed).", default="none", choices=("none", "without_structure")),
+    Key("series", "wave_calibration_folder", "string", "-",
+        "Folder of the wave calibration (relative to the case's folder): a calibration made "
+        "once for this flume and these seas, shared by several series; empty: calibration/ "
+        "in the series' output folder (a campaign's: calibration_<case name>/ in its folder).",
+        default=""),
     # [[series_steps]]
     Key("series_steps", "significant_height", "number", "m",
         "Spectral significant wave height Hm0 of the step's sea.", valid_range=_POSITIVE),

@@ -18,7 +18,8 @@ import math
 from riprap.analysis.design_formulas import hudson_stability_number, van_der_meer_cubes_damage
 from riprap.geometry.unit_kinds import UNIT_RECORDS
 
-__all__ = ["flume_stability", "incident_at_toe", "HUDSON_TRUNK_STABILITY"]
+__all__ = ["flume_stability", "incident_at_toe", "incident_peak_period_at_toe", "reflection_at_toe",
+           "HUDSON_TRUNK_STABILITY"]
 
 #: K_D of a trunk under non-breaking waves per unit kind (armour_design.md §5.2, kept in each
 #: kind's record); None: no value retrieved for it (cubes: Van der Meer's formula instead).
@@ -54,6 +55,26 @@ def incident_at_toe(waves_report: dict):
     return None, None, None, "no analysed surface gauge"
 
 
+def _mean_of_triples(waves_report: dict, key: str) -> float | None:
+    entries = waves_report.get("reflection_three_gauge", [])
+    values = [e.get(key) for e in (entries if isinstance(entries, list) else [])
+              if isinstance(e, dict)]
+    values = [v for v in values if _finite(v)]
+    return sum(values) / len(values) if values else None
+
+
+def incident_peak_period_at_toe(waves_report: dict) -> float | None:
+    """The incident waves' peak period Tp (s) at the toe: the mean of the three-gauge splits'
+    smoothed peak periods (``incident_Tp_s``), None where no split gave one."""
+    return _mean_of_triples(waves_report, "incident_Tp_s")
+
+
+def reflection_at_toe(waves_report: dict) -> float | None:
+    """The structure's reflection coefficient K_r = Hm0,reflected / Hm0,incident: the mean of
+    the three-gauge splits', None where no split gave one."""
+    return _mean_of_triples(waves_report, "reflection_coefficient")
+
+
 def flume_stability(waves_report: dict, layer_summary: dict, *, unit_kind: str,
                     nominal_diameter: float, armour_density: float, water_density: float,
                     slope_cot: float) -> dict:
@@ -84,7 +105,9 @@ def flume_stability(waves_report: dict, layer_summary: dict, *, unit_kind: str,
                if waves_report.get("record_end_s") is not None else "") + ")")
         return result
     stability = height / (delta * nominal_diameter)
-    result.update({"Hm0_m": height, "Tz_s": period, "waves": waves, "stability_number": stability})
+    result.update({"Hm0_m": height, "Tz_s": period, "waves": waves, "stability_number": stability,
+                   "incident_Tp_s": incident_peak_period_at_toe(waves_report),
+                   "reflection_coefficient": reflection_at_toe(waves_report)})
     if "hudson" in result:
         result["hudson"]["ratio"] = stability / result["hudson"]["stability_number"]
     if unit_kind in ("cube", "antifer_cube") and period and waves and math.isfinite(period):

@@ -28,7 +28,8 @@ from riprap import schema
 from riprap.errors import CaseFileError
 from riprap.waves.theory import group_velocity, jonswap_spectrum, wave_length
 
-__all__ = ["StepSea", "step_seas", "step_case_text", "mean_zero_crossing_period"]
+__all__ = ["StepSea", "step_seas", "step_case_text", "step_case_data", "case_text",
+           "mean_zero_crossing_period"]
 
 #: Peak periods a step runs on after its sea has passed the structure, when [series] settle_time
 #: is 0: the last waves' run-up and run-down, and the units they moved coming to rest.
@@ -96,10 +97,12 @@ def step_seas(case, seed_offset: int = 0) -> list[StepSea]:
     return seas
 
 
-def step_case_text(case, sea: StepSea) -> str:
-    """The case file of one step: the series case's text as TOML with the step's sea in
-    ``[waves]``, its end time, no ``[series]`` tables, and every file path made absolute (the step's
-    case lives in the step's folder)."""
+def step_case_data(case, sea: StepSea, gain: float = 1.0, period_factor: float = 1.0) -> dict:
+    """The case of one step as TOML data: the series case's with the step's sea in ``[waves]``,
+    its end time, no ``[series]`` tables, and every file path made absolute (the step's case
+    lives in the step's folder). ``gain`` and ``period_factor``: the wave maker's calibration
+    (``riprap.workflows.series_calibration``): the sea is made with Hm0 x gain and Tp x
+    period_factor so that the one asked arrives at the toe."""
     path = Path(case.source)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
@@ -108,15 +111,19 @@ def step_case_text(case, sea: StepSea) -> str:
                             f"({error})") from None
     data.pop("series", None)
     data.pop("series_steps", None)
-    data["waves"].update(significant_height=sea.significant_height, peak_period=sea.peak_period,
+    period = sea.peak_period * period_factor
+    data["waves"].update(significant_height=sea.significant_height * gain, peak_period=period,
                          peak_enhancement=sea.peak_enhancement, seed=sea.seed,
-                         duration=max(sea.duration, SPECTRUM_PERIODS * sea.peak_period),
+                         duration=max(sea.duration, SPECTRUM_PERIODS * period),
                          stop_time=sea.duration)
     data["simulation"]["end_time"] = sea.end_time
     _absolute_paths(data, case.base_dir)
-    lines = [f"# riprap test series {path.name}: step {sea.number} (Hm0 = "
-             f"{sea.significant_height:g} m, Tp = {sea.peak_period:.4g} s); written by riprap, "
-             "the series case is the one to edit"]
+    return data
+
+
+def case_text(data: dict, header: str) -> str:
+    """TOML data written as a case file, ``header`` its first comment line."""
+    lines = [f"# {header}"]
     lines += [f"{name} = {schema.format_toml_value(value)}" for name, value in data.items()
               if not isinstance(value, (dict, list)) or (isinstance(value, list) and not
                                                          all(isinstance(v, dict) for v in value))]
@@ -127,6 +134,16 @@ def step_case_text(case, sea: StepSea) -> str:
             for entry in value:
                 lines += ["", f"[[{name}]]"] + _pairs(entry)
     return "\n".join(lines) + "\n"
+
+
+def step_case_text(case, sea: StepSea, gain: float = 1.0, period_factor: float = 1.0) -> str:
+    """The case file of one step (``step_case_data`` written out)."""
+    maker = ("" if gain == 1.0 and period_factor == 1.0 else
+             f"; the wave maker calibrated: Hm0 x {gain:.4f}, Tp x {period_factor:.4f}")
+    return case_text(step_case_data(case, sea, gain, period_factor),
+                     f"riprap test series {Path(case.source).name}: step {sea.number} (Hm0 = "
+                     f"{sea.significant_height:g} m, Tp = {sea.peak_period:.4g} s{maker}); "
+                     "written by riprap, the series case is the one to edit")
 
 
 def _pairs(table: dict) -> list[str]:

@@ -39,12 +39,18 @@ COLUMN_NAMES = {
     "van_der_meer_cubes_N_od": "Van der Meer (1988) N_od, cubes",
     "eurotop_crest_width_factor": "EurOtop C_r (crest width)",
     "eurotop_q_m3_s_m": "EurOtop q (m^3/s per m)",
+    "asked_Hm0_m": "Hm0 asked (m)",
+    "asked_Tp_s": "Tp asked (s)",
+    "Tp_s": "Tp at the toe (s)",
+    "reflection_coefficient": "K_r (reflection)",
+    "wave_maker_gain": "wave maker gain on Hm0",
 }
 #: A mean overtopping discharge below this (m^3/s per m, 1e-6 l/s per m: a few drops over a
 #: test) is drawn as none: a log axis down to round-off would hide the rest.
 DRY_Q = 1e-9
 #: Columns measured in the flume (a NaN there: "not measured"); the others are computed.
-MEASURED_COLUMNS = ("Hm0_m", "Tm_s", "stability_number", "q_m3_s_m")
+MEASURED_COLUMNS = ("Hm0_m", "Tm_s", "stability_number", "q_m3_s_m", "Tp_s",
+                    "reflection_coefficient")
 #: The formulas' start of damage (``formulas.start_of_damage``) in words.
 START_NAMES = {"hudson_stability_number": "Hudson's N_s (no damage)",
                "single_layer_cubes_start": "single-layer cubes' start of damage, N_s",
@@ -299,8 +305,14 @@ def write_series_report(out, results: dict) -> dict:
     for step in results["steps"]:
         folder = Path(step["folder"])
         relative = folder.name
+        maker = step.get("wave_maker")
+        calibrated = ("" if not maker else
+                      f" (the wave maker at Hm0 x {maker['gain']:.3f}: the calibration run "
+                      f"without the structure saw {maker['measured_Hm0_m']:.4g} m, "
+                      f"{maker['measured_Tp_s']:.3g} s at the toe)")
         parts.append(f"<h3>Step {step['step']}: target Hm0 {step['target_Hm0_m']:g} m, Tp "
-                     f"{step['Tp_s']:.3g} s</h3><p><a href='{relative}/survey/report.html'>survey "
+                     f"{step['Tp_s']:.3g} s{html.escape(calibrated)}</h3>"
+                     f"<p><a href='{relative}/survey/report.html'>survey "
                      f"report</a> · <a href='{relative}/survey/per_wave.csv'>per-wave table</a> · "
                      f"<a href='{relative}/survey/units.csv'>units</a></p>")
         for picture in sorted((folder / "survey").glob("*.png")):

@@ -35,7 +35,7 @@ from riprap.waves.theory import GRAVITY, wave_number
 __all__ = ["WaveStatistics", "wave_statistics", "ReflectionAnalysis", "separate_incident_reflected",
            "separate_regular_wave", "separate_three_gauges", "harmonic_amplitude",
            "even_record", "zero_down_crossing_heights", "variance_density", "three_gauge_split",
-           "gauge_spectra"]
+           "gauge_spectra", "smoothed_peak_period"]
 
 # The band of the Goda-Suzuki split: where the gauge spacing is within this fraction of a wave length.
 _GODA_SUZUKI_BAND = (0.05, 0.45)
@@ -152,11 +152,29 @@ class ReflectionAnalysis:
     reflected_hm0: float         # m
     reflection_coefficient: float
     band: tuple                  # (lowest, highest) frequency used (Hz)
+    #: the incident spectrum's peak period (s) by Read's Fp5 (irregular three-gauge splits only)
+    incident_peak_period: float | None = None
 
     def as_dict(self) -> dict:
-        return {"incident_Hm0_m": self.incident_hm0, "reflected_Hm0_m": self.reflected_hm0,
-                "reflection_coefficient": self.reflection_coefficient,
-                "band_Hz": list(self.band)}
+        entry = {"incident_Hm0_m": self.incident_hm0, "reflected_Hm0_m": self.reflected_hm0,
+                 "reflection_coefficient": self.reflection_coefficient,
+                 "band_Hz": list(self.band)}
+        if self.incident_peak_period is not None:
+            entry["incident_Tp_s"] = self.incident_peak_period
+        return entry
+
+
+def smoothed_peak_period(frequencies, energies) -> float:
+    """The peak period (s) of a spectrum given as energies per frequency, by Read's (1988)
+    Fp5 = sum f E^5 / sum E^5: the raw periodogram of a few dozen waves puts its highest bin
+    several per cent either side of the sea's peak, the fifth power weighs the bins near the
+    top and averages over them (the IAHR list of sea state parameters, 1989, names it)."""
+    frequencies = np.asarray(frequencies, dtype=float)
+    weights = np.asarray(energies, dtype=float) ** 5
+    total = float(np.sum(weights))
+    if not total > 0.0:
+        return float("nan")
+    return float(total / np.sum(weights * frequencies))
 
 
 def separate_incident_reflected(times, eta_1, eta_2, spacing: float, depth: float,
@@ -283,7 +301,7 @@ def separate_three_gauges(times, records, positions, depth: float,
     t, frequencies, spectra, peak_period = gauge_spectra(times, records, peak_period)
     fp = 1.0 / peak_period
     energy_incident = energy_reflected = 0.0
-    used = []
+    used, incident_energies = [], []
     for m, f in enumerate(frequencies):
         if m == 0 or not band[0] * fp <= f <= band[1] * fp:
             continue
@@ -293,6 +311,7 @@ def separate_three_gauges(times, records, positions, depth: float,
         energy_incident += 0.5 * abs(split[0]) ** 2
         energy_reflected += 0.5 * abs(split[1]) ** 2
         used.append(f)
+        incident_energies.append(0.5 * abs(split[0]) ** 2)
     if not used:
         raise CaseFileError(f"wave analysis: no frequency near the peak ({fp:.3g} Hz) can be split "
                             f"with gauges at x = {positions.tolist()} m over a record of "
@@ -301,7 +320,8 @@ def separate_three_gauges(times, records, positions, depth: float,
                               reflected_hm0=4.0 * math.sqrt(energy_reflected),
                               reflection_coefficient=math.sqrt(energy_reflected / energy_incident)
                               if energy_incident > 0 else float("nan"),
-                              band=(used[0], used[-1]))
+                              band=(used[0], used[-1]),
+                              incident_peak_period=smoothed_peak_period(used, incident_energies))
 
 
 def harmonic_amplitude(times, eta, period: float) -> complex:

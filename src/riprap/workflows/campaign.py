@@ -47,6 +47,10 @@ from riprap.io.csv_tables import write_columns_csv
 from riprap.io.log_file import append_log_lines, log_size, read_new_log_lines
 from riprap.work_estimate import duration_words, warning_line
 from riprap.workflows.series import check_series, run_series, series_wall_seconds
+from riprap.case.series_steps import step_seas
+from riprap.workflows.series_calibration import (calibrate_step, calibration_cost_seconds,
+                                                 calibration_folder,
+                                                 read_calibration, write_calibration)
 from riprap.workflows.series_progress import SERIES_LOG
 from riprap.workflows.series_record import (RUN_MODES, mode_words, run_mode, series_fingerprint,
                                             smoke_note)
@@ -94,10 +98,8 @@ def members_of(case_files, seeds=(0,)) -> list[Member]:
     return members
 
 
-def _run_member(case_file: str, folder: str, seed_offset: int, threads: int,
-                mode: str = "full") -> dict:
-    """A member on a worker: its series, with ``threads`` numba threads (no progress bar), in the
-    campaign's run ``mode`` whatever the worker's own environment says."""
+def _on_worker(threads: int, mode: str) -> None:
+    """A worker set to the campaign's run ``mode`` and ``threads`` numba threads."""
     import numba
 
     if mode == "smoke":
@@ -105,11 +107,82 @@ def _run_member(case_file: str, folder: str, seed_offset: int, threads: int,
     else:
         os.environ.pop("RIPRAP_SMOKE", None)
     numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+
+
+def _run_member(case_file: str, folder: str, seed_offset: int, threads: int,
+                mode: str = "full", calibration_directory: str | None = None) -> dict:
+    """A member on a worker: its series, with ``threads`` numba threads (no progress bar), in the
+    campaign's run ``mode`` whatever the worker's own environment says."""
+    _on_worker(threads, mode)
     lines = []
     results = run_series(load_case(case_file), output_directory=folder, progress=False,
-                         say=lines.append, seed_offset=seed_offset, log_warnings=True)
+                         say=lines.append, seed_offset=seed_offset, log_warnings=True,
+                         calibration_directory=calibration_directory)
     results["log"] = lines
     return results
+
+
+def _calibrate_on_worker(case_file: str, folder: str, step: int, threads: int,
+                         mode: str) -> list[str]:
+    """One step's wave calibration on a worker; returns its messages."""
+    _on_worker(threads, mode)
+    case = load_case(case_file)
+    lines = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")     # the checks said them before the workers started
+        calibrate_step(case, step_seas(case, 0)[step - 1], folder, say=lines.append)
+    return lines
+
+
+def calibration_directories(members: list[Member], cases: dict, out: Path) -> dict:
+    """Per case file whose series calibrates its waves, the calibration's folder: ``[series]
+    wave_calibration_folder``, else ``calibration_<case name>`` in the campaign's folder (every
+    member of the case shares it)."""
+    folders = {}
+    for member in members:
+        case = cases[member.case_file]
+        if case.series.wave_calibration != "none":
+            folders[member.case_file] = (
+                calibration_folder(case, out) if case.series.wave_calibration_folder
+                else out / f"calibration_{member.case_file.stem}")
+    return folders
+
+
+def _calibrate(client, cases: dict, folders: dict, threads: int, logs) -> None:
+    """Every step of every case's wave calibration as Dask tasks at once (the steps do not
+    depend on each other), then each case's ``calibration.json``; a calibration kept before
+    is read, not run again."""
+    if run_mode() == "smoke" or not folders:
+        if folders:
+            logs.say("riprap: a smoke campaign makes no wave calibration: the steps run at the "
+                     "wave maker's gain 1")
+        return
+    futures = {}
+    for case_file, folder in folders.items():
+        case = cases[case_file]
+        done = read_calibration(case, folder)
+        for sea in step_seas(case, 0):
+            if sea.number not in done:
+                futures[(case_file, sea.number)] = client.submit(
+                    _calibrate_on_worker, str(case_file), str(folder), sea.number, threads,
+                    run_mode(), key=f"riprap-calibrate-{case_file.stem}-{sea.number}", pure=False)
+    if futures:
+        logs.say(f"riprap: wave calibration of {len(futures)} steps on the workers first (the "
+                 "members run after it)")
+    failed = []
+    for (case_file, number), future in futures.items():
+        try:
+            for line in future.result():
+                logs.say(f"[{case_file.stem} calibration] {line}")
+        except Exception as error:  # noqa: BLE001 - said with the step, then the campaign stops
+            failed.append(f"{case_file.stem} step {number}: {error}")
+    if failed:
+        raise RiprapError("the wave calibration failed (" + "; ".join(failed) + "): no member "
+                          "was started; mend the cause and start the same command again")
+    for case_file, folder in folders.items():
+        case = cases[case_file]
+        made = read_calibration(case, folder)
+        write_calibration(case, folder, [made[k] for k in sorted(made)])
 
 
 def _client(scheduler: str | None, workers: int, threads: int):
@@ -200,7 +273,8 @@ def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int =
             if not case.is_series:
                 raise CaseFileError(f"{member.case_file}: a campaign member is a test series: "
                                     "the case needs [series] and [[series_steps]]")
-            check_series(case, out / member.name, member.seed_offset)
+            check_series(case, out / member.name, member.seed_offset,
+                         calibration_directories([member], cases, out).get(member.case_file))
     fingerprints = [series_fingerprint(cases[m.case_file]) for m in members]
     growth = _claim(out, members, fingerprints)      # before any worker starts
     own_cluster = None
@@ -218,8 +292,13 @@ def run_campaign(members: list[Member], out, *, workers: int = 2, threads: int =
                  + (f"; {mode_words('smoke')}" if run_mode() == "smoke" else "")
                  + f"; progress in {out / CAMPAIGN_LOG}")
         logs.say(f"riprap: {campaign_cost(members, cases, workers)}")
+        calibrations = calibration_directories(members, cases, out)
+        _calibrate(client, cases, calibrations, threads, logs)
         futures = [client.submit(_run_member, str(m.case_file), str(out / m.name), m.seed_offset,
-                                 threads, run_mode(), key=f"riprap-{m.name}", pure=False)
+                                 threads, run_mode(),
+                                 None if m.case_file not in calibrations
+                                 else str(calibrations[m.case_file]),
+                                 key=f"riprap-{m.name}", pure=False)
                    for m in members]
         results, failed = {}, {}
         waiting = dict(zip(members, futures))
@@ -272,12 +351,20 @@ def campaign_cost(members: list[Member], cases: dict, workers: int) -> str:
     busy = [0.0] * max(1, min(workers, len(members)))
     for cost in costs:
         busy[busy.index(min(busy))] += cost
+    calibrated = {m.case_file for m in members
+                  if cases[m.case_file].series.wave_calibration != "none"}
+    calibration = sum(calibration_cost_seconds(cases[f])[0] for f in calibrated)
+    workers_used = max(1, min(workers, sum(len(cases[f].series_steps) for f in calibrated) or 1))
+    calibration_words = ("" if not calibrated else
+                         f"; first the wave calibration, about "
+                         f"{duration_words(calibration / workers_used)} on the workers")
     return (f"cost: about {duration_words(max(busy))} of wall time for the campaign: "
             f"{len(members)} members of about {duration_words(min(costs))}"
             + (f" to {duration_words(max(costs))}" if duration_words(max(costs))
                != duration_words(min(costs)) else "")
             + f" each (2 cores per member, examples/10's measured pace, within a factor of "
-            f"2-3) on {len(busy)} worker{'s' if len(busy) > 1 else ''} at once")
+            f"2-3) on {len(busy)} worker{'s' if len(busy) > 1 else ''} at once"
+            + calibration_words)
 
 
 class _MemberLogs:

@@ -42,6 +42,9 @@ from riprap.io.csv_tables import read_columns_csv, write_columns_csv
 from riprap.io.series_report import write_series_report
 from riprap.workflows.analyse import analyse
 from riprap.work_estimate import duration_words, flume_run_seconds
+from riprap.workflows.series_calibration import (HEIGHT_TOLERANCE, PERIOD_TOLERANCE,
+                                                 calibrate_series, calibration_cost_seconds,
+                                                 calibration_folder, read_calibration)
 from riprap.workflows.series_progress import SERIES_LOG, SeriesLog, StepProgress
 from riprap.workflows.series_record import (SERIES_RECORD, claim_series_folder, run_mode,
                                             smoke_note, series_fingerprint, series_record,
@@ -62,15 +65,20 @@ class _Step:
     text: str
     case: object
     folder: Path
+    maker: object = None        # the wave maker's calibration of the step (None: gain 1)
 
 
-def _steps(case, out: Path, seed_offset: int = 0) -> list[_Step]:
+def _steps(case, out: Path, seed_offset: int = 0, calibration: dict | None = None
+           ) -> list[_Step]:
     """Every step's sea, case text and case, each checked as ``riprap run`` checks a flume (the
-    flume can carry the sea) before anything runs."""
+    flume can carry the sea) before anything runs; ``calibration``: the wave maker's per step
+    (``riprap.workflows.series_calibration``), by step number."""
     steps = []
     for sea in step_seas(case, seed_offset):
         folder = step_folder(out, sea.number)
-        text = step_case_text(case, sea)
+        maker = (calibration or {}).get(sea.number)
+        text = (step_case_text(case, sea) if maker is None
+                else step_case_text(case, sea, maker.gain, maker.period_factor))
         where = (f"{case.source} [[series_steps]] step {sea.number} (Hm0 = "
                  f"{sea.significant_height:g} m, Tp = {sea.peak_period:.3g} s)")
         try:
@@ -79,7 +87,7 @@ def _steps(case, out: Path, seed_offset: int = 0) -> list[_Step]:
         except CaseFileError as error:
             message = str(error).replace(str(folder / "step.toml"), "step.toml")
             raise CaseFileError(f"{where}: {message}") from None
-        steps.append(_Step(sea, text, step_case, folder))
+        steps.append(_Step(sea, text, step_case, folder, maker))
     return steps
 
 
@@ -91,9 +99,11 @@ def _record(case, steps: list[_Step], seed_offset: int = 0) -> dict:
         seed_offset)
 
 
-def check_series(case, output_directory=None, seed_offset: int = 0) -> list[str]:
+def check_series(case, output_directory=None, seed_offset: int = 0,
+                 calibration_directory=None) -> list[str]:
     """Every check ``run_series`` makes before it runs (each step's flume, the bodies of the
-    first step, the output folder's series record); returns what was checked, in words."""
+    first step, the output folder's series record, a wave calibration kept before); returns what
+    was checked, in words."""
     out = Path(output_directory or case.output.directory)
     steps = _steps(case, out, seed_offset)
     first = build_fluid_run(steps[0].case, output_directory=steps[0].folder, progress=False)
@@ -104,11 +114,31 @@ def check_series(case, output_directory=None, seed_offset: int = 0) -> list[str]
             + ", ".join(f"{s.sea.significant_height:g}" for s in steps) + " m",
             f"cost: about {duration_words(seconds)} of wall time for the series ({basis}); a "
             "campaign runs one member (series) per worker at once",
+            *_calibration_lines(case, out, calibration_directory),
             f"bodies of the first step ({case.body_count})",
             *([] if layer is None
               else [f"filter layer: {line}" for line in layer.lines(entries=False)]),
             f"the series folder {out} (a series of this case, run mode and riprap version, or "
             "none)" + (f": {claim.note}" if claim.note else "")]
+
+
+def _calibration_lines(case, out: Path, calibration_directory=None) -> list[str]:
+    """What wave calibration the series will run, and its cost, in words."""
+    if case.series.wave_calibration == "none":
+        return ["wave calibration: none ([series] wave_calibration = \"none\"): the wave maker "
+                "makes the asked sea; the steps' incident Hm0 at the toe is what the flume lets "
+                "through"]
+    folder = Path(calibration_directory or calibration_folder(case, out))
+    done = read_calibration(case, folder)       # refuses a folder of another flume or sea
+    seconds, runs = calibration_cost_seconds(case)
+    count = len(case.series_steps)
+    return [f"wave calibration: each step's sea run first without the bodies until the incident "
+            f"Hm0 at the toe is within {HEIGHT_TOLERANCE:.0%} and Tp within "
+            f"{PERIOD_TOLERANCE:.0%} of the asked ones, kept in {folder}: "
+            + (f"{len(done)} of {count} steps calibrated before; " if done else "")
+            + f"about {runs} runs, {duration_words(seconds)} of wall time for the {count} "
+            f"step{'s' if count > 1 else ''} "
+            "(two runs a step, one cell across the flume where nothing varies across it)"]
 
 
 def series_wall_seconds(case, seed_offset: int = 0) -> tuple[float, str]:
@@ -129,22 +159,26 @@ def series_wall_seconds(case, seed_offset: int = 0) -> tuple[float, str]:
 
 
 def run_series(case, *, output_directory=None, progress: bool = True, say=print,
-               seed_offset: int = 0, log_warnings: bool = False) -> dict:
+               seed_offset: int = 0, log_warnings: bool = False,
+               calibration_directory=None) -> dict:
     """Run the test series of ``case`` (a case with ``[series]``) into ``output_directory``
     (default ``[output] directory``), every step's seed raised by ``seed_offset`` (a campaign's
     member); returns the series results (``series_results.json``). Every message is said
     (``say``) and kept in the folder's ``series.log`` with each step's progress;
     ``log_warnings``: warnings go there too, as ``riprap: warning:`` lines, instead of being
-    printed by Python (a campaign's worker)."""
+    printed by Python (a campaign's worker). ``calibration_directory``: the wave calibration's
+    folder (``[series] wave_calibration``; default ``series_calibration.calibration_folder``)."""
     log = SeriesLog(say)
     if not log_warnings:
-        return _run_series(case, output_directory, progress, log, seed_offset)
+        return _run_series(case, output_directory, progress, log, seed_offset,
+                           calibration_directory)
     with log.warnings_logged():
-        return _run_series(case, output_directory, progress, log, seed_offset)
+        return _run_series(case, output_directory, progress, log, seed_offset,
+                           calibration_directory)
 
 
 def _run_series(case, output_directory, progress: bool, say: SeriesLog,
-                seed_offset: int) -> dict:
+                seed_offset: int, calibration_directory=None) -> dict:
     if not case.is_series:
         raise CaseFileError(f"{case.source}: has no [series] table: run it with riprap run")
     out = Path(output_directory or case.output.directory)
@@ -158,6 +192,11 @@ def _run_series(case, output_directory, progress: bool, say: SeriesLog,
         set_smoke_steps_aside(out)
     say.open(out / SERIES_LOG)
     write_json(out / SERIES_RECORD, record)
+    if case.series.wave_calibration != "none":
+        folder = Path(calibration_directory or calibration_folder(case, out))
+        made = {c.step: c for c in calibrate_series(case, folder, say=say)}
+        if made:
+            steps = _steps(case, out, seed_offset, made)
     total = sum(s.sea.end_time for s in steps)
     simulated, wall = 0.0, 0.0
     for index, step in enumerate(steps):
@@ -178,6 +217,9 @@ def _run_series(case, output_directory, progress: bool, say: SeriesLog,
             say(f"riprap: series step {sea.number}/{len(steps)}: Hm0 = {sea.significant_height:g} "
                 f"m, Tp = {sea.peak_period:.3g} s, {sea.duration:.4g} s of sea"
                 + (f" (~{sea.waves} waves)" if sea.waves else "")
+                + ("" if step.maker is None else
+                   f", the wave maker at Hm0 x {step.maker.gain:.3f}, Tp x "
+                   f"{step.maker.period_factor:.3f} (calibrated)")
                 + f", {sea.end_time:.4g} s simulated{to_go}")
             started = wallclock.perf_counter()
             _run_step(step, steps[index - 1] if index else None, len(steps), progress,
@@ -247,11 +289,13 @@ def _survey(step: _Step, first: Path, case, say) -> None:
 def _series_results(out: Path, steps: list[_Step], case) -> dict:
     """The damage curve from every step's survey and per-wave table, beside the formulas."""
     rows, flume, per_wave, counted_so_far, unmeasured = [], {}, {}, 0, {}
+    measured_at_toe = []
     for step in steps:
         folder = step.folder
         layer = read_json_object(folder / "survey" / "layer_summary.json", "layer summary",
                                  "riprap series wrote it after the step")
         flume = layer.get("flume_test") or {}
+        measured_at_toe.append(flume)
         if not isinstance(flume.get("Hm0_m"), (int, float)):
             unmeasured[step.sea.number] = _why_not_measured(flume)
         waves = {"overtopping_m3_per_m": [], "wave": []}
@@ -282,6 +326,15 @@ def _series_results(out: Path, steps: list[_Step], case) -> dict:
                            delta=float(flume.get("relative_density", math.nan)),
                            slope_cot=float(flume.get("slope_cot", math.nan)), freeboard=freeboard,
                            crest_width=crest_width, crest_width_source=crest_width_source)
+    # asked against measured, per step (the wave maker's calibration, issue 54)
+    curve = results["curve"]
+    curve["asked_Hm0_m"] = [s.sea.significant_height for s in steps]
+    curve["asked_Tp_s"] = [s.sea.peak_period for s in steps]
+    curve["Tp_s"] = [_number(m.get("incident_Tp_s")) for m in measured_at_toe]
+    curve["reflection_coefficient"] = [_number(m.get("reflection_coefficient"))
+                                       for m in measured_at_toe]
+    curve["wave_maker_gain"] = [s.maker.gain if s.maker is not None else 1.0 for s in steps]
+    results["wave_calibration"] = case.series.wave_calibration
     results["per_wave"] = per_wave
     results["run_mode"] = run_mode()
     if results["run_mode"] != "full":
@@ -290,6 +343,7 @@ def _series_results(out: Path, steps: list[_Step], case) -> dict:
     results["displacement_threshold_over_dn"] = case.series.displacement_threshold
     results["steps"] = [{"step": s.sea.number, "folder": str(s.folder),
                          "target_Hm0_m": s.sea.significant_height, "Tp_s": s.sea.peak_period,
+                         "wave_maker": (None if s.maker is None else s.maker.as_dict()),
                          "target_waves": s.sea.waves, "sea_duration_s": s.sea.duration,
                          "wave_height_not_measured": unmeasured.get(s.sea.number)}
                         for s in steps]
