@@ -12,7 +12,8 @@ normal 85 % quantile, so that the two given numbers are reproduced exactly. The 
 interpolates standard gradings with a Rosin-Rammler curve in mass,
 ``M_y = M_50 (ln(1 - y) / ln 0.5)^(1/n_RRM)`` (p. 113, as coded in Sander-w/breakwater
 ``material.py``, see shared/validation/armour_design.md section 5.3); both are two-parameter
-curves through the same two anchor points and differ in the tails only. A log-normal distribution
+curves through the same two anchor points and differ in the tails only (the Rosin-Rammler curve,
+the EN 13383 classes and their checks are in ``armour_stone.py``). A log-normal distribution
 by mass is log-normal by count too, with the same ``sigma`` and mean ``ln D_n50 - 3 sigma^2`` (each
 stone weighs ``rho D_n^3``), which is what :meth:`RockGrading.sample` draws from: a set of sampled
 stones has the grading's mass curve.
@@ -39,6 +40,36 @@ _MAX_SPREAD = 5.0
 
 # Random rocks: number of hull points (shapes.random_rock's default).
 _ROCK_VERTICES = 24
+
+
+def checked_spread(value: object, where: str, name: str = "dn85_over_dn15",
+                   widest: float = _MAX_SPREAD,
+                   meaning: str = "a ratio of nominal diameters, not of masses") -> float:
+    """A spread (by default ``D_n85 / D_n15``) as a number in 1 .. ``widest``.
+
+    A mass ratio ``M85 / M15`` typed where the ratio of nominal diameters is meant is its cube, and
+    is refused above ``_MAX_SPREAD``. ``where`` and ``name`` head the message, ``meaning`` says
+    what the ratio is.
+    """
+    try:
+        spread = float(value)
+    except (TypeError, ValueError) as error:
+        raise CaseFileError(f"{where}: {name} must be a number, got {value!r}") from error
+    if not (np.isfinite(spread) and 1.0 <= spread <= widest):
+        raise CaseFileError(f"{where}: {name} must lie in 1..{widest:g} ({meaning}), got {spread}")
+    return spread
+
+
+def checked_draw(count: object, rng: object, where: str) -> int:
+    """The number of stones to draw, an integer >= 0, and ``rng`` a numpy Generator."""
+    if int(count) != count or count < 0:
+        raise CaseFileError(f"{where}: count must be an integer >= 0, got {count}")
+    if not isinstance(rng, np.random.Generator):
+        raise CaseFileError(
+            f"{where}: rng must be a numpy.random.Generator "
+            f"(numpy.random.default_rng(seed)), got {type(rng).__name__}"
+        )
+    return int(count)
 
 
 def _standard_normal_quantile(probability: np.ndarray) -> np.ndarray:
@@ -69,24 +100,17 @@ class RockGrading:
     dn85_over_dn15: float
 
     def __post_init__(self) -> None:
-        for name in ("dn50", "dn85_over_dn15"):
-            value = getattr(self, name)
-            try:
-                value = float(value)
-            except (TypeError, ValueError) as error:
-                raise CaseFileError(
-                    f"RockGrading: {name} must be a number, got {value!r}"
-                ) from error
-            object.__setattr__(self, name, value)
+        try:
+            dn50 = float(self.dn50)
+        except (TypeError, ValueError) as error:
+            raise CaseFileError(f"RockGrading: dn50 must be a number, got {self.dn50!r}") from error
+        object.__setattr__(self, "dn50", dn50)
         if not (np.isfinite(self.dn50) and self.dn50 > 0.0):
             raise CaseFileError(
                 f"RockGrading: dn50 must be a positive length in m, got {self.dn50}"
             )
-        if not (np.isfinite(self.dn85_over_dn15) and 1.0 <= self.dn85_over_dn15 <= _MAX_SPREAD):
-            raise CaseFileError(
-                f"RockGrading: dn85_over_dn15 must lie in 1..{_MAX_SPREAD:g} (a ratio of nominal "
-                f"diameters, not of masses), got {self.dn85_over_dn15}"
-            )
+        object.__setattr__(self, "dn85_over_dn15",
+                           checked_spread(self.dn85_over_dn15, "RockGrading"))
 
     @property
     def log_spread(self) -> float:
@@ -121,16 +145,10 @@ class RockGrading:
         -------
         numpy.ndarray, shape (count,)
         """
-        if int(count) != count or count < 0:
-            raise CaseFileError(f"RockGrading.sample: count must be an integer >= 0, got {count}")
-        if not isinstance(rng, np.random.Generator):
-            raise CaseFileError(
-                f"RockGrading.sample: rng must be a numpy.random.Generator "
-                f"(numpy.random.default_rng(seed)), got {type(rng).__name__}"
-            )
+        count = checked_draw(count, rng, "RockGrading.sample")
         sigma = self.log_spread
         count_median = np.log(self.dn50) - 3.0 * sigma**2
-        return np.exp(rng.normal(count_median, sigma, size=int(count)))
+        return np.exp(rng.normal(count_median, sigma, size=count))
 
     def size_classes(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """``n`` representative sizes and how often to draw each (by count).
