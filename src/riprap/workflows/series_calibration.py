@@ -178,6 +178,7 @@ def calibration_case_text(case, sea: StepSea, gain: float, period_factor: float)
     data["gauges"] = [g for g in data.get("gauges", []) if g.get("type") == "surface"]
     data.get("output", {}).pop("body_forces_interval", None)
     fluid = data["fluid"]
+    fluid.pop("contact_only_below_cells", None)     # no bodies: nothing is contact-only
     if _uniform_across(data):
         cells = list(fluid["cells"])
         low = float(fluid["lower"][1])
