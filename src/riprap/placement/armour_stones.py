@@ -37,7 +37,7 @@ from riprap.errors import CaseFileError
 from riprap.limits import START_OVERLAP_FRACTION
 from riprap.placement import layer_metrics
 from riprap.placement.lowering import Surface, VerticalLowering
-from riprap.placement.place import Underlayer, _rock_surfaces, _run_settings, _strip
+from riprap.placement.place import Underlayer, _rock_surfaces, on_underlayer
 from riprap.schema import MAXIMUM_BODY_COUNT
 from riprap.simulation import Simulation
 from riprap.solid.shape import RigidShape
@@ -306,19 +306,7 @@ def _clear_start(slope, stones, underlayer, materials, run, design) -> Simulatio
 
 
 def _layer_simulation(slope, stones, underlayer, materials, run) -> Simulation:
-    sim = Simulation(**_run_settings(run))
-    materials.add_to(sim)
-    for shape in underlayer.shapes:
-        sim.add_shape(shape.name, shape)
-    for shape in stones.shapes:
-        sim.add_shape(shape.name, shape)
-    sim.add_walls(slope.walls(face_material=materials.face.name,
-                              side_material=materials.side_wall.name))
-    _strip(sim, slope)
-    for k in range(len(underlayer.positions)):
-        sim.add_body(shape=underlayer.shapes[underlayer.shape_of_rock[k]].name,
-                     material=materials.rock.name, position=underlayer.positions[k],
-                     orientation=underlayer.quaternions[k], fixed=True, frame="principal")
+    sim = on_underlayer(slope, underlayer, materials, run, stones.shapes)
     for k in range(len(stones.positions)):
         sim.add_body(shape=stones.shapes[stones.shape_of_stone[k]].name,
                      material=materials.unit.name, position=stones.positions[k],

@@ -473,13 +473,14 @@ def _combined_runs(results: list[dict]) -> dict:
     return combined
 
 
-def _placement_simulation(slope, unit_shape, underlayer, state, members, materials,
-                          run) -> Simulation:
+def on_underlayer(slope, underlayer, materials, run, shapes) -> Simulation:
+    """A placement run on the fixed ``underlayer``: its materials, the rocks' ``shapes`` and
+    those of what is placed on them, the slope's walls (a strip's sides wrapping), every rock
+    held fixed (bodies 0 .. n_rocks - 1)."""
     sim = Simulation(**_run_settings(run))
     materials.add_to(sim)
-    for s in underlayer.shapes:
+    for s in list(underlayer.shapes) + list(shapes):
         sim.add_shape(s.name, s)
-    sim.add_shape(unit_shape.name, unit_shape)
     sim.add_walls(slope.walls(face_material=materials.face.name,
                               side_material=materials.side_wall.name))
     _strip(sim, slope)
@@ -487,6 +488,12 @@ def _placement_simulation(slope, unit_shape, underlayer, state, members, materia
         sim.add_body(shape=underlayer.shapes[underlayer.shape_of_rock[k]].name,
                      material=materials.rock.name, position=underlayer.positions[k],
                      orientation=underlayer.quaternions[k], fixed=True, frame="principal")
+    return sim
+
+
+def _placement_simulation(slope, unit_shape, underlayer, state, members, materials,
+                          run) -> Simulation:
+    sim = on_underlayer(slope, underlayer, materials, run, [unit_shape])
     for k in members:
         # New units: orientations apply to the unit's mesh as built (frame "shape"); units carried
         # over from an earlier stage have the solver's principal-frame orientation.
