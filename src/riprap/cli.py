@@ -153,6 +153,9 @@ def _place_case(path: Path, out: str | None, quiet: bool) -> int:
         print(f"riprap: placement case {path}: {case.armour.unit} units on a "
               f"1:{case.slope.cotangent} slope")
     summary = run_placement(case, output_directory=out, progress=not quiet)
+    if case.armour_stone is not None:
+        _say_stone_layer(summary)
+        return 0
     if summary.get("smoke"):
         print(f"riprap: SMOKE MODE: {summary['units_placed']} units placed on "
               f"{summary['underlayer_rocks']} rocks; {summary['smoke_note']}, so none are "
@@ -166,6 +169,26 @@ def _place_case(path: Path, out: str | None, quiet: bool) -> int:
     for key, value in summary["outputs"].items():
         print(f"riprap: {key}: {value}")
     return 0
+
+
+def _say_stone_layer(summary: dict) -> None:
+    """A rock armour placement's layer beside its design, and its stones' grading."""
+    measured, design = summary["measured"], summary["design"]
+    grading = summary["grading"]
+    smoke = " (SMOKE MODE: the runs were cut short; these figures are no layer's)" \
+        if summary.get("smoke") else ""
+    print(f"riprap: {measured['stones_placed']} stones in {design['layers']} layer(s), "
+          f"{measured['stones_rolled_off']} rolled off{smoke}; layer thickness coefficient k_t "
+          f"{_measured(measured['layer_thickness_coefficient'], '{:.3f}')} (design "
+          f"{design['layer_thickness_coefficient']:g}), porosity "
+          f"{_measured(measured['porosity'], '{:.3f}')} (design {design['porosity']:g}), stones "
+          f"per m^2 {_measured(measured['stones_per_area'], '{:.4g}')} (design "
+          f"{design['stones_per_area']:.4g})")
+    print(f"riprap: the stones placed: M50 {grading['placed']['M50_kg']:.4g} kg, M85/M15 "
+          f"{grading['placed']['M85_over_M15']:.3g} (the grading: {grading['asked']['M50_kg']:.4g}"
+          f" kg, {grading['asked']['M85_over_M15']:.3g})")
+    for key, value in summary["outputs"].items():
+        print(f"riprap: {key}: {value}")
 
 
 def _measured(value, form: str) -> str:

@@ -287,6 +287,10 @@ TABLES: tuple[Table, ...] = (
     Table("underlayer", False, 0, None,
           "`riprap place` only: graded rocks dropped on the face, then held fixed."),
     Table("armour", False, 0, None, "`riprap place` only: the armour unit placed on the underlayer."),
+    Table("armour_stone", False, 0, None,
+          "`riprap place` only, instead of [armour] and [placement]: rock armour, graded armour "
+          "stones set down stone by stone on a grid across the slope from the toe up, a layer "
+          "at a time (docs/rock-armour.md)."),
     Table("placement", False, 0, None,
           "`riprap place` only: where the units start, how they are oriented, when they rest."),
     Table("fluid", False, 0, None,
@@ -569,6 +573,52 @@ KEYS: tuple[Key, ...] = (
     Key("armour", "mesh_size", "number", "m",
         "Target tetrahedron edge length; 0 uses the unit's own default.", default=0.0,
         valid_range=_NON_NEGATIVE),
+    # [armour_stone]
+    Key("armour_stone", "material", "string", "-", "Material of the stones.",
+        references="materials"),
+    Key("armour_stone", "grading", "string", "-",
+        "An EN 13383-1 standard grading by name (LMA 5/40, LMA 10/60, LMA 40/200, LMA 15/300, "
+        "LMA 60/300, HMA 300/1000, HMA 1000/3000, HMA 3000/6000, HMA 6000/10000, HMA "
+        "10000/15000; masses of the prototype, kg), scaled by length_scale; empty: dn50 and "
+        "dn85_over_dn15 give the grading.", default=""),
+    Key("armour_stone", "dn50", "number", "m",
+        "Median nominal diameter D_n50 of the model's stones (without a grading name).",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("armour_stone", "dn85_over_dn15", "number", "-",
+        "Spread D_n85 / D_n15 of the stones (without a grading name; a ratio of diameters).",
+        default=1.25, valid_range=Range(minimum=1.0, maximum=5.0)),
+    Key("armour_stone", "length_scale", "number", "-",
+        "Length scale prototype / model of a named grading (1: the prototype itself); the "
+        "stones are scaled keeping H / (Delta D_n), as laboratories scale them.", default=1.0,
+        valid_range=Range(minimum=1.0)),
+    Key("armour_stone", "prototype_water_density", "number", "kg/m^3",
+        "Water density of the prototype (sea water) for the scaling of a named grading.",
+        default=1025.0, valid_range=Range(minimum=900.0, maximum=1100.0)),
+    Key("armour_stone", "layers", "integer", "-", "Layers of stones (2: a double layer).",
+        default=2, valid_range=Range(minimum=1, maximum=2)),
+    Key("armour_stone", "placement", "string", "-",
+        "standard (each stone set down where it comes, at a random orientation) or dense (each "
+        "stone turned to the orientation that sets it deepest into the gaps), the Rock "
+        "Manual's two placements.", default="standard", choices=("standard", "dense")),
+    Key("armour_stone", "porosity", "number", "-",
+        "Design porosity n_v of the layer, which sets the stones per area N_a = n k_t (1 - n_v) "
+        "/ D_n50^2 (0.37: Shore Protection Manual 1984, Table 7-13).", default=0.37,
+        valid_range=Range(minimum=0.1, maximum=0.6)),
+    Key("armour_stone", "stone_shapes", "integer", "-", "Distinct random stone shapes.",
+        default=8, valid_range=Range(minimum=1, maximum=64)),
+    Key("armour_stone", "size_classes", "integer", "-",
+        "Size classes of the grading the shapes stand for (at most stone_shapes).", default=3,
+        valid_range=Range(minimum=1, maximum=16)),
+    Key("armour_stone", "from_s", "number", "m", "Lower end of the armour along the face.",
+        default=0.0, valid_range=_NON_NEGATIVE),
+    Key("armour_stone", "to_s", "number", "m",
+        "Upper end of the armour along the face; 0: the whole face.", default=0.0,
+        valid_range=_NON_NEGATIVE),
+    Key("armour_stone", "settle_time", "number", "s",
+        "Longest simulated time to let each layer of stones settle.", default=2.0,
+        valid_range=_POSITIVE),
+    Key("armour_stone", "seed", "integer", "-", "Seed of stone shapes, choices and orientations.",
+        default=0, valid_range=_NON_NEGATIVE),
     # [placement]
     Key("placement", "grid_file", "string", "-",
         "CSV grid of unit centroids (x, y, z; optional qw, qx, qy, qz or roll, pitch, yaw; "

@@ -19,7 +19,10 @@ Tables = dict
 DESIGN_GRID_KEYS = ("rows", "units_per_row", "units_per_alternate_row",
                     "packing_density_coefficient", "first_row_s", "drop_height")
 #: Tables only ``riprap place`` reads.
-PLACEMENT_TABLES = ("slope", "underlayer", "armour", "placement")
+PLACEMENT_TABLES = ("slope", "underlayer", "armour", "placement", "armour_stone")
+#: The tables of a placement of units, and of one of rock armour.
+UNIT_PLACEMENT_TABLES = ("slope", "underlayer", "armour", "placement")
+STONE_PLACEMENT_TABLES = ("slope", "underlayer", "armour_stone")
 
 
 def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
@@ -37,7 +40,7 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
                          simulation["checkpoint_interval"]):
         # a placement's runs last their settle_time (the longer one counts), a run its end_time
         ends = [(tables[name]["settle_time"], f"{name}.settle_time")
-                for name in ("underlayer", "placement")
+                for name in ("underlayer", "placement", "armour_stone")
                 if tables.get(name) is not None and ok(tables[name]["settle_time"])]
         end_time, end_key = max(ends) if ends else (simulation["end_time"], "end_time")
         for key, value, message in schedule_problems(
@@ -71,11 +74,17 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
     given_placement = [name for name in PLACEMENT_TABLES if tables.get(name) is not None]
     has_bodies = bool(tables.get("bodies")) or bool(tables.get("body_grids"))
     if given_placement:
-        missing = [f"[{name}]" for name in PLACEMENT_TABLES if tables.get(name) is None]
+        stones = tables.get("armour_stone") is not None
+        if stones and (tables.get("armour") is not None or tables.get("placement") is not None):
+            add(("armour_stone",), "rock armour ([armour_stone]) or armour units ([armour] and "
+                "[placement]), not both: one layer is placed per case")
+        needed = STONE_PLACEMENT_TABLES if stones else UNIT_PLACEMENT_TABLES
+        missing = [f"[{name}]" for name in needed if tables.get(name) is None]
         if missing:
             add((given_placement[0],),
-                f"an armour placement (riprap place) needs [slope], [underlayer], [armour] and "
-                f"[placement]; missing: {', '.join(missing)}")
+                "an armour placement (riprap place) needs "
+                + (", ".join(f"[{name}]" for name in needed))
+                + f"; missing: {', '.join(missing)}")
         if tables.get("fluid") is not None:
             add(("fluid",), "a case is either an armour placement ([slope], [underlayer], [armour], "
                 "[placement]; riprap place) or a fluid run ([fluid]; riprap run), not both: place "
@@ -91,7 +100,38 @@ def check_cross_rules(tables: Tables, add: Callable, invalid: object) -> None:
         _check_placement(tables, add, ok)
 
 
+def _check_armour_stone(tables: Tables, add: Callable, ok: Callable) -> None:
+    stone = tables.get("armour_stone")
+    if not stone:
+        return
+    named = ok(stone["grading"]) and stone["grading"] not in ("", None)
+    if named and ok(stone["dn50"]) and stone["dn50"] > 0:
+        add(("armour_stone", "dn50"), "a grading name gives the stones' sizes; give the name or "
+            "dn50 (with dn85_over_dn15), not both", stone["dn50"])
+    if not named and ok(stone["dn50"]) and stone["dn50"] <= 0:
+        add(("armour_stone",), "give a grading (an EN 13383 name such as \"HMA 300/1000\") or "
+            "dn50 (> 0, with dn85_over_dn15)")
+    if not named and ok(stone["length_scale"]) and stone["length_scale"] != 1.0:
+        add(("armour_stone", "length_scale"), "scales a named grading; dn50 is the model's "
+            "already", stone["length_scale"])
+    if ok(stone["stone_shapes"], stone["size_classes"]) \
+            and stone["size_classes"] > stone["stone_shapes"]:
+        add(("armour_stone", "size_classes"), f"more than stone_shapes = "
+            f"{stone['stone_shapes']}: every size class needs a shape of its own",
+            stone["size_classes"])
+    slope = tables.get("slope")
+    if slope and ok(slope["length"], stone["from_s"], stone["to_s"]):
+        high = stone["to_s"] or slope["length"]
+        if stone["to_s"] > slope["length"]:
+            add(("armour_stone", "to_s"), f"beyond the crest: the face is {slope['length']:g} m "
+                "long (slope.length); 0 means the whole face", stone["to_s"])
+        elif stone["from_s"] >= high:
+            add(("armour_stone", "from_s"), f"not below to_s = {high:g} m: no stone would be "
+                "placed", stone["from_s"])
+
+
 def _check_placement(tables: Tables, add: Callable, ok: Callable) -> None:
+    _check_armour_stone(tables, add, ok)
     placement, armour = tables.get("placement"), tables.get("armour")
     slope, underlayer = tables.get("slope"), tables.get("underlayer")
     if placement:

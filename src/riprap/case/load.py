@@ -25,8 +25,8 @@ from riprap import schema
 from riprap.case.cross_rules import check_cross_rules
 # The specs are generated from the schema in riprap.case.specs; named here too, where the loaded
 # case's parts have always been imported from.
-from riprap.case.specs import (ArmourSpec, BodyGridSpec, BodySpec, Case, DeformableSpec,
-                               FluidSpec, FrictionSpec, GaugeSpec, MaterialSpec,
+from riprap.case.specs import (ArmourSpec, ArmourStoneSpec, BodyGridSpec, BodySpec, Case,
+                               DeformableSpec, FluidSpec, FrictionSpec, GaugeSpec, MaterialSpec,
                                OutputSettings, PlacementSpec, PorousZoneSpec, RegionSpec,
                                SeriesSpec, SeriesStepSpec, ShapeSpec, SimulationSettings,
                                SlopeSpec, UnderlayerSpec, WallSpec, WavesSpec)
@@ -635,7 +635,7 @@ class _Validator:
         # riprap place makes its own shapes and bodies: a placement case needs none; a fluid case
         # without bodies needs neither shapes nor materials.
         minimum = part.minimum_count
-        if part.name == "shapes" and "placement" in data:
+        if part.name == "shapes" and ("placement" in data or "armour_stone" in data):
             minimum = 0
         if part.name in ("shapes", "materials") and ("fluid" in data or "pack" in data):
             minimum = 0
@@ -780,7 +780,8 @@ class _Validator:
                 self._problems.add(("body_grids",), f"the case creates {_count(total)} bodies, more "
                                    f"than the {schema.MAXIMUM_BODY_COUNT:,} a case may create")
             return
-        if tables.get("placement") is not None or tables.get("fluid") is not None:
+        if (tables.get("placement") is not None or tables.get("armour_stone") is not None
+                or tables.get("fluid") is not None):
             return               # riprap place makes the bodies; a fluid case needs none
         if top and top.get("pack") not in (None, "", _INVALID):
             return               # the pack brings its bodies
@@ -823,6 +824,7 @@ class _Validator:
             slope=_optional(SlopeSpec, tables["slope"]),
             underlayer=_optional(UnderlayerSpec, tables["underlayer"]),
             armour=_optional(ArmourSpec, tables["armour"]),
+            armour_stone=_optional(ArmourStoneSpec, tables["armour_stone"]),
             placement=_optional(PlacementSpec, tables["placement"]),
             fluid=_optional(FluidSpec, tables["fluid"]),
             deformable=_optional(DeformableSpec, tables["deformable"]),

@@ -25,6 +25,7 @@ __all__ = [
     "SlopeSpec",
     "UnderlayerSpec",
     "ArmourSpec",
+    "ArmourStoneSpec",
     "PlacementSpec",
     "FluidSpec",
     "DeformableSpec",
@@ -136,6 +137,7 @@ WallSpec = spec_class("WallSpec", "walls")
 SlopeSpec = spec_class("SlopeSpec", "slope")
 UnderlayerSpec = spec_class("UnderlayerSpec", "underlayer")
 ArmourSpec = spec_class("ArmourSpec", "armour")
+ArmourStoneSpec = spec_class("ArmourStoneSpec", "armour_stone")
 PlacementSpec = spec_class("PlacementSpec", "placement")
 FluidSpec = spec_class("FluidSpec", "fluid")
 DeformableSpec = spec_class("DeformableSpec", "deformable",
@@ -180,6 +182,7 @@ class Case:
     slope: SlopeSpec | None = None
     underlayer: UnderlayerSpec | None = None
     armour: ArmourSpec | None = None
+    armour_stone: ArmourStoneSpec | None = None
     placement: PlacementSpec | None = None
     fluid: FluidSpec | None = None
     deformable: DeformableSpec | None = None
@@ -204,7 +207,7 @@ class Case:
     @property
     def is_placement(self) -> bool:
         """Whether the case describes an armour placement (``riprap place``)."""
-        return self.placement is not None
+        return self.placement is not None or self.armour_stone is not None
 
     @property
     def body_count(self) -> int:

@@ -34,6 +34,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from riprap.errors import CaseFileError
+from riprap.io.contact_history import ContactHistory
 from riprap.limits import START_OVERLAP_FRACTION
 from riprap.placement import layer_metrics
 from riprap.placement.lowering import Surface, VerticalLowering
@@ -155,6 +156,7 @@ class ArmourStones:
     frames: list                   # "shape" (as built) or "principal"
     simulation: object = None      # the last run
     contact_history: object = None  # its contacts (springs, resting depths): the next run's start
+    resting_history: object = None  # the contacts at the final poses, for the pack
     summary: dict = field(default_factory=dict)
 
     def node_sets(self) -> list[np.ndarray]:
@@ -210,6 +212,7 @@ def place_armour_stones(slope, library, underlayer: Underlayer, *, materials, de
         stones.quaternions = solver.quaternions[first:].copy()
         stones.frames = ["principal"] * len(stones.positions)
         stones.simulation = sim
+    stones.resting_history = _resting_history(slope, stones, underlayer, materials, run)
     stones.summary = stone_layer_summary(slope, stones, underlayer, design, s_range)
     stones.summary["runs"] = results
     return stones
@@ -260,6 +263,30 @@ def _set_down_layer(slope, stones, grid, layer, design, rng, probability, rock_s
     stones.positions = np.vstack([stones.positions, np.array(positions)])
     stones.quaternions = np.vstack([stones.quaternions, np.array(quaternions)])
     stones.frames = stones.frames + ["shape"] * count
+
+
+def _resting_history(slope, stones, underlayer, materials, run) -> ContactHistory:
+    """The contacts of the placed layer at its final poses, for the pack: the last run's springs,
+    each pair's overlap measured again at the poses written (the run's last contact list is a
+    step older than its last poses, and a stone still creeping at the rest speed is a few
+    micrometres further in), the deeper of a pair's two orders, every touching pair listed
+    (the lower body first, walls second), so that ``riprap run`` of the pack accepts what rests
+    and refuses only a body moved into another."""
+    carried = stones.contact_history
+    probe = _layer_simulation(slope, stones, underlayer, materials, run)
+    probe.build_without_checks()
+    depths: dict = {}
+    for i, j, depth in probe.solver.overlaps(0.0):
+        pair = (i, j) if j < 0 else (min(i, j), max(i, j))
+        depths[pair] = max(depth, depths.get(pair, 0.0))
+    listed = list(zip(carried.body_i.tolist(), carried.body_j.tolist()))
+    extra = [pair for pair in depths if pair not in set(listed)]
+    return ContactHistory(
+        np.concatenate([carried.body_i, np.array([p[0] for p in extra], dtype=np.int64)]),
+        np.concatenate([carried.body_j, np.array([p[1] for p in extra], dtype=np.int64)]),
+        np.vstack([carried.springs, np.zeros((len(extra), 6))]),
+        [max(depths.get(pair, 0.0), float(d)) for pair, d in zip(listed, carried.overlap_depths)]
+        + [depths[pair] for pair in extra])
 
 
 def _clear_start(slope, stones, underlayer, materials, run, design) -> Simulation:
@@ -339,6 +366,8 @@ def stone_layer_summary(slope, stones: ArmourStones, underlayer: Underlayer,
     measured = {
         "stones_placed": int(len(stones.positions)),
         "stones_rolled_off": int((~on_face).sum()),
+        "stones_below_toe": int((coords[:, 0] <= -dn50).sum()),
+        "stones_beyond_top": int((coords[:, 0] >= slope.length).sum()),
         "measuring_area_m2": float(area),
         "stones_measured": count,
         "stones_per_area": count / area if area > 0 else math.nan,

@@ -16,6 +16,7 @@ from riprap.errors import CaseFileError
 from riprap.io.output_folder import check_output_folder
 from riprap.solid.materials import PairFriction, friction_by_pair
 from riprap.workflows.place import PLACEMENT_NOT_CHECKED, placement_materials, prepare_placement
+from riprap.workflows.place_stones import prepare_stone_placement
 
 __all__ = ["CheckReport", "check_case", "friction_in_use"]
 
@@ -44,7 +45,23 @@ def check_case(case: Case, *, output_directory=None, restart=None) -> CheckRepor
         raise CaseFileError(f"{case.source}: a placement does not restart (--restart {restart}); "
                             "run 'riprap place' again")
     sim = None
-    if case.is_placement:
+    if case.is_placement and case.armour_stone is not None:
+        inputs = prepare_stone_placement(case, placement_materials(case))
+        grading = inputs.grading
+        report = CheckReport(
+            f"a rock armour placement for riprap place: {inputs.design.layers} layer(s) of "
+            f"stones of D_n50 = {grading.dn50:.3g} m on a 1:{case.slope.cotangent:g} slope",
+            checked=["tables and keys",
+                     f"the grading ({'class ' + grading.standard_class.name if grading.standard_class else 'custom'}"
+                     f": M50 {grading.m50:.4g} kg, M85/M15 {grading.m85_over_m15:.3g})",
+                     f"{len(inputs.stones)} stone shapes, {len(inputs.rocks)} rock shapes",
+                     f"the grid: {inputs.stone_count} stones ({inputs.design.stones_per_area:.4g} "
+                     f"per m^2: k_t {inputs.design.layer_thickness_coefficient:g}, design "
+                     f"porosity {inputs.design.porosity:g})",
+                     f"the underlayer's start lattice ({inputs.rock_count} rocks)",
+                     f"the filter rule (D_n50 ratio {grading.dn50 / case.underlayer.dn50:.2f})"],
+            not_checked=list(PLACEMENT_NOT_CHECKED))
+    elif case.is_placement:
         inputs = prepare_placement(case)
         report = CheckReport(
             f"an armour placement for riprap place: {case.armour.unit} units on a "

@@ -11,7 +11,6 @@ Output folder:
 """
 from __future__ import annotations
 
-import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,15 +20,12 @@ import numpy as np
 from riprap.analysis.layer_state import LayerDescription
 from riprap.case.body_start import check_grid_starts
 from riprap.case.build import SMOKE_END_TIME, build_friction_pairs, build_material, smoke_mode
-from riprap.case.load import parse_case
 from riprap.errors import CaseFileError
 from riprap.geometry.armour_units import armour_unit
 from riprap.geometry.rock_grading import RockGrading, rock_library
-from riprap.io.case_text import read_case_text
 from riprap.io.grid_file import read_grid_file
 from riprap.io.layer_file import CONTACTS_FILE_NAME, write_contact_table, write_layer_file
 from riprap.io.output_folder import prepare_output_folder
-from riprap.io.pack import PackBody, write_pack
 from riprap.io.summary import write_json
 from riprap.placement import (PlacementMaterials, Slope, build_underlayer, design_grid,
                               place_units, unit_orientations)
@@ -40,6 +36,8 @@ from riprap.placement.place import (UNIT_SHAPE_NAME, check_generated_positions,
 from riprap.schema import MAXIMUM_BODY_COUNT
 from riprap.solid.shape import RigidShape
 from riprap.work_estimate import RiprapWarning, check_rigid_run
+from riprap.workflows.place_stones import run_stone_placement
+from riprap.workflows.placed_pack import write_checked_pack, write_placed_pack
 
 
 def _material(case, name):
@@ -52,7 +50,8 @@ def _material(case, name):
 def placement_materials(case) -> PlacementMaterials:
     """The four roles' materials and the ``[[friction]]`` pairs between them (a pair naming a
     material no role has meets nothing in a placement)."""
-    roles = dict(unit=_material(case, case.armour.material),
+    units = case.armour_stone if case.armour_stone is not None else case.armour
+    roles = dict(unit=_material(case, units.material),
                  rock=_material(case, case.underlayer.material),
                  face=_material(case, case.slope.face_material),
                  side_wall=_material(case, case.slope.side_wall_material))
@@ -62,8 +61,9 @@ def placement_materials(case) -> PlacementMaterials:
 
 
 def _require_tables(case) -> None:
-    missing = [f"[{name}]" for name in ("slope", "underlayer", "armour", "placement")
-               if getattr(case, name) is None]
+    needed = (("slope", "underlayer", "armour_stone") if case.armour_stone is not None
+              else ("slope", "underlayer", "armour", "placement"))
+    missing = [f"[{name}]" for name in needed if getattr(case, name) is None]
     if missing:
         raise CaseFileError(f"{case.source}: riprap place needs the tables {', '.join(missing)} "
                             "(see docs/case-file.md)")
@@ -223,6 +223,10 @@ def _unit_orientations(case, slope, grid):
 def run_placement(case, *, output_directory=None, progress: bool = True) -> dict:
     """Build the underlayer and the armour layer of ``case``; returns the summary (also written
     as ``summary.json``)."""
+    if case.armour_stone is not None:
+        _require_tables(case)
+        return run_stone_placement(case, placement_materials(case),
+                                   output_directory=output_directory, progress=progress)
     inputs = prepare_placement(case)
     out = prepare_output_folder(output_directory or case.output.directory)
     ul, pl = case.underlayer, case.placement
@@ -296,29 +300,9 @@ def _layer_description(unit, slope, underlayer, result, design_positions):
 def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
     sim = result.simulation
     solver = sim.solver
-    names = {index: name for name, index in sim.shape_names.items()}
-    shapes = {names[k]: shape.mesh for k, shape in enumerate(solver.shapes)}
-    material_names = [m.name for m in solver.materials]
-    omegas = solver.angular_velocities
-    bodies = [PackBody(shape=names[int(solver.shape_index[b])],
-                       material=material_names[int(solver.material_index_of_body[b])],
-                       position=tuple(solver.positions[b]), orientation=tuple(solver.quaternions[b]),
-                       velocity=tuple(solver.velocities[b]), angular_velocity=tuple(omegas[b]),
-                       fixed=bool(solver.fixed[b]))
-              for b in range(solver.n_bodies)]
-    pack = write_checked_pack(out, shapes=shapes, materials=materials.all(), bodies=bodies,
-                      walls=slope.walls(face_material=materials.face.name,
-                                        side_material=materials.side_wall.name),
-                      simulation={"end_time": case.simulation.end_time,
-                                  "time_step": case.simulation.time_step,
-                                  "time_step_safety": case.simulation.time_step_safety,
-                                  "gravity": list(case.simulation.gravity),
-                                  # a strip's pack runs on the strip (dry, or in its fluid)
-                                  **({"periodic_y_low": 0.0, "periodic_y_high": slope.width}
-                                     if slope.periodic else {})},
-                      comment=f"armour layer placed by riprap place from {case.source}",
-                      contact_history=sim.contact_history(),
-                      friction_pairs=materials.friction_pairs)
+    pack = write_placed_pack(case, sim, materials, slope, out,
+                             comment=f"armour layer placed by riprap place from {case.source}",
+                             contact_history=sim.contact_history())
     outputs = {"pack": str(pack), "paraview": str(out / "deposition" / "bodies.pvd"),
                "layer": str(write_layer_file(out, layer)),
                "contacts": str(write_contact_table(out / CONTACTS_FILE_NAME, solver.contacts))}
@@ -326,15 +310,6 @@ def _write_outputs(case, result, materials, slope, out: Path, layer) -> dict:
         outputs["picture"] = str(_write_layer_picture(out / "final_layer.png", sim, slope,
                                                       n_units=len(result.unit_bodies)))
     return outputs
-
-
-def write_checked_pack(directory, **pack) -> Path:
-    """:func:`riprap.io.pack.write_pack`, then the written ``pack.toml`` read back through the case
-    parser: a value the schema rejects is an error that names the file and line now, instead of a
-    surprise at the next ``riprap run``. Keywords as ``write_pack``'s."""
-    path = write_pack(directory, **pack)
-    parse_case(read_case_text(path), source=os.fspath(path), base_dir=Path(directory).resolve())
-    return path
 
 
 # Seen from above the sea side of the slope, looking at the face, like the 3D views of
