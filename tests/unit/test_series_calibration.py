@@ -167,3 +167,64 @@ def test_the_incident_peak_period_of_a_split_sea(seed):
     assert abs(split.incident_peak_period / tp - 1.0) < 0.03
     assert split.as_dict()["incident_Tp_s"] == split.incident_peak_period
     assert abs(split.reflection_coefficient - 0.4) < 0.02
+
+
+def test_a_calibration_run_that_becomes_unstable_goes_on_with_a_lower_courant_number(
+        tmp_path, monkeypatch):
+    """The flume without its armour can break waves harder than the structure does: a run that
+    becomes unstable goes on from its last good state with the Courant number halved (as the
+    error advises), and a step whose runs keep failing is refused naming it. Here the first run
+    is made to fail at its end (its last checkpoint stands for the failure checkpoint)."""
+    import shutil
+
+    from riprap.errors import InstabilityError
+
+    real = series_calibration.build_fluid_run
+    calls = []
+
+    class FailingOnce:
+        def __init__(self, simulation, folder, always):
+            self.simulation, self.folder, self.always = simulation, folder, always
+
+        def __getattr__(self, name):
+            return getattr(self.simulation, name)
+
+        def __setattr__(self, name, value):
+            if name in ("simulation", "folder", "always"):
+                object.__setattr__(self, name, value)
+            else:
+                setattr(self.simulation, name, value)
+
+        def run(self, restart_from=None):
+            calls.append((restart_from, self.simulation.fluid_courant_number()))
+            if self.always or len(calls) == 1:
+                if restart_from is None:
+                    self.simulation.run()
+                (self.folder / "summary.json").unlink(missing_ok=True)
+                shutil.copy(self.folder / "checkpoint.npz", self.folder / "failure_checkpoint.npz")
+                raise InstabilityError("the flow blew up (made to, by the test)")
+            return self.simulation.run(restart_from=restart_from)
+
+    def build(run_case, *, output_directory, progress, always=False):
+        simulation = real(run_case, output_directory=output_directory, progress=progress)
+        simulation.fluid_courant_number = lambda: run_case.fluid.courant_number
+        return FailingOnce(simulation, Path(output_directory), always)
+
+    monkeypatch.setattr(series_calibration, "build_fluid_run", build)
+    case_file = _case(tmp_path / "shaky", height=0.08)
+    (result,) = calibrate_series(load_case(case_file), tmp_path / "shaky" / "cal",
+                                 say=lambda line: None)
+    assert calls[0] == (None, 0.3)
+    assert calls[1][0].name == "failure_checkpoint.npz" and calls[1][1] == 0.15
+    assert "courant_number = 0.15" in (tmp_path / "shaky" / "cal" / "step_01_try_1"
+                                       / "case.toml").read_text()
+    assert abs(result.measured_hm0 / 0.08 - 1.0) <= 0.03
+
+    calls.clear()
+    monkeypatch.setattr(series_calibration, "build_fluid_run",
+                        lambda run_case, **kw: build(run_case, always=True, **kw))
+    with pytest.raises(CaseFileError, match=r"step 1: its calibration run .* became unstable 3 "
+                                            r"time\(s\), the last at \[fluid\] courant_number = "
+                                            r"0.075: the flow blew up"):
+        calibrate_series(load_case(_case(tmp_path / "worse", height=0.08)),
+                         tmp_path / "worse" / "cal", say=lambda line: None)

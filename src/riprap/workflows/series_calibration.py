@@ -49,7 +49,7 @@ from riprap.case.build import smoke_mode
 from riprap.case.build_fluid import build_fluid_run, build_fluid_solver
 from riprap.case.load import parse_case
 from riprap.case.series_steps import StepSea, case_text, step_case_data, step_seas
-from riprap.errors import CaseFileError
+from riprap.errors import CaseFileError, InstabilityError
 from riprap.io.json_files import read_json_object, write_json
 from riprap.io.output_folder import prepare_output_folder
 from riprap.io.pack import riprap_version
@@ -66,6 +66,9 @@ CALIBRATION_FORMAT = 1
 HEIGHT_TOLERANCE = 0.03
 #: Its Tp within this fraction.
 PERIOD_TOLERANCE = 0.05
+#: Times a calibration run that became unstable goes on from its last good state, each with the
+#: Courant number halved, before the step is refused.
+UNSTABLE_RETRIES = 2
 #: Runs of the flume per step at most.
 MAX_TRIES = 4
 #: The largest gain accepted: a flume that needs the wave maker at twice the asked height
@@ -166,11 +169,15 @@ def _uniform_across(data: dict) -> bool:
     return True
 
 
-def calibration_case_text(case, sea: StepSea, gain: float, period_factor: float) -> str:
+def calibration_case_text(case, sea: StepSea, gain: float, period_factor: float,
+                          courant_number: float | None = None) -> str:
     """The case of one calibration run: the step's case with the wave maker at Hm0 x ``gain``
     and Tp x ``period_factor``, without the structure's bodies, one cell wide where nothing
-    varies across the flume."""
+    varies across the flume; ``courant_number``: a lower one than the case's (a run continued
+    after it became unstable)."""
     data = step_case_data(case, sea, gain, period_factor)
+    if courant_number is not None:
+        data["fluid"]["courant_number"] = courant_number
     data = {name: value for name, value in data.items() if name in _FLUME_TABLES}
     for key in _BODY_SIMULATION_KEYS:
         data["simulation"].pop(key, None)
@@ -201,14 +208,32 @@ def _measure(case, sea: StepSea, gain: float, factor: float, folder: Path) -> tu
     its checkpoint, or read when done before)."""
     report_file = folder / "waves_report.json"
     if not (folder / "summary.json").is_file():
-        text = calibration_case_text(case, sea, gain, factor)
         prepare_output_folder(folder)
-        (folder / "case.toml").write_text(text, encoding="utf-8")
-        run_case = parse_case(text, source=str(folder / "case.toml"), base_dir=folder)
-        simulation = build_fluid_run(run_case, output_directory=folder, progress=False)
-        simulation.case_file = str((folder / "case.toml").resolve())
         checkpoint = folder / "checkpoint.npz"
-        simulation.run(restart_from=checkpoint if checkpoint.is_file() else None)
+        restart = checkpoint if checkpoint.is_file() else None
+        courant = None
+        for attempt in range(UNSTABLE_RETRIES + 1):
+            text = calibration_case_text(case, sea, gain, factor, courant)
+            (folder / "case.toml").write_text(text, encoding="utf-8")
+            run_case = parse_case(text, source=str(folder / "case.toml"), base_dir=folder)
+            simulation = build_fluid_run(run_case, output_directory=folder, progress=False)
+            simulation.case_file = str((folder / "case.toml").resolve())
+            try:
+                simulation.run(restart_from=restart)
+                break
+            except InstabilityError as error:
+                # the flume without its armour: the waves break on the bare core, harder than
+                # on the structure; as the error advises, on from the last good state with the
+                # Courant number halved (the waves at the gauges passed them before)
+                failure = folder / "failure_checkpoint.npz"
+                if attempt == UNSTABLE_RETRIES or not failure.is_file():
+                    raise CaseFileError(
+                        f"{case.source} [[series_steps]] step {sea.number}: its calibration run "
+                        f"({folder}) became unstable {attempt + 1} time(s), the last at "
+                        f"[fluid] courant_number = {run_case.fluid.courant_number:g}: "
+                        f"{str(error).splitlines()[0]}") from None
+                courant = 0.5 * run_case.fluid.courant_number
+                restart = failure
     report = read_json_object(report_file, "calibration run's waves report",
                               "delete the run's folder to run it again")
     height = incident_at_toe(report)[0]
