@@ -222,18 +222,19 @@ def _measure(case, sea: StepSea, gain: float, factor: float, folder: Path) -> tu
                 simulation.run(restart_from=restart)
                 break
             except InstabilityError as error:
-                # the flume without its armour: the waves break on the bare core, harder than
-                # on the structure; as the error advises, on from the last good state with the
-                # Courant number halved (the waves at the gauges passed them before)
-                failure = folder / "failure_checkpoint.npz"
-                if attempt == UNSTABLE_RETRIES or not failure.is_file():
+                # the flume without its armour: the waves break on the bare core and overtop
+                # it harder than the structure lets them (the ladder's blew up in the spray
+                # over the crest); on from the last scheduled checkpoint with the Courant number
+                # halved. Not from failure_checkpoint.npz: the flow is tested for non-finite
+                # values only, so the "last good state" can hold speeds of 1e74 m/s already
+                if attempt == UNSTABLE_RETRIES:
                     raise CaseFileError(
                         f"{case.source} [[series_steps]] step {sea.number}: its calibration run "
                         f"({folder}) became unstable {attempt + 1} time(s), the last at "
                         f"[fluid] courant_number = {run_case.fluid.courant_number:g}: "
                         f"{str(error).splitlines()[0]}") from None
                 courant = 0.5 * run_case.fluid.courant_number
-                restart = failure
+                restart = checkpoint if checkpoint.is_file() else None
     report = read_json_object(report_file, "calibration run's waves report",
                               "delete the run's folder to run it again")
     height = incident_at_toe(report)[0]
