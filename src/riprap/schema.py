@@ -864,6 +864,11 @@ KEYS: tuple[Key, ...] = (
         valid_range=_NON_NEGATIVE),
     Key("porous_zones", "added_mass", "number", "-", "c of the added mass (1 + c)/n.",
         default=0.34, valid_range=_NON_NEGATIVE),
+    Key("porous_zones", "part", "string", "-",
+        "Which part of the breakwater the zone is: the core (its stone_diameter is the core's "
+        "D50 in the rock formulas and the notional permeability; without a core zone the core "
+        "is taken as impermeable), a filter, or other.", default="other",
+        choices=("core", "filter", "other")),
     Key("porous_zones", "lower", "vector", "m", "Lower corner of the box.", variant="box"),
     Key("porous_zones", "upper", "vector", "m", "Upper corner of the box.", variant="box",
         greater_than="lower"),

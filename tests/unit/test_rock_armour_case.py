@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+import riprap as rr
 from riprap.cli import main
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "rock_armour_place.toml"
@@ -100,6 +101,21 @@ def test_place_writes_a_pack_and_the_layer_beside_its_design(tmp_path):
     # same seed, same layer, byte for byte but the first line's date of writing
     assert pack.split("\n", 1)[1] == (tmp_path / "b" / "pack.toml").read_text().split("\n", 1)[1]
     assert "periodic_y_high" in pack
+    # the pack's layer.json makes the stones the layer's units: riprap analyse measures the
+    # layer as the placement did (same k_t, porosity, stones per area), the long axes' fabric
+    layer = json.loads((tmp_path / "a" / "layer.json").read_text())
+    assert layer["unit_kind"] == "armour_stone" and len(layer["unit_bodies"]) == \
+        measured["stones_placed"]
+    assert layer["nominal_diameter_m"] == pytest.approx(grading["placed"]["Dn50_m"], rel=1e-9)
+    analysis = rr.analyse(tmp_path / "a", out=tmp_path / "analysis").layer
+    assert analysis["unit"] == "armour_stone"
+    for key in ("layer_thickness_coefficient", "porosity", "stones_per_area"):
+        assert analysis[key] == pytest.approx(measured[key], rel=1e-9), key
+    assert analysis["design_layer_thickness_coefficient"] == pytest.approx(0.91)
+    assert analysis["design_stones_per_area"] == pytest.approx(design["stones_per_area"])
+    assert 0.33 <= analysis["long_axis_fabric"]["S1"] <= 1.0
+    report = (tmp_path / "analysis" / "report.html").read_text()
+    assert "layer thickness coefficient k_t" in report and "Orientation of the long axes" in report
     run = tmp_path / "run.toml"
     run.write_text(f'format_version = 1\npack = "{tmp_path / "a" / "pack.toml"}"\n\n'
                    "[simulation]\nend_time = 0.01\n\n[output]\ndirectory = \"run\"\n"

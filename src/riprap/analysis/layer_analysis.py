@@ -170,7 +170,7 @@ def analyse_layer(state, *, displaced_threshold_dn: float = None) -> LayerAnalys
     columns["rocking_events"] = (rocking_events(state.rotation_history[:, bodies], ROCKING_ANGLE_DEG)
                                  if state.rotation_history is not None
                                  else np.full(n_units, np.nan))
-    nose_axes = None
+    primary_axes = None
     for name, axis in layer.unit_axes.items():
         world = state.rotations[bodies] @ np.asarray(axis, dtype=float)
         down = lower_hemisphere(world) if n_units else np.zeros((0, 3))
@@ -182,8 +182,8 @@ def analyse_layer(state, *, displaced_threshold_dn: float = None) -> LayerAnalys
         columns[f"{name}_net_north"] = net[:, 1]
         for component, label in enumerate("xyz"):
             columns[f"{name}_axis_{label}"] = down[:, component]
-        if name == "nose":
-            nose_axes = down
+        if name == layer.primary_axis:
+            primary_axes = down
 
     unit_unit, unit_underlayer = _pair_force_magnitudes(state, is_unit)
     dn = layer.nominal_diameter
@@ -192,6 +192,8 @@ def analyse_layer(state, *, displaced_threshold_dn: float = None) -> LayerAnalys
     figures = layer_metrics.layer_figures(
         slope, positions[on_face], node_sets, rows=columns["row"][on_face], nominal_diameter=dn,
         unit_volume=layer.unit_volume, underlayer_level=layer.underlayer_top)
+    if layer.is_rock:
+        figures = _rock_layer_figures(state, bodies)
     coordination = columns["coordination_number"]
     values, counts = np.unique(coordination, return_counts=True)
     fos = columns["factor_of_safety"]
@@ -217,6 +219,7 @@ def analyse_layer(state, *, displaced_threshold_dn: float = None) -> LayerAnalys
         "design_packing_density_coefficient": float(layer.design.get("packing_density_coefficient", np.nan)),
         "design_layer_thickness_m": float(layer.design.get("layer_thickness_m", np.nan)),
         "design_porosity": float(layer.design.get("porosity", np.nan)),
+        **(_rock_design(layer.design) if layer.is_rock else {}),
         "coordination_number_mean": float(coordination.mean()) if n_units else 0.0,
         "coordination_number_min": int(coordination.min()) if n_units else 0,
         "coordination_number_max": int(coordination.max()) if n_units else 0,
@@ -229,7 +232,8 @@ def analyse_layer(state, *, displaced_threshold_dn: float = None) -> LayerAnalys
         "factor_of_safety_median": float(np.median(fos)) if n_units else float("nan"),
         "units_below_factor_of_safety_1": [int(k) for k in np.flatnonzero(fos < 1.0)],
         "mean_distance_from_design_m": float(columns["distance_from_design_m"].mean()) if n_units else 0.0,
-        "nose_axis_fabric": _fabric(nose_axes) if nose_axes is not None else {},
+        f"{layer.primary_axis}_axis_fabric": (_fabric(primary_axes) if primary_axes is not None
+                                               else {}),
         **_displacement_summary(state, columns, displaced_threshold_dn),
     }
     if not state.contacts_recorded:
@@ -244,6 +248,36 @@ def analyse_layer(state, *, displaced_threshold_dn: float = None) -> LayerAnalys
     return LayerAnalysis(units=columns, layer=summary, unit_unit_forces=unit_unit,
                          unit_underlayer_forces=unit_underlayer, state=state)
 
+
+def _rock_design(design: dict) -> dict:
+    """A rock layer's design k_t and stones per area (with the grading's D_n50, as designed)."""
+    dn50 = design["dn50_m"]
+    return {"design_dn50_m": float(dn50),
+            "design_layer_thickness_coefficient": float(design["layer_thickness_m"]
+                                                        / (design["layers"] * dn50)),
+            "design_stones_per_area": float(design["packing_density_coefficient"] / dn50 ** 2)}
+
+
+def _rock_layer_figures(state, bodies) -> dict:
+    """A rock layer's figures measured as ``riprap place`` measures them
+    (:func:`riprap.placement.layer_metrics.stone_layer_figures`: k_t, N_a, porosity, roughness
+    between a D_n50 inside the lowest and highest stones), under the names the units' figures
+    have (phi = N_a D_n50^2 for a packing density coefficient)."""
+    layer = state.layer
+    dn = layer.nominal_diameter
+    volumes = np.array([float(state.meshes[int(state.shape_of_body[b])].volumes().sum())
+                        for b in bodies])
+    rock = layer_metrics.stone_layer_figures(
+        layer.slope, state.positions[bodies], [state.world_nodes(b) for b in bodies], volumes,
+        dn50=dn, layers=int(round(layer.design.get("layers", 2))),
+        underlayer_level=layer.underlayer_top)
+    return {"packing_density_coefficient": rock["stones_per_area_times_dn50_squared"],
+            "layer_thickness_m": rock["layer_thickness_m"], "porosity": rock["porosity"],
+            "measuring_area_m2": rock["measuring_area_m2"],
+            "layer_thickness_coefficient": rock["layer_thickness_coefficient"],
+            "stones_per_area": rock["stones_per_area"],
+            "stones_measured": rock["stones_measured"],
+            "surface_roughness_over_dn50": rock["surface_roughness_over_dn50"]}
 
 def _displacement_columns(state, bodies) -> dict:
     """The units' displacement and rotation since the state's reference (NaN without one)."""

@@ -23,7 +23,10 @@ from riprap.placement.slope import Slope
 from riprap.solid.contact_statistics import pair_friction
 from riprap.solid.materials import friction_table
 
-__all__ = ["LayerDescription", "LayerState", "state_from_simulation"]
+__all__ = ["LayerDescription", "LayerState", "state_from_simulation", "ROCK_ARMOUR_KIND"]
+
+#: ``unit_kind`` of a layer of graded armour stone (``riprap place`` of ``[armour_stone]``).
+ROCK_ARMOUR_KIND = "armour_stone"
 
 
 @dataclass(frozen=True, eq=False)
@@ -34,16 +37,19 @@ class LayerDescription:
     ----------
     unit_kind : str
         Armour unit kind (``riprap.geometry.armour_units.UNIT_KINDS``).
-    unit_shape : str
-        Name of the units' shape in the pack.
+    unit_shape : str or tuple of str
+        Name of the units' shape in the pack; for rock armour (``unit_kind`` ``"armour_stone"``)
+        the names of the stones' shapes, one per stone of the grading's library.
     nominal_diameter : float
-        D_n = V^(1/3) of a unit (m).
+        D_n = V^(1/3) of a unit (m); of rock armour, the placed stones' D_n50.
     unit_volume : float
-        Volume of one unit (m^3).
+        Volume of one unit (m^3); of rock armour, the placed stones' mean volume.
     unit_height : float
-        Characteristic height H of a unit (m).
+        Characteristic height H of a unit (m); of rock armour, D_n50.
     unit_axes : dict of str to (3,) array
-        Named unit vectors in the frame of the unit's mesh as stored (``"nose"`` at least).
+        Named unit vectors in the frame of the unit's mesh as stored; the first is the one whose
+        fabric and stereonet the analysis gives (``"nose"`` of a concrete unit, ``"long"`` of a
+        stone: its axis of least inertia).
     slope : Slope
         The face the layer rests on.
     underlayer_top : float
@@ -74,6 +80,21 @@ class LayerDescription:
     @property
     def n_units(self) -> int:
         return len(self.unit_bodies)
+
+    @property
+    def unit_shape_names(self) -> tuple:
+        """The shape names the units may have (one for concrete units)."""
+        return (self.unit_shape,) if isinstance(self.unit_shape, str) else tuple(self.unit_shape)
+
+    @property
+    def primary_axis(self) -> str:
+        """The axis whose fabric the analysis reports (the first of ``unit_axes``)."""
+        return next(iter(self.unit_axes))
+
+    @property
+    def is_rock(self) -> bool:
+        """Rock armour (graded stones), judged by S and the rock formulas."""
+        return self.unit_kind == ROCK_ARMOUR_KIND
 
     @classmethod
     def from_fields(cls, fields: dict) -> "LayerDescription":
@@ -108,6 +129,33 @@ class LayerDescription:
                     "layer_thickness_m": design.layers * design.layer_thickness_coefficient
                     * unit.nominal_diameter,
                     "porosity": design.porosity})
+
+    @classmethod
+    def for_stones(cls, *, shape_names, nominal_diameter, mean_volume, design, slope,
+                   underlayer_top, unit_bodies, rows, design_positions, filter_dn50,
+                   grading_ratio) -> "LayerDescription":
+        """The description of a layer of graded armour stone: ``shape_names`` the stones' shapes
+        in the pack (each stored in its principal frame, axes by increasing moment of inertia: x
+        the long axis, z the short one); ``nominal_diameter`` the placed stones' D_n50,
+        ``mean_volume`` their mean volume; ``design`` a
+        :class:`riprap.placement.armour_stones.StoneLayerDesign`; ``filter_dn50`` the
+        underlayer's D_n50 and ``grading_ratio`` the placed stones' D_n85 / D_n15 (for the rock
+        formulas)."""
+        return cls(
+            unit_kind=ROCK_ARMOUR_KIND, unit_shape=tuple(shape_names),
+            nominal_diameter=float(nominal_diameter), unit_volume=float(mean_volume),
+            unit_height=float(nominal_diameter),
+            unit_axes={"long": np.array([1.0, 0.0, 0.0]), "short": np.array([0.0, 0.0, 1.0])},
+            slope=slope, underlayer_top=float(underlayer_top),
+            unit_bodies=np.asarray(unit_bodies, dtype=np.int64),
+            rows=np.asarray(rows, dtype=np.int64),
+            design_positions=np.asarray(design_positions, dtype=float).reshape(-1, 3),
+            # the packing density coefficient of n layers: N_a D_n50^2 = n k_t (1 - n_v)
+            design={"packing_density_coefficient": design.stones_per_area * design.dn50 ** 2,
+                    "layer_thickness_m": design.layer_thickness, "porosity": design.porosity,
+                    "layers": float(design.layers), "dn50_m": design.dn50,
+                    "filter_dn50_m": float(filter_dn50),
+                    "placed_dn85_over_dn15": float(grading_ratio)})
 
 
 @dataclass(frozen=True, eq=False)

@@ -31,6 +31,8 @@ import math
 from scipy.optimize import brentq
 
 from riprap.analysis.design_formulas import hudson_stability_number, van_der_meer_cubes_damage
+from riprap.analysis.rock_formulas import (etemad_shahidi_2020_damage, van_der_meer_2021_damage,
+                                           van_gent_2003_damage)
 from riprap.analysis.stability_report import HUDSON_TRUNK_STABILITY
 from riprap.errors import CaseFileError
 
@@ -47,7 +49,13 @@ SINGLE_LAYER_CUBES_FAILURE = 3.5
 CUBES_START_NOD = 0.2
 #: EurOtop (2018) table 6.2, roughness factor gamma_f of a permeable-core slope per unit kind.
 ROUGHNESS_FACTORS = {"core_loc_like": 0.44, "accropode_like": 0.46, "xbloc_like": 0.45,
-                     "tetrapod": 0.38, "cube": 0.47, "antifer_cube": 0.50}
+                     "tetrapod": 0.38, "cube": 0.47, "antifer_cube": 0.50,
+                     # EurOtop (2018) Table 6.2: rock, two layers, permeable core
+                     "armour_stone": 0.40}
+#: Columns of a rock series' curve, one per formula, each cumulative over the steps.
+ROCK_FORMULA_COLUMNS = {"van_der_meer_2021_S": "Van der Meer (2021)",
+                        "van_gent_2003_S": "Van Gent et al. (2003)",
+                        "etemad_shahidi_2020_S": "Etemad-Shahidi et al. (2020)"}
 
 
 def cumulative_damage(formula, sea_states) -> list[float]:
@@ -66,6 +74,28 @@ def cumulative_damage(formula, sea_states) -> list[float]:
         damage = max(damage, formula(hs, tm, equivalent + waves))
         out.append(damage)
     return out
+
+
+def rock_formula_curves(sea_states, *, slope_cot: float, delta: float, nominal_diameter: float,
+                        permeability: float, core_nominal_diameter: float) -> dict:
+    """The three rock formulas' S after each of ``sea_states`` ((H_s, T_m-1,0, N) run one after
+    the other), damage carried from step to step as equivalent waves (:func:`cumulative_damage`);
+    NaN where a step's waves are unmeasured. Columns :data:`ROCK_FORMULA_COLUMNS`."""
+    common = {"slope_cot": slope_cot, "armour_density": 1000.0 * (1.0 + delta),
+              "water_density": 1000.0, "nominal_diameter": nominal_diameter}
+    formulas = {
+        "van_der_meer_2021_S": lambda hs, tm, n: van_der_meer_2021_damage(
+            hs=hs, spectral_period=tm, waves=max(n, 1e-12), permeability=permeability, **common),
+        "van_gent_2003_S": lambda hs, tm, n: van_gent_2003_damage(
+            hs=hs, waves=max(n, 1e-12), core_nominal_diameter=core_nominal_diameter, **common),
+        "etemad_shahidi_2020_S": lambda hs, tm, n: etemad_shahidi_2020_damage(
+            hs=hs, spectral_period=tm, waves=max(n, 1e-12),
+            core_nominal_diameter=core_nominal_diameter, **common)}
+    usable = all(math.isfinite(h) and h > 0 and math.isfinite(t) and t > 0 and n > 0
+                 for h, t, n in sea_states)
+    return {name: (cumulative_damage(formula, sea_states) if usable
+                   else [math.nan] * len(sea_states))
+            for name, formula in formulas.items()}
 
 
 def eurotop_mean_overtopping(hm0: float, freeboard: float, roughness: float) -> float:

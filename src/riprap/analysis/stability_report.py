@@ -9,16 +9,21 @@ mean period Tz and the number of waves there; from the layer analysis: the units
 - Hudson's for the unit (K_D of the trunk, non-breaking waves: ``HUDSON_TRUNK_STABILITY``, from
   ``shared/validation/armour_design.md`` §5.2: the Deltares coastal-structures-toolbox and the Rock
   Manual), N_s,Hudson = (K_D cot alpha)^(1/3), meant for no damage (0-5 % of units displaced);
-- for cubes, Van der Meer's (1988) double-layer N_od for the same Hm0, Tz and number of waves.
+- for cubes, Van der Meer's (1988) double-layer N_od for the same Hm0, Tz and number of waves;
+- for rock armour (``unit_kind`` ``"armour_stone"``), the damage level S, its Rock Manual class,
+  where the profile eroded and the three rock formulas for the same H_s, T_m-1,0 and N
+  (:mod:`riprap.analysis.rock_stability`).
 """
 from __future__ import annotations
 
 import math
 
 from riprap.analysis.design_formulas import hudson_stability_number, van_der_meer_cubes_damage
+from riprap.analysis.rock_stability import eroded_zone, rock_stability
 from riprap.geometry.unit_kinds import UNIT_RECORDS
 
 __all__ = ["flume_stability", "incident_at_toe", "incident_peak_period_at_toe", "reflection_at_toe",
+           "incident_spectral_period_at_toe",
            "HUDSON_TRUNK_STABILITY"]
 
 #: K_D of a trunk under non-breaking waves per unit kind (armour_design.md §5.2, kept in each
@@ -69,6 +74,19 @@ def incident_peak_period_at_toe(waves_report: dict) -> float | None:
     return _mean_of_triples(waves_report, "incident_Tp_s")
 
 
+def incident_spectral_period_at_toe(waves_report: dict) -> tuple[float | None, str]:
+    """T_m-1,0 (s) at the toe and where it was read: the mean of the three-gauge splits'
+    incident T_m-1,0, else the first analysed surface gauge's (incident and reflected)."""
+    period = _mean_of_triples(waves_report, "incident_Tm-1,0_s")
+    if period is not None:
+        return period, "incident (Mansard-Funke, mean of the gauge triples)"
+    gauges = waves_report.get("gauges", {})
+    for gauge in (gauges.values() if isinstance(gauges, dict) else []):
+        if isinstance(gauge, dict) and _finite(gauge.get("Tm-1,0_s")):
+            return gauge["Tm-1,0_s"], "first surface gauge (incident and reflected)"
+    return None, "no analysed surface gauge"
+
+
 def reflection_at_toe(waves_report: dict) -> float | None:
     """The structure's reflection coefficient K_r = Hm0,reflected / Hm0,incident: the mean of
     the three-gauge splits', None where no split gave one."""
@@ -77,8 +95,10 @@ def reflection_at_toe(waves_report: dict) -> float | None:
 
 def flume_stability(waves_report: dict, layer_summary: dict, *, unit_kind: str,
                     nominal_diameter: float, armour_density: float, water_density: float,
-                    slope_cot: float) -> dict:
-    """The stability part of the flume test's report (a dict for JSON)."""
+                    slope_cot: float, rock_section=None, still_water_level=None) -> dict:
+    """The stability part of the flume test's report (a dict for JSON); ``rock_section`` (a
+    :class:`riprap.analysis.rock_stability.RockSection`) and ``still_water_level`` for rock
+    armour."""
     height, period, waves, source = incident_at_toe(waves_report)
     delta = armour_density / water_density - 1.0
     result = {"unit": unit_kind, "nominal_diameter_m": nominal_diameter, "relative_density": delta,
@@ -110,6 +130,18 @@ def flume_stability(waves_report: dict, layer_summary: dict, *, unit_kind: str,
                    "reflection_coefficient": reflection_at_toe(waves_report)})
     if "hudson" in result:
         result["hudson"]["ratio"] = stability / result["hudson"]["stability_number"]
+    if unit_kind == "armour_stone" and rock_section is not None and waves:
+        spectral, spectral_source = incident_spectral_period_at_toe(waves_report)
+        damage = layer_summary.get("damage_level_s")
+        result["rock"] = rock_stability(
+            hs=height, spectral_period=spectral, waves=waves, slope_cot=slope_cot,
+            armour_density=armour_density, water_density=water_density,
+            nominal_diameter=nominal_diameter,
+            damage=damage if _finite(damage) else None, section=rock_section)
+        result["rock"]["spectral_period_source"] = spectral_source
+        result["rock"]["eroded_zone"] = eroded_zone(
+            layer_summary.get("damage_profiles", {}), nominal_diameter=nominal_diameter,
+            still_water_level=still_water_level, significant_height=height)
     if unit_kind in ("cube", "antifer_cube") and period and waves and math.isfinite(period):
         result["van_der_meer_cubes"] = {
             "N_od": van_der_meer_cubes_damage(hs=height, tm=period, waves=waves, delta=delta,

@@ -343,9 +343,11 @@ def comparison_stereonets(path, analyses, labels) -> list[Path]:
     figure = plt.figure(figsize=(5.2 * len(analyses), 5.6))
     for k, (analysis, label) in enumerate(zip(analyses, labels)):
         axes = figure.add_subplot(1, len(analyses), k + 1, projection="stereonet")
-        fabric = analysis.layer.get("nose_axis_fabric", {})
-        _draw_stereonet(axes, analysis.units["nose_trend_deg"], analysis.units["nose_plunge_deg"],
-                        f"{label}: {len(analysis.units['unit_id'])} nose axes\n"
+        axis = analysis.state.layer.primary_axis
+        fabric = analysis.layer.get(f"{axis}_axis_fabric", {})
+        _draw_stereonet(axes, analysis.units[f"{axis}_trend_deg"],
+                        analysis.units[f"{axis}_plunge_deg"],
+                        f"{label}: {len(analysis.units['unit_id'])} {axis} axes\n"
                         f"S1 {fabric.get('S1', float('nan')):.2f}, S3 {fabric.get('S3', float('nan')):.2f}")
     return _save(figure, Path(path))
 

@@ -100,6 +100,13 @@ DESIGN_TOLERANCES = (
     ("layer_thickness_m", "layer thickness (m)", 0.10, "relative"),
     ("porosity", "layer porosity", 0.05, "absolute"),
 )
+#: Rock armour's further rows, riprap's working values as above: k_t +-10 % (the thickness's own
+#: tolerance; the Rock Manual gives k_t of a double layer as 0.91 for standard and dense
+#: placement, without a tolerance), stones per area +-5 % (as phi, whose count it is).
+ROCK_DESIGN_TOLERANCES = (
+    ("layer_thickness_coefficient", "layer thickness coefficient k_t", 0.10, "relative"),
+    ("stones_per_area", "stones per m2", 0.05, "relative"),
+)
 
 
 def design_verdict(layer: dict) -> list[dict]:
@@ -116,7 +123,9 @@ def design_verdict(layer: dict) -> list[dict]:
     [('packing_density_coefficient', None), ('layer_thickness_m', False), ('porosity', None)]
     """
     rows = []
-    for key, label, tolerance, kind in DESIGN_TOLERANCES:
+    # rock armour adds its layer thickness coefficient (the Rock Manual's k_t) and stones per area
+    extra = ROCK_DESIGN_TOLERANCES if "design_layer_thickness_coefficient" in layer else ()
+    for key, label, tolerance, kind in DESIGN_TOLERANCES + extra:
         design = float(layer.get(f"design_{key}", math.nan))
         measured = float(layer.get(key, math.nan))
         absolute = tolerance * abs(design) if kind == "relative" else tolerance
@@ -372,11 +381,13 @@ def write_analysis(out, analysis) -> dict:
                "contacts": str(write_contact_table(out / "contacts.csv", state.contacts)),
                "summary": str(write_json(out / "layer_summary.json", layer))}
     outputs.update(_write_paraview(out, analysis))
-    fabric = layer.get("nose_axis_fabric", {})
+    axis = state.layer.primary_axis
+    fabric = layer.get(f"{axis}_axis_fabric", {})
     slope = state.layer.slope
     figures.stereonet_figure(
-        out / "stereonet.png", units["nose_trend_deg"], units["nose_plunge_deg"],
-        title=(f"Nose axes of {layer['units']} {layer['unit']} units, lower hemisphere, equal area\n"
+        out / "stereonet.png", units[f"{axis}_trend_deg"], units[f"{axis}_plunge_deg"],
+        title=(f"{axis.capitalize()} axes of {layer['units']} {layer['unit']} units, lower "
+               "hemisphere, equal area\n"
                f"fabric S1 {fabric.get('S1', float('nan')):.2f}, S2 {fabric.get('S2', float('nan')):.2f}, "
                f"S3 {fabric.get('S3', float('nan')):.2f} (random: 0.33 each)"),
         slope_dip_direction_deg=(270.0, slope.angle_deg))
@@ -398,6 +409,7 @@ def write_analysis(out, analysis) -> dict:
 
 def _write_report(out: Path, analysis) -> Path:
     layer, units = analysis.layer, analysis.units
+    axis = analysis.state.layer.primary_axis
     histogram = ", ".join(f"{k}: {v}" for k, v in layer["coordination_number_histogram"].items())
     low = layer["units_below_factor_of_safety_1"]
     # Only the first letter raised: str.capitalize would also lower the unit, "(N)" to "(n)".
@@ -432,8 +444,8 @@ def _write_report(out: Path, analysis) -> Path:
         f"Units with a factor of safety below 1: {len(low)}"
         f"{' (' + ', '.join(map(str, low[:20])) + (' ...' if len(low) > 20 else '') + ')' if low else ''}"
         f"{'; see <a href=#reading-factors-of-safety>what that means for a unit at rest</a>' if low else ''}.</p>"
-        "<h2>Orientation of the nose axes</h2><div class='figures'>"
-        "<img src='stereonet.svg' alt='stereonet of the nose axes'></div>"
+        f"<h2>Orientation of the {axis} axes</h2>"
+        f"<div class='figures'><img src='stereonet.svg' alt='stereonet of the {axis} axes'></div>"
         f"{fields}"
         f"{_distributions(out)}"
         f"{_displacement_section(layer, units)}"

@@ -46,11 +46,13 @@ CONTACT_COLUMNS = ("body_i", "body_j", "point_x_m", "point_y_m", "point_z_m",
 # Fields of layer.json: name -> (kind, meaning), all required.
 _FIELDS = {
     "unit_kind": ("string", "armour unit kind"),
-    "unit_shape": ("string", "name of the units' shape in pack.toml"),
+    "unit_shape": ("shape_names", "name of the units' shape in pack.toml (a list of names for "
+                                  "rock armour's stones)"),
     "nominal_diameter_m": ("number", "D_n of a unit"),
     "unit_volume_m3": ("number", "volume of a unit"),
     "unit_height_m": ("number", "height H of a unit"),
-    "unit_axes": ("axes", "named unit vectors in the unit mesh's frame, 'nose' at least"),
+    "unit_axes": ("axes", "named unit vectors in the unit mesh's frame, the primary first "
+                          "('nose' of a unit, 'long' of a stone)"),
     "slope": ("slope", "cotangent, width, length, toe_x, toe_level, toe_stop_distance (and "
                        "periodic: true on a periodic strip; absent: false)"),
     "underlayer_top_m": ("number", "underlayer top above the face"),
@@ -73,7 +75,8 @@ def write_layer_file(directory, layer) -> Path:
         "format": LAYER_FORMAT,
         "format_version": LAYER_FORMAT_VERSION,
         "unit_kind": layer.unit_kind,
-        "unit_shape": layer.unit_shape,
+        "unit_shape": (layer.unit_shape if isinstance(layer.unit_shape, str)
+                       else list(layer.unit_shape)),
         "nominal_diameter_m": float(layer.nominal_diameter),
         "unit_volume_m3": float(layer.unit_volume),
         "unit_height_m": float(layer.unit_height),
@@ -139,9 +142,15 @@ def _check_field(name, value, kind, problems) -> None:
             k = wrong[0]
             bad(f"'{name}' must be a list of [x, y, z] points (3 finite numbers each); entry {k} "
                 f"is {value[k]!r}" + (f" ({len(wrong)} bad entries)" if len(wrong) > 1 else ""))
+    elif kind == "shape_names":
+        names = [value] if isinstance(value, str) else value
+        if not (isinstance(names, list) and names
+                and all(isinstance(v, str) and v for v in names)):
+            bad(f"'{name}' must be a shape name or a non-empty list of them, got {value!r}")
     elif kind == "axes":
-        if not isinstance(value, dict) or "nose" not in value:
-            bad(f"'{name}' must map axis names to [x, y, z], with a 'nose' axis")
+        if not isinstance(value, dict) or not value:
+            bad(f"'{name}' must map axis names to [x, y, z] (the primary axis first: 'nose' of a "
+                "unit, 'long' of a stone)")
             return
         for axis, vector in value.items():
             if not _is_point(vector):
@@ -231,6 +240,12 @@ def read_layer_file(directory, n_bodies: int | None = None) -> dict:
             if bad:
                 problems.append(("unit_bodies", f"'unit_bodies' names bodies {bad[:5]} but the pack "
                                                 f"has {n_bodies} bodies (indices from 0)"))
+        if data["unit_kind"] == "armour_stone":
+            lacking = [k for k in ("layers", "dn50_m", "packing_density_coefficient",
+                                   "layer_thickness_m") if k not in data["design"]]
+            if lacking:
+                problems.append(("design", "a rock layer's 'design' needs " + ", ".join(
+                    f"'{k}'" for k in lacking) + " (riprap place of [armour_stone] writes them)"))
         if len(set(data["unit_bodies"])) != n_units:
             problems.append(("unit_bodies", "'unit_bodies' lists a body twice"))
     if problems:
@@ -241,7 +256,9 @@ def read_layer_file(directory, n_bodies: int | None = None) -> dict:
         raise CaseFileError.from_problems(located, 20)
     slope_line = _field_line(text, "slope")
     return dict(
-        unit_kind=data["unit_kind"], unit_shape=data["unit_shape"],
+        unit_kind=data["unit_kind"],
+        unit_shape=(data["unit_shape"] if isinstance(data["unit_shape"], str)
+                    else tuple(data["unit_shape"])),
         nominal_diameter=float(data["nominal_diameter_m"]), unit_volume=float(data["unit_volume_m3"]),
         unit_height=float(data["unit_height_m"]),
         unit_axes={name: np.asarray(axis, dtype=float) for name, axis in data["unit_axes"].items()},

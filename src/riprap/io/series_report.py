@@ -44,13 +44,21 @@ COLUMN_NAMES = {
     "Tp_s": "Tp at the toe (s)",
     "reflection_coefficient": "K_r (reflection)",
     "wave_maker_gain": "wave maker gain on Hm0",
+    "Tm_1_0_s": "T_m-1,0 at the toe (s)",
+    "rock_damage_class": "Rock Manual class of S",
+    "van_der_meer_2021_S": "Van der Meer (2021) S, waves so far",
+    "van_gent_2003_S": "Van Gent et al. (2003) S, waves so far",
+    "etemad_shahidi_2020_S": "Etemad-Shahidi et al. (2020) S, waves so far",
 }
 #: A mean overtopping discharge below this (m^3/s per m, 1e-6 l/s per m: a few drops over a
 #: test) is drawn as none: a log axis down to round-off would hide the rest.
 DRY_Q = 1e-9
 #: Columns measured in the flume (a NaN there: "not measured"); the others are computed.
 MEASURED_COLUMNS = ("Hm0_m", "Tm_s", "stability_number", "q_m3_s_m", "Tp_s",
-                    "reflection_coefficient")
+                    "reflection_coefficient", "Tm_1_0_s")
+#: A rock series' formula columns and how each is drawn.
+_ROCK_STYLES = (("van_der_meer_2021_S", "s--", "C1"), ("van_gent_2003_S", "D--", "C3"),
+                ("etemad_shahidi_2020_S", "v--", "C4"))
 #: The formulas' start of damage (``formulas.start_of_damage``) in words.
 START_NAMES = {"hudson_stability_number": "Hudson's N_s (no damage)",
                "single_layer_cubes_start": "single-layer cubes' start of damage, N_s",
@@ -121,8 +129,32 @@ def _damage_curve_figure(path: Path, results: dict, missing: dict) -> Path:
     return path
 
 
+def _rock_damage_panel(left, ns: np.ndarray, curve: dict, results: dict) -> None:
+    """Rock armour: S against N_s beside the three rock formulas (cumulative over the steps) and
+    the Rock Manual's start of damage and failure for the slope."""
+    left.plot(ns, curve["S"], "o-", color="C0", label="S, riprap")
+    for column, style, colour in _ROCK_STYLES:
+        values = np.asarray(curve.get(column, []), dtype=float)
+        if values.size and np.isfinite(values).any():
+            left.plot(ns, values, style, color=colour, alpha=0.8,
+                      label=COLUMN_NAMES[column].replace(", waves so far", ""))
+    thresholds = results["formulas"].get("rock", {}).get("damage_thresholds") or {}
+    for key, style, words in (("start", ":", "start of damage"), ("failure", "--", "failure")):
+        if isinstance(thresholds.get(key), (int, float)):
+            left.axhline(thresholds[key], color="0.4", linestyle=style,
+                         label=f"{words} S {thresholds[key]:g} (Rock Manual)")
+    left.set_xlabel("stability number Hm0 / (Delta Dn50)")
+    left.set_ylabel("damage level S = A_e / Dn50^2")
+    left.set_ylim(bottom=0.0)
+    left.legend(fontsize=7)
+    left.grid(alpha=0.3)
+
+
 def _damage_curve_panel(left, ns: np.ndarray, curve: dict, results: dict) -> None:
     """N_od and S against N_s for the steps that measured their waves, beside the formulas."""
+    if "van_gent_2003_S" in curve:
+        _rock_damage_panel(left, ns, curve, results)
+        return
     left.plot(ns, curve["N_od"], "o-", color="C0", label="N_od, riprap")
     formula = np.asarray(curve["van_der_meer_cubes_N_od"], dtype=float)
     if np.isfinite(formula).any():

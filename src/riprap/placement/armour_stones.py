@@ -34,6 +34,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from riprap.errors import CaseFileError
+from riprap.geometry.armour_stone import grading_statistics
 from riprap.io.contact_history import ContactHistory
 from riprap.limits import START_OVERLAP_FRACTION
 from riprap.placement import layer_metrics
@@ -158,6 +159,10 @@ class ArmourStones:
     contact_history: object = None  # its contacts (springs, resting depths): the next run's start
     resting_history: object = None  # the contacts at the final poses, for the pack
     summary: dict = field(default_factory=dict)
+    set_positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    # (n, 3): where each stone was set down (its centroid when lowered, before the layer ran)
+    rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    # (n,): the grid row of each stone in its layer, 0 at the toe
 
     def node_sets(self) -> list[np.ndarray]:
         """The world nodes of every stone."""
@@ -233,6 +238,8 @@ def _set_down_layer(slope, stones, grid, layer, design, rng, probability, rock_s
     start_height = 2.0 * design.layers * design.dn50 + 2.0 * max(
         s.bounding_radius for s in stones.shapes)
     order = np.lexsort((grid[:, 1], grid[:, 0]))
+    # the rows of the grid by their s (a row's points share it exactly: stone_grid)
+    _, row_of_point = np.unique(grid[:, 0], return_inverse=True)
     positions, quaternions = [], []
     for k in order:
         shape = stones.shapes[choice[k]]
@@ -261,6 +268,8 @@ def _set_down_layer(slope, stones, grid, layer, design, rng, probability, rock_s
     stones.shape_of_stone = np.concatenate([stones.shape_of_stone, choice[order]])
     stones.layer_of_stone = np.concatenate([stones.layer_of_stone, np.full(count, layer)])
     stones.positions = np.vstack([stones.positions, np.array(positions)])
+    stones.set_positions = np.vstack([stones.set_positions, np.array(positions)])
+    stones.rows = np.concatenate([stones.rows, row_of_point[order]]).astype(np.int64)
     stones.quaternions = np.vstack([stones.quaternions, np.array(quaternions)])
     stones.frames = stones.frames + ["shape"] * count
 
@@ -348,36 +357,17 @@ def _layer_simulation(slope, stones, underlayer, materials, run) -> Simulation:
 def stone_layer_summary(slope, stones: ArmourStones, underlayer: Underlayer,
                         design: StoneLayerDesign, s_range) -> dict:
     """The placed layer beside its design: stones per area, layer thickness and its k_t, bulk
-    porosity, over the face between a D_n50 inside the lowest and the highest stone centroids."""
+    porosity, over the face between a D_n50 inside the lowest and the highest stone centroids,
+    with the placed stones' own D_n50 (as a laboratory measures the stones it placed; the
+    grading's is ``design.dn50``)."""
     dn50 = design.dn50
-    coords = slope.to_slope(stones.positions)
-    on_face = (coords[:, 0] > -dn50) & (coords[:, 0] < slope.length)
-    s_low = coords[on_face, 0].min() + dn50
-    s_high = coords[on_face, 0].max() - dn50
-    inside = on_face & (coords[:, 0] >= s_low) & (coords[:, 0] <= s_high)
-    area = slope.slope_area(s_low, s_high) if s_high > s_low else 0.0
     volumes = np.array([float(stones.shapes[c].mesh.volumes().sum())
                         for c in stones.shape_of_stone])
-    nodes = [n for n, ok in zip(stones.node_sets(), inside) if ok]
-    tops = layer_metrics.body_tops(slope, nodes) if nodes else np.zeros(0)
-    upper = tops[tops >= np.median(tops)] if len(tops) else tops
-    thickness = float(upper.mean() - underlayer.top_level) if len(upper) else math.nan
-    count = int(inside.sum())
-    measured = {
-        "stones_placed": int(len(stones.positions)),
-        "stones_rolled_off": int((~on_face).sum()),
-        "stones_below_toe": int((coords[:, 0] <= -dn50).sum()),
-        "stones_beyond_top": int((coords[:, 0] >= slope.length).sum()),
-        "measuring_area_m2": float(area),
-        "stones_measured": count,
-        "stones_per_area": count / area if area > 0 else math.nan,
-        "layer_thickness_m": thickness,
-        "porosity": (float(1.0 - volumes[inside].sum() / (area * thickness))
-                     if area > 0 and thickness > 0 else math.nan),
-        "surface_roughness_over_dn50": float(np.std(upper) / dn50) if len(upper) else math.nan,
-    }
-    measured["layer_thickness_coefficient"] = thickness / (design.layers * dn50)
-    measured["stones_per_area_times_dn50_squared"] = measured["stones_per_area"] * dn50 ** 2
+    # D_n50 of the volumes: any density gives the same (masses and density cancel)
+    placed_dn50 = grading_statistics(2650.0 * volumes, density=2650.0).dn50
+    measured = {"dn50_m": placed_dn50, **layer_metrics.stone_layer_figures(
+        slope, stones.positions, stones.node_sets(), volumes, dn50=placed_dn50,
+        layers=design.layers, underlayer_level=underlayer.top_level)}
     return {"design": {"dn50_m": dn50, "layers": design.layers, "placement": design.placement,
                        "layer_thickness_coefficient": design.layer_thickness_coefficient,
                        "porosity": design.porosity, "layer_thickness_m": design.layer_thickness,

@@ -89,3 +89,42 @@ def layer_figures(slope, unit_positions, unit_node_sets, *, rows, nominal_diamet
         figures[NOT_MEASURED] = ("the units' tops are not above the underlayer's top: no layer "
                                  "thickness, so no porosity")
     return figures
+
+
+def stone_layer_figures(slope, positions, node_sets, volumes, *, dn50: float, layers: int,
+                        underlayer_level: float) -> dict:
+    """A layer of graded armour stone measured as the Rock Manual measures one (5.2.2.10;
+    k_t on p. 126): over the face between a D_n50 inside the lowest and the highest stone
+    centroids, the stones per area N_a, the layer thickness t from the underlayer's top to the
+    mean of the upper half of the stone tops (a survey staff's foot rests on the higher stones),
+    k_t = t / (n D_n50), the bulk porosity 1 - (stone volume) / (area t) and the roughness of
+    the tops (their standard deviation over D_n50). ``positions`` (n, 3) world centroids,
+    ``node_sets`` each stone's world nodes, ``volumes`` (n,) m^3."""
+    coords = slope.to_slope(np.asarray(positions, dtype=float).reshape(-1, 3))
+    volumes = np.asarray(volumes, dtype=float)
+    on_face = (coords[:, 0] > -dn50) & (coords[:, 0] < slope.length)
+    s_low = coords[on_face, 0].min() + dn50 if on_face.any() else 0.0
+    s_high = coords[on_face, 0].max() - dn50 if on_face.any() else 0.0
+    inside = on_face & (coords[:, 0] >= s_low) & (coords[:, 0] <= s_high)
+    area = slope.slope_area(s_low, s_high) if s_high > s_low else 0.0
+    tops = body_tops(slope, [n for n, ok in zip(node_sets, inside) if ok])
+    upper = tops[tops >= np.median(tops)] if len(tops) else tops
+    thickness = float(upper.mean() - underlayer_level) if len(upper) else float("nan")
+    count = int(inside.sum())
+    per_area = count / area if area > 0 else float("nan")
+    return {
+        "stones_placed": int(len(coords)),
+        "stones_rolled_off": int((~on_face).sum()),
+        "stones_below_toe": int((coords[:, 0] <= -dn50).sum()),
+        "stones_beyond_top": int((coords[:, 0] >= slope.length).sum()),
+        "measuring_area_m2": float(area),
+        "stones_measured": count,
+        "stones_per_area": per_area,
+        "layer_thickness_m": thickness,
+        "porosity": (float(1.0 - volumes[inside].sum() / (area * thickness))
+                     if area > 0 and thickness > 0 else float("nan")),
+        "surface_roughness_over_dn50": (float(np.std(upper) / dn50) if len(upper)
+                                        else float("nan")),
+        "layer_thickness_coefficient": thickness / (layers * dn50),
+        "stones_per_area_times_dn50_squared": per_area * dn50 ** 2,
+    }

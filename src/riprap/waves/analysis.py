@@ -154,6 +154,9 @@ class ReflectionAnalysis:
     band: tuple                  # (lowest, highest) frequency used (Hz)
     #: the incident spectrum's peak period (s) by Read's Fp5 (irregular three-gauge splits only)
     incident_peak_period: float | None = None
+    #: the incident spectrum's T_m-1,0 = m_-1 / m_0 over the band split (s; irregular three-gauge
+    #: splits only): the period of the rock formulas (Van der Meer 2021, Etemad-Shahidi 2020)
+    incident_spectral_period: float | None = None
 
     def as_dict(self) -> dict:
         entry = {"incident_Hm0_m": self.incident_hm0, "reflected_Hm0_m": self.reflected_hm0,
@@ -161,6 +164,8 @@ class ReflectionAnalysis:
                  "band_Hz": list(self.band)}
         if self.incident_peak_period is not None:
             entry["incident_Tp_s"] = self.incident_peak_period
+        if self.incident_spectral_period is not None:
+            entry["incident_Tm-1,0_s"] = self.incident_spectral_period
         return entry
 
 
@@ -321,7 +326,16 @@ def separate_three_gauges(times, records, positions, depth: float,
                               reflection_coefficient=math.sqrt(energy_reflected / energy_incident)
                               if energy_incident > 0 else float("nan"),
                               band=(used[0], used[-1]),
-                              incident_peak_period=smoothed_peak_period(used, incident_energies))
+                              incident_peak_period=smoothed_peak_period(used, incident_energies),
+                              incident_spectral_period=_spectral_period(used, incident_energies))
+
+
+def _spectral_period(frequencies, energies) -> float:
+    """T_m-1,0 = m_-1 / m_0 (s) of a spectrum given as energies per frequency."""
+    frequencies = np.asarray(frequencies, dtype=float)
+    energies = np.asarray(energies, dtype=float)
+    total = float(energies.sum())
+    return float((energies / frequencies).sum() / total) if total > 0 else float("nan")
 
 
 def harmonic_amplitude(times, eta, period: float) -> complex:

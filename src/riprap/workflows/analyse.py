@@ -14,6 +14,7 @@ import numpy as np
 
 from riprap.analysis.flume_test import FlumeRecords, fluid_force_columns, with_derived
 from riprap.analysis.layer_analysis import DISPLACED_THRESHOLD_DN, LayerAnalysis, analyse_layer
+from riprap.analysis.rock_stability import NOMINAL_OVER_SIEVE_DIAMETER, RockSection
 from riprap.analysis.stability_report import flume_stability
 from riprap.errors import CaseFileError
 from riprap.io.analysis_input import is_run_folder, load_waves_report, run_was_smoke
@@ -113,7 +114,9 @@ def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:
     analysis.layer["flume_test"] = flume_stability(
         waves, analysis.layer, unit_kind=layer.unit_kind, nominal_diameter=layer.nominal_diameter,
         armour_density=float(densities[unit]), water_density=water_density,
-        slope_cot=layer.slope.cotangent)
+        slope_cot=layer.slope.cotangent,
+        rock_section=_rock_section(case, layer) if layer.is_rock else None,
+        still_water_level=_still_water_level(case))
     # where the crest begins, for the crest width of a series' EurOtop comparison
     analysis.layer["flume_test"]["slope_crest_x_m"] = float(layer.slope.crest_x)
     gauges = read_run_gauges(Path(path), case)
@@ -122,6 +125,36 @@ def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:
     records = FlumeRecords(waves_report=waves, times=times, columns=columns, target=_target(case),
                            contacts=contacts)
     return replace(analysis, flume=with_derived(records, analysis.units))
+
+
+def _still_water_level(case) -> float | None:
+    spec = case.waves
+    if spec is None or "still_water_level" not in spec.parameters:
+        return None
+    return float(spec.parameters["still_water_level"])
+
+
+def _rock_section(case, layer) -> RockSection:
+    """The cross-section the rock formulas need: the filter from the layer's design, the core
+    from the case's ``[[porous_zones]]`` of ``part = "core"`` (its D50 as D_n50 = 0.84 D50;
+    none: an impermeable core, said so), the depth at the toe from the still water level."""
+    cores = [zone for zone in case.porous_zones if zone.part == "core"]
+    if cores:
+        d50 = max(float(zone.stone_diameter) for zone in cores)
+        core, note = (NOMINAL_OVER_SIEVE_DIAMETER * d50,
+                      f"the case's porous core ([[porous_zones]] part = \"core\"): D50 {d50:g} m, "
+                      f"D_n50 = {NOMINAL_OVER_SIEVE_DIAMETER} D50 (The Rock Manual 3.4.1)")
+    else:
+        others = len(case.porous_zones)
+        core, note = 0.0, ("no [[porous_zones]] has part = \"core\": the core is taken as "
+                           "impermeable (D_n50,core 0, P 0.1)"
+                           + (f"; the case has {others} other porous zone(s)" if others else ""))
+    level = _still_water_level(case)
+    design = layer.design
+    return RockSection(
+        filter_dn50=design.get("filter_dn50_m"), core_dn50=core, core_note=note,
+        grading_ratio=design.get("placed_dn85_over_dn15"),
+        water_depth=(level - float(layer.slope.toe[2])) if level is not None else None)
 
 
 def _target(case) -> dict | None:

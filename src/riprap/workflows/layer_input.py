@@ -72,13 +72,16 @@ def _rotation_matrices(quaternions) -> np.ndarray:
 
 
 def _check_layer_against_case(layer, case, shape_names, pack_file) -> None:
-    if layer.unit_shape not in shape_names:
-        raise CaseFileError(f"{pack_file.parent / 'layer.json'}: unit_shape '{layer.unit_shape}' is "
+    allowed = layer.unit_shape_names
+    unknown = [name for name in allowed if name not in shape_names]
+    if unknown:
+        raise CaseFileError(f"{pack_file.parent / 'layer.json'}: unit_shape '{unknown[0]}' is "
                             f"not a shape of {pack_file} (shapes: {', '.join(shape_names)})")
-    wrong = [int(b) for b in layer.unit_bodies if case.bodies[b].shape != layer.unit_shape]
+    wrong = [int(b) for b in layer.unit_bodies if case.bodies[b].shape not in allowed]
     if wrong:
+        names = "', '".join(allowed[:5]) + ("', ..." if len(allowed) > 5 else "'")
         raise CaseFileError(f"{pack_file.parent / 'layer.json'}: unit_bodies {wrong[:5]} are not "
-                            f"'{layer.unit_shape}' bodies in {pack_file}")
+                            f"'{names} bodies in {pack_file}")
 
 
 def _check_contacts(contacts, n_bodies, n_walls, where) -> None:

@@ -12,8 +12,9 @@ the one asked (M50, W85/W15, D_n50; for a named class its EN 13383 requirements)
 
 Output folder: ``underlayer/`` and ``stones/layer_<k>/`` (the runs), ``pack.toml`` and
 ``shapes/`` (rocks fixed, stones free; ``riprap run`` reads it), ``contacts.csv``,
-``final_layer.png``, ``summary.json``. No ``layer.json`` yet: ``riprap analyse`` reads layers of
-armour units; rock armour's survey (S from the profiles) comes with the rock series.
+``final_layer.png``, ``summary.json`` and ``layer.json`` (the stones as the layer's units, of kind
+``armour_stone``: ``riprap analyse`` and a test series' survey read it; S from the profiles and
+the rock formulas in its stability report).
 """
 from __future__ import annotations
 
@@ -26,7 +27,8 @@ from riprap.case.build import SMOKE_END_TIME, smoke_mode
 from riprap.errors import CaseFileError
 from riprap.geometry.armour_stone import ArmourGrading, standard_grading
 from riprap.geometry.rock_grading import RockGrading, rock_library
-from riprap.io.layer_file import CONTACTS_FILE_NAME, write_contact_table
+from riprap.analysis.layer_state import LayerDescription
+from riprap.io.layer_file import CONTACTS_FILE_NAME, write_contact_table, write_layer_file
 from riprap.io.output_folder import prepare_output_folder
 from riprap.io.summary import write_json
 from riprap.placement import PlacementMaterials, Slope, build_underlayer
@@ -156,9 +158,16 @@ def run_stone_placement(case, materials: PlacementMaterials, *, output_directory
     summary["underlayer_rocks"] = int(len(underlayer.positions))
     summary["underlayer_top_m"] = float(underlayer.top_level)
     summary["runs"] = runs
-    summary["analysis"] = ("riprap analyse reads layers of armour units; rock armour's survey "
-                           "(S from the profiles) is not written by this placement yet")
     summary["outputs"] = _write_outputs(case, stones, materials, slope, out)
+    layer = LayerDescription.for_stones(
+        shape_names=sorted({stones.shapes[c].name for c in stones.shape_of_stone}),
+        nominal_diameter=summary["grading"]["placed"]["Dn50_m"], mean_volume=volumes.mean(),
+        design=inputs.design, slope=slope, underlayer_top=underlayer.top_level,
+        unit_bodies=np.arange(len(underlayer.positions),
+                              len(underlayer.positions) + len(stones.positions)),
+        rows=stones.rows, design_positions=stones.set_positions, filter_dn50=ul.dn50,
+        grading_ratio=summary["grading"]["placed"]["Dn85_over_Dn15"])
+    summary["outputs"]["layer"] = str(write_layer_file(out, layer))
     write_json(out / "summary.json", summary)
     return summary
 

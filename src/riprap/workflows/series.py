@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riprap.analysis.series_damage import series_curve
+from riprap.analysis.series_damage import ROCK_FORMULA_COLUMNS, rock_formula_curves, series_curve
 from riprap.case.build_fluid import build_fluid_run, build_fluid_solver
 from riprap.case.load import parse_case
 from riprap.case.series_steps import mean_zero_crossing_period, step_case_text, step_seas
@@ -286,6 +286,37 @@ def _survey(step: _Step, first: Path, case, say) -> None:
         f"{layer.get('damage_level_s', math.nan):.3g}")
 
 
+def _rock_curves(curve: dict, measured_at_toe: list, last: dict) -> dict:
+    """A rock series' curve gains T_m-1,0 at the toe, the Rock Manual class of each step's S and
+    the three rock formulas' S, cumulative over the steps (the structure's P and core from the
+    last surveyed step's report); returns the formulas' record for the results."""
+    rocks = [m.get("rock") or {} for m in measured_at_toe]
+    curve["Tm_1_0_s"] = [_number(r.get("spectral_period_s")) for r in rocks]
+    curve["rock_damage_class"] = [r.get("damage_class", "") for r in rocks]
+    rock = last.get("rock") or {}
+    if "notional_permeability" not in rock:
+        for column in ROCK_FORMULA_COLUMNS:
+            curve[column] = [math.nan] * len(rocks)
+        return {"note": "no step's survey has the rock section (no waves measured at the toe)"}
+    sea_states = [(h, t, n) for h, t, n in zip(curve["Hm0_m"], curve["Tm_1_0_s"],
+                                                 curve["waves"])]
+    curve.update(rock_formula_curves(
+        sea_states, slope_cot=float(last["slope_cot"]), delta=float(last["relative_density"]),
+        nominal_diameter=float(last["nominal_diameter_m"]),
+        permeability=float(rock["notional_permeability"]),
+        core_nominal_diameter=float(rock["core_dn50_m"])))
+    return {"notional_permeability": rock["notional_permeability"],
+            "notional_permeability_reason": rock.get("notional_permeability_reason"),
+            "core_dn50_m": rock["core_dn50_m"], "core": rock.get("core"),
+            "filter_dn50_m": rock.get("filter_dn50_m"),
+            "damage_thresholds": rock.get("damage_class_thresholds"),
+            "columns": ROCK_FORMULA_COLUMNS,
+            "sources": "Van der Meer (2021) with T_m-1,0 and P; Van Gent et al. (2003) with "
+                       "D_n50,core; Etemad-Shahidi et al. (2020, corrigendum 2022) with C_p; "
+                       "damage carried between steps as equivalent waves (Van der Meer 1988); "
+                       "damage classes: The Rock Manual (2007) Table 5.22"}
+
+
 def _series_results(out: Path, steps: list[_Step], case) -> dict:
     """The damage curve from every step's survey and per-wave table, beside the formulas."""
     rows, flume, per_wave, counted_so_far, unmeasured = [], {}, {}, 0, {}
@@ -334,6 +365,8 @@ def _series_results(out: Path, steps: list[_Step], case) -> dict:
     curve["reflection_coefficient"] = [_number(m.get("reflection_coefficient"))
                                        for m in measured_at_toe]
     curve["wave_maker_gain"] = [s.maker.gain if s.maker is not None else 1.0 for s in steps]
+    if flume.get("unit") == "armour_stone":
+        results["formulas"]["rock"] = _rock_curves(curve, measured_at_toe, flume)
     results["wave_calibration"] = case.series.wave_calibration
     results["per_wave"] = per_wave
     results["run_mode"] = run_mode()
