@@ -184,6 +184,12 @@ def _say_stone_layer(summary: dict) -> None:
           f"{_measured(measured['porosity'], '{:.3f}')} (design {design['porosity']:g}), stones "
           f"per m^2 {_measured(measured['stones_per_area'], '{:.4g}')} (design "
           f"{design['stones_per_area']:.4g})")
+    berm = measured.get("toe_berm")
+    if berm:
+        print(f"riprap: toe berm {design['toe_berm_width_m']:g} m wide: {berm['stones']} stones, "
+              f"top {berm['top_above_bed_m']:.3g} m above the bed (design "
+              f"{berm['design_top_above_bed_m']:.3g} m), {berm['stones_off_the_bed']} ended on "
+              "the face")
     print(f"riprap: the stones placed: M50 {grading['placed']['M50_kg']:.4g} kg, M85/M15 "
           f"{grading['placed']['M85_over_M15']:.3g} (the grading: {grading['asked']['M50_kg']:.4g}"
           f" kg, {grading['asked']['M85_over_M15']:.3g})")

@@ -614,6 +614,11 @@ KEYS: tuple[Key, ...] = (
     Key("armour_stone", "to_s", "number", "m",
         "Upper end of the armour along the face; 0: the whole face.", default=0.0,
         valid_range=_NON_NEGATIVE),
+    Key("armour_stone", "toe_berm_width", "number", "m",
+        "Width of a toe berm of the same stones on the bed in front of the toe, in as many "
+        "layers as the slope's (about 3 D_n50: three stones); 0: no berm, the slope's "
+        "toe_stop_distance holds the layer. The berm needs [slope] toe_stop_distance at least "
+        "this wide (the fixed toe in front of it).", default=0.0, valid_range=_NON_NEGATIVE),
     Key("armour_stone", "settle_time", "number", "s",
         "Longest simulated time to let each layer of stones settle.", default=2.0,
         valid_range=_POSITIVE),

@@ -64,7 +64,19 @@ def test_the_design_by_hand():
     slope = Slope(cotangent=2.0, width=0.4, length=2.0, periodic=True)
     grid = stone_grid(slope, design, (0.0, 2.0), 0)
     per_layer = len(grid) / (0.4 * 2.0)
-    assert per_layer == pytest.approx(design.stones_per_area / 2, rel=0.1)
+    assert per_layer == pytest.approx(design.stones_per_area / 2, rel=0.04)
+    # a strip 4.5 spacings wide holds 4 stones across (or 5): the rows move closer (or apart)
+    # so that a row's share of the face keeps the design's count
+    for width in (4.5 * design.spacing, 4.4 * design.spacing, 5.6 * design.spacing):
+        strip = Slope(cotangent=2.0, width=width, length=2.0, periodic=True)
+        points = stone_grid(strip, design, (0.0, 2.0), 0)
+        rows = np.unique(points[:, 0])
+        area = width * (rows[-1] - rows[0])
+        inner = np.sum((points[:, 0] > rows[0]) & (points[:, 0] < rows[-1]))
+        edge = len(points) - inner
+        # trapezoid over the rows: half of the first and last rows, all between
+        assert (inner + 0.5 * edge) / area == pytest.approx(design.stones_per_area / 2,
+                                                            rel=1e-9), width
 
 
 def test_a_double_layer_rests_on_the_face_near_its_design(placed):
@@ -91,7 +103,33 @@ def test_the_same_seed_places_the_same_layer(placed):
     ({"dn50": 0.04, "placement": "careful"}, "placement = 'careful'"),
     ({"dn50": 0.04, "layers": 3}, "3 layer\\(s\\) placed standard has no layer thickness"),
     ({"dn50": 0.04, "porosity": 1.2}, "porosity must lie between 0 and 1"),
+    ({"dn50": 0.04, "toe_berm_width": -0.1}, "toe_berm_width must be 0"),
+    ({"dn50": 0.04, "toe_berm_width": 0.02}, "holds no stone of D_n50"),
 ])
 def test_bad_designs_are_refused(keys, words):
     with pytest.raises(CaseFileError, match=words):
         StoneLayerDesign(**keys)
+
+
+def test_a_toe_berm_grid_lies_on_the_bed_in_front_of_the_toe():
+    """Berm rows a spacing apart from the toe seaward, within the berm's width, the second layer
+    shifted half a spacing; the face's rows unchanged."""
+    slope = Slope(cotangent=2.0, width=0.2, length=0.4, toe_x=0.5, toe_stop_distance=0.15,
+                  periodic=True)
+    plain = StoneLayerDesign(dn50=DN50)
+    berm = StoneLayerDesign(dn50=DN50, toe_berm_width=0.12)
+    cos = math.cos(slope.angle)
+    across = round(slope.width / berm.spacing)
+    spacing = berm.spacing ** 2 / (slope.width / across)   # the rows' spacing on this strip
+    for layer in (0, 1):
+        face = stone_grid(slope, plain, (0.0, 0.4), layer)
+        both = stone_grid(slope, berm, (0.0, 0.4), layer)
+        np.testing.assert_array_equal(both[both[:, 0] >= 0], face)
+        back = -both[both[:, 0] < 0, 0] * cos          # distance seaward of the toe along x
+        rows = np.unique(np.round(back, 12))
+        # rows at 0.5, 1.5, ... spacings (+ half a spacing on the second layer) while a stone's
+        # half D_n50 stays inside the berm
+        expected = [0.5 * spacing + k * spacing + 0.5 * spacing * layer for k in range(5)]
+        expected = [b for b in expected if b <= 0.12 - 0.5 * DN50]
+        np.testing.assert_allclose(rows, expected, rtol=1e-9)
+        assert len(back) == across * len(expected)

@@ -134,6 +134,8 @@ def test_place_writes_a_pack_and_the_layer_beside_its_design(tmp_path):
     ("seed = 2", "seed = 2\nto_s = 0.5", "to_s.*beyond the crest"),
     ("seed = 2", "seed = 2\nlength_scale = 30.0", "length_scale.*scales a named grading"),
     ("seed = 2", "seed = 2\nplacement = \"careful\"", "placement"),
+    ("seed = 2", "seed = 2\ntoe_berm_width = 0.12", "toe_berm_width = 0.12 m.*toe_stop_distance "
+     "= 0.02 m; give toe_stop_distance 0.12 m or more"),
 ])
 def test_bad_rock_armour_is_refused_by_check_and_place(tmp_path, capsys, old, new, words):
     import re
@@ -144,3 +146,21 @@ def test_bad_rock_armour_is_refused_by_check_and_place(tmp_path, capsys, old, ne
         err = capsys.readouterr().err
         assert re.search(words, err), err
         assert not (tmp_path / "out").exists()
+
+
+def test_a_toe_berm_is_placed_on_the_bed_and_said(tmp_path, capsys):
+    """A toe berm three stones wide in two layers (about 3 D_n50 by 2 layers, as a contractor
+    builds a rock toe) in front of the toe, held by the toe stop: its stones rest on the bed,
+    its top near the design layer thickness, none carried onto the face."""
+    case = _case(tmp_path, "toe_stop_distance = 0.02", "toe_stop_distance = 0.13")
+    case.write_text(case.read_text().replace("seed = 2", "seed = 2\ntoe_berm_width = 0.12"))
+    assert main(["place", str(case), "--out", str(tmp_path / "b")]) == 0
+    assert "toe berm 0.12 m wide" in capsys.readouterr().out
+    summary = json.loads((tmp_path / "b" / "summary.json").read_text())
+    berm = summary["measured"]["toe_berm"]
+    assert summary["design"]["toe_berm_width_m"] == 0.12
+    assert berm["stones"] >= 8 and berm["stones_off_the_bed"] == 0
+    assert 0.6 < berm["top_above_bed_m"] / berm["design_top_above_bed_m"] < 1.4
+    # every stone, the berm's too, is a unit of the layer the analysis reads
+    layer = json.loads((tmp_path / "b" / "layer.json").read_text())
+    assert len(layer["unit_bodies"]) == summary["grading"]["placed"]["stones"]

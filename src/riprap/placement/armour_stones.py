@@ -71,11 +71,21 @@ class StoneLayerDesign:
     layers: int = 2
     placement: str = "standard"
     porosity: float = ROCK_DESIGN_POROSITY
+    #: width (m) of a toe berm of the same stones on the bed in front of the toe, in as many
+    #: layers as the slope's; 0: none (the slope's toe stop holds the layer)
+    toe_berm_width: float = 0.0
 
     def __post_init__(self):
         if not (math.isfinite(self.dn50) and self.dn50 > 0):
             raise CaseFileError(f"armour stones: dn50 must be a positive length in m, got "
                                 f"{self.dn50!r}")
+        if not (math.isfinite(self.toe_berm_width) and self.toe_berm_width >= 0):
+            raise CaseFileError(f"armour stones: toe_berm_width must be 0 (no berm) or a positive "
+                                f"width in m, got {self.toe_berm_width!r}")
+        if 0 < self.toe_berm_width < self.dn50:
+            raise CaseFileError(f"armour stones: a toe berm {self.toe_berm_width:g} m wide holds "
+                                f"no stone of D_n50 = {self.dn50:g} m; give toe_berm_width 0 (no "
+                                f"berm) or about {3 * self.dn50:.3g} m (three stones)")
         if self.placement not in STONE_PLACEMENTS:
             raise CaseFileError(f"armour stones: placement = {self.placement!r}: expected one of "
                                 f"{', '.join(STONE_PLACEMENTS)}")
@@ -112,8 +122,9 @@ def stone_grid(slope, design: StoneLayerDesign, s_range, layer: int) -> np.ndarr
     """(s, y) of the stones of ``layer`` (0 first) on the face between ``s_range``: rows along
     the face a spacing apart, alternate rows shifted half a spacing across, the second layer
     shifted half a spacing both ways. On a periodic strip a row holds a whole number of stones
-    (its spacing stretched to fill the width); between walls the rows keep half a spacing from
-    each wall."""
+    (the spacing across stretched or shrunk to fill the width) and the rows' spacing along the
+    face changes the other way, so that the grid keeps the design's stones per area on any
+    width; between walls the rows keep half a spacing from each wall."""
     s_low, s_high = (float(v) for v in s_range)
     spacing = design.spacing
     if slope.periodic:
@@ -122,7 +133,8 @@ def stone_grid(slope, design: StoneLayerDesign, s_range, layer: int) -> np.ndarr
     else:
         across = int((slope.width - spacing) // spacing) + 1
         dy = spacing
-    rows = int((s_high - s_low - 0.5 * spacing) // spacing) + 1
+    ds = spacing ** 2 / dy          # one stone per ds x dy: the design's stones per area
+    rows = int((s_high - s_low - 0.5 * ds) // ds) + 1
     if across < 1 or rows < 1 or slope.width < design.dn50:
         raise CaseFileError(f"armour stones: the face s = {s_low:g}..{s_high:g} m by "
                             f"{slope.width:g} m holds no row of stones {spacing:.3g} m apart "
@@ -130,7 +142,7 @@ def stone_grid(slope, design: StoneLayerDesign, s_range, layer: int) -> np.ndarr
     points = []
     for row in range(rows):
         shift = 0.5 * dy * ((row + layer) % 2)
-        s = s_low + 0.5 * spacing + row * spacing + 0.5 * spacing * (layer % 2)
+        s = s_low + 0.5 * ds + row * ds + 0.5 * ds * (layer % 2)
         if s > s_high - 0.5 * design.dn50:
             continue            # a stone there would stand out over the top of the face
         y0 = (0.5 * dy if slope.periodic else 0.5 * (slope.width - (across - 1) * dy)) + shift
@@ -139,8 +151,34 @@ def stone_grid(slope, design: StoneLayerDesign, s_range, layer: int) -> np.ndarr
             if not slope.periodic and y > slope.width - 0.5 * design.dn50:
                 continue
             points.append((s, y))
+    points.extend(_berm_points(slope, design, layer, across, dy, ds))
     points = np.array(points)
     points[:, 1] = slope.wrapped(points[:, 1])
+    return points
+
+
+def _berm_points(slope, design: StoneLayerDesign, layer: int, across: int, dy: float,
+                 ds: float) -> list:
+    """(s, y) of a toe berm's stones of ``layer``: rows across the bed ``ds`` apart from the
+    toe seaward over ``design.toe_berm_width``, staggered as the face's; s < 0 (along the face's
+    line produced below the toe: straight above it lies the bed point the stone is lowered
+    onto)."""
+    if design.toe_berm_width <= 0:
+        return []
+    cos = math.cos(slope.angle)
+    points, row = [], 0
+    while True:
+        back = 0.5 * ds + row * ds + 0.5 * ds * (layer % 2)
+        if back > design.toe_berm_width - 0.5 * design.dn50:
+            break
+        shift = 0.5 * dy * ((row + layer + 1) % 2)
+        y0 = (0.5 * dy if slope.periodic else 0.5 * (slope.width - (across - 1) * dy)) + shift
+        for column in range(across):
+            y = y0 + column * dy
+            if not slope.periodic and y > slope.width - 0.5 * design.dn50:
+                continue
+            points.append((-back / cos, y))
+        row += 1
     return points
 
 
@@ -162,7 +200,9 @@ class ArmourStones:
     set_positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     # (n, 3): where each stone was set down (its centroid when lowered, before the layer ran)
     rows: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    # (n,): the grid row of each stone in its layer, 0 at the toe
+    # (n,): the grid row of each stone in its layer, 0 the lowest (a toe berm's rows first)
+    in_berm: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
+    # (n,): set down in the toe berm (on the bed in front of the toe), not on the face
 
     def node_sets(self) -> list[np.ndarray]:
         """The world nodes of every stone."""
@@ -270,6 +310,7 @@ def _set_down_layer(slope, stones, grid, layer, design, rng, probability, rock_s
     stones.positions = np.vstack([stones.positions, np.array(positions)])
     stones.set_positions = np.vstack([stones.set_positions, np.array(positions)])
     stones.rows = np.concatenate([stones.rows, row_of_point[order]]).astype(np.int64)
+    stones.in_berm = np.concatenate([stones.in_berm, grid[order, 0] < 0.0])
     stones.quaternions = np.vstack([stones.quaternions, np.array(quaternions)])
     stones.frames = stones.frames + ["shape"] * count
 
@@ -332,11 +373,26 @@ def _clear_start(slope, stones, underlayer, materials, run, design) -> Simulatio
             sim.accepted_overlaps = {pair: max(depth, carried.get(pair, 0.0))
                                      for pair, depth in {**carried, **resting}.items()}
             return sim
-        for k, depth in lifts.items():
-            step = 2.0 * depth + _RELEASE_GAP * design.dn50 * 2.0 ** attempt
-            stones.positions[k, 2] += step
-            if k in off_walls:      # the toe stop stands upright: up the slope, too
-                stones.positions[k, 0] += step
+        reach = 2.0 * max(s.bounding_radius for s in stones.shapes)
+        moves = np.zeros(len(stones.positions))
+        sideways = np.zeros(len(stones.positions), dtype=bool)
+        for k in sorted(lifts):
+            # its own lift on top of what it is carried up by (a stone below it lifted)
+            total = moves[k] + 2.0 * lifts[k] + _RELEASE_GAP * design.dn50 * 2.0 ** attempt
+            moves[k] = total
+            sideways[k] = k in off_walls
+            # the stones set down after this one within reach of it may rest on it (each was
+            # lowered onto those before it), and others on them: they go up with it, or each
+            # lift would push into the next stone up the face
+            group = [k]
+            for m in np.flatnonzero(new & (np.arange(len(new)) > k)):
+                if np.min(np.linalg.norm(stones.positions[group, :2] - stones.positions[m, :2],
+                                         axis=1)) <= reach:
+                    group.append(int(m))
+            moves[group[1:]] = np.maximum(moves[group[1:]], total)
+        stones.positions[:, 2] += moves
+        # the toe stop stands upright: a stone pressed into it goes up the slope too
+        stones.positions[sideways, 0] += moves[sideways]
     raise CaseFileError(f"armour stones: stones {sorted(lifts)[:10]} still overlap after being "
                         f"lifted {_MAX_LIFTS} times; the grid is too dense for these stones")
 
@@ -365,10 +421,27 @@ def stone_layer_summary(slope, stones: ArmourStones, underlayer: Underlayer,
                         for c in stones.shape_of_stone])
     # D_n50 of the volumes: any density gives the same (masses and density cancel)
     placed_dn50 = grading_statistics(2650.0 * volumes, density=2650.0).dn50
+    face = ~stones.in_berm
+    nodes = stones.node_sets()
     measured = {"dn50_m": placed_dn50, **layer_metrics.stone_layer_figures(
-        slope, stones.positions, stones.node_sets(), volumes, dn50=placed_dn50,
-        layers=design.layers, underlayer_level=underlayer.top_level)}
+        slope, stones.positions[face], [n for n, ok in zip(nodes, face) if ok], volumes[face],
+        dn50=placed_dn50, layers=design.layers, underlayer_level=underlayer.top_level)}
+    if stones.in_berm.any():
+        # the berm's top above the bed: the highest point of each berm stone's nodes above the
+        # bed, the upper half's mean (as a staff's foot on the higher stones)
+        levels = np.array([nodes[k][:, 2].max() for k in np.flatnonzero(stones.in_berm)])
+        levels = levels - slope.toe_level
+        upper = levels[levels >= np.median(levels)]
+        measured["toe_berm"] = {
+            "stones": int(stones.in_berm.sum()),
+            "top_above_bed_m": float(upper.mean()),
+            "design_top_above_bed_m": design.layer_thickness,
+            # berm stones that ended on the face (their centroid half a D_n50 past the toe)
+            "stones_off_the_bed": int(sum(
+                1 for k in np.flatnonzero(stones.in_berm)
+                if stones.positions[k, 0] > slope.toe_x + 0.5 * dn50))}
     return {"design": {"dn50_m": dn50, "layers": design.layers, "placement": design.placement,
+                       "toe_berm_width_m": design.toe_berm_width,
                        "layer_thickness_coefficient": design.layer_thickness_coefficient,
                        "porosity": design.porosity, "layer_thickness_m": design.layer_thickness,
                        "stones_per_area": design.stones_per_area,

@@ -97,11 +97,17 @@ def prepare_stone_placement(case, materials: PlacementMaterials) -> StonePlaceme
                             f"{grading.dn50 / 2.3:.3g} m")
     try:
         design = StoneLayerDesign(dn50=grading.dn50, layers=spec.layers,
-                                  placement=spec.placement, porosity=spec.porosity)
+                                  placement=spec.placement, porosity=spec.porosity,
+                                  toe_berm_width=spec.toe_berm_width)
         s_range = (spec.from_s, spec.to_s or slope.length)
         count = sum(len(stone_grid(slope, design, s_range, layer)) for layer in range(spec.layers))
     except CaseFileError as error:
         raise CaseFileError(f"{where}: {error}") from None
+    if design.toe_berm_width > 0 and slope.toe_stop_distance < design.toe_berm_width:
+        raise CaseFileError(f"{where} toe_berm_width = {design.toe_berm_width:g} m: the berm "
+                            "lies on the bed between the toe and the fixed toe stop, but [slope] "
+                            f"toe_stop_distance = {slope.toe_stop_distance:g} m; give "
+                            f"toe_stop_distance {design.toe_berm_width:g} m or more")
     if not slope.periodic and slope.width < 2.0 * design.spacing:
         raise CaseFileError(f"{where}: the section (slope.width = {slope.width:g} m) holds fewer "
                             f"than two stones across ({design.spacing:.3g} m apart, D_n50 = "
