@@ -109,6 +109,13 @@ ROCK_DESIGN_TOLERANCES = (
 )
 
 
+def primary_axis_name(layer: dict) -> str:
+    """The axis whose fabric a layer summary gives (``<name>_axis_fabric``: ``nose`` of concrete
+    units, ``long`` of armour stones)."""
+    return next((key[:-len("_axis_fabric")] for key in layer if key.endswith("_axis_fabric")),
+                "nose")
+
+
 def design_verdict(layer: dict) -> list[dict]:
     """The layer measured against design, one entry per row of :data:`DESIGN_TOLERANCES`.
 
@@ -409,7 +416,7 @@ def write_analysis(out, analysis) -> dict:
 
 def _write_report(out: Path, analysis) -> Path:
     layer, units = analysis.layer, analysis.units
-    axis = analysis.state.layer.primary_axis
+    axis = primary_axis_name(layer)
     histogram = ", ".join(f"{k}: {v}" for k, v in layer["coordination_number_histogram"].items())
     low = layer["units_below_factor_of_safety_1"]
     # Only the first letter raised: str.capitalize would also lower the unit, "(N)" to "(n)".
