@@ -198,3 +198,47 @@ def test_check_gives_a_cost_estimate_for_a_series_and_a_campaign(tmp_path):
     assert "3 members" in one_worker and "on 1 worker at once" in one_worker
     assert "on 3 workers at once" in three
     assert not (tmp_path / "out").exists()
+
+
+def test_a_rock_series_sets_s_beside_the_three_formulas(tmp_path, drawn):
+    """Rock armour (issue 55): the curve gains T_m-1,0, the Rock Manual class and the three
+    formulas' S cumulative over the steps; the report draws S beside them and names P."""
+    from riprap.analysis.rock_stability import RockSection, rock_stability
+    from riprap.analysis.series_damage import rock_formula_curves
+    from riprap.workflows.series import _rock_curves
+
+    section = RockSection(filter_dn50=0.013, core_dn50=0.0084, core_note="the case's core")
+    steps = ((1, 0.08, 1.3, 50, 0.8), (2, 0.10, 1.45, 50, 2.9))
+    rows = [{"step": k, "Hm0_m": hm0, "Tm_s": 1.1, "waves": n, "units_displaced": 0,
+             "N_od": 0.0, "S": s, "rocking_events": 0, "q_m3_s_m": 0.0}
+            for k, hm0, _, n, s in steps]
+    results = series_curve(rows, unit_kind="armour_stone", nominal_diameter=0.03, delta=1.65,
+                           slope_cot=2.0, freeboard=0.1, crest_width=None)
+    flumes = [{"unit": "armour_stone", "slope_cot": 2.0, "relative_density": 1.65,
+               "nominal_diameter_m": 0.03,
+               "rock": rock_stability(hs=hm0, spectral_period=tm, waves=n, slope_cot=2.0,
+                                      armour_density=2650.0, water_density=1000.0,
+                                      nominal_diameter=0.03, damage=s, section=section)}
+              for _, hm0, tm, n, s in steps]
+    results["formulas"]["rock"] = _rock_curves(results["curve"], flumes, flumes[-1])
+    curve = results["curve"]
+    assert curve["Tm_1_0_s"] == [1.3, 1.45]
+    assert curve["rock_damage_class"] == ["none", "start of damage"]
+    expected = rock_formula_curves([(0.08, 1.3, 50), (0.10, 1.45, 50)], slope_cot=2.0,
+                                   delta=1.65, nominal_diameter=0.03, permeability=0.4,
+                                   core_nominal_diameter=0.0084)
+    for column, values in expected.items():
+        assert curve[column] == values
+        assert values[1] > values[0]
+    results.update({"per_wave": {}, "run_mode": "full", "displacement_threshold_over_dn": 1.0,
+                    "case_file": str(tmp_path / "rock.toml"),
+                    "steps": [{"step": k, "folder": str(tmp_path / f"step_{k:02d}"),
+                               "target_Hm0_m": hm0, "Tp_s": 1.5, "target_waves": 50,
+                               "sea_duration_s": 75.0, "wave_height_not_measured": None}
+                              for k, hm0, *_ in steps]})
+    write_series_report(tmp_path, results)
+    assert drawn["damage_curve.png"][0]
+    page = (tmp_path / "report.html").read_text()
+    assert "Notional permeability P = 0.4" in page and "core D<sub>n50</sub> 0.0084 m" in page
+    assert ">Van Gent et al. (2003) S, waves so far</th>" in page
+    assert ">Rock Manual class of S</th>" in page

@@ -301,6 +301,21 @@ def _figure_html(name: str, plots: list[str], missing: dict, width: str = "") ->
     return f"<img src='{name}' alt='{html.escape(', '.join(plots))}'{style}>{notes}"
 
 
+def _rock_note(results: dict) -> str:
+    """A rock series: the structure the formulas were given (P and its reason, the core)."""
+    rock = results.get("formulas", {}).get("rock")
+    if not rock:
+        return ""
+    if "notional_permeability" not in rock:
+        return f"<p class='missing'>Rock formulas: {html.escape(rock.get('note', ''))}</p>"
+    core = rock.get("core_dn50_m") or 0.0
+    return ("<p>Rock armour: the formulas' S are for the waves measured at the toe, the damage "
+            "carried from step to step as equivalent waves. Notional permeability P = "
+            f"{rock['notional_permeability']:g} ({html.escape(str(rock.get('notional_permeability_reason')))}); "
+            + (f"core D<sub>n50</sub> {core:.3g} m" if core > 0 else "an impermeable core")
+            + f" ({html.escape(str(rock.get('core')))}). {html.escape(rock.get('sources', ''))}.</p>")
+
+
 def write_series_report(out, results: dict) -> dict:
     """``damage_curve.png``, ``overtopping.png`` and ``report.html`` in ``out``; returns their
     paths by name. A plot with nothing to show (``figures_not_computed``) is drawn as the
@@ -324,6 +339,7 @@ def write_series_report(out, results: dict) -> dict:
              ("<p class='missing'>" + html.escape(" ".join(unmeasured)) + "</p>"
               if unmeasured else ""),
              _first_displacement(results),
+             _rock_note(results),
              _crest_width_note(results),
              _figure_html("damage_curve.png", ["damage curve", "damage development N_od(N)"],
                           missing),
