@@ -161,6 +161,9 @@ def test_bad_layer_file_fields_are_named_with_file_line_and_field(tmp_path):
         ("slope", dict(good["slope"], cotangent="steep"), "'slope': 'cotangent' must be a finite"),
         ("design", {"porosity": "high"}, "'design': 'porosity' must be a finite number"),
         ("rows", [0, 1], "'rows' has 2 entries, 'unit_bodies' 1"),
+        ("unit_shape", [], "'unit_shape' must be a shape name or a non-empty list of them"),
+        ("unit_shape", ["stone_0", 3], "'unit_shape' must be a shape name or a non-empty list"),
+        ("unit_axes", {}, "'unit_axes' must map axis names to [x, y, z] (the primary axis"),
     ]
     for field, value, expected in breakages:
         data = dict(good, **{field: value})
@@ -172,6 +175,13 @@ def test_bad_layer_file_fields_are_named_with_file_line_and_field(tmp_path):
         message = str(error.value)
         assert f"layer.json:{line}: " in message, (field, message)
         assert expected in message, (field, message)
+    # rock armour's layer needs the design the rock analysis reads: named at the design's line
+    text = json.dumps(dict(good, unit_kind="armour_stone"), indent=1)
+    (tmp_path / "layer.json").write_text(text)
+    line = next(k for k, row in enumerate(text.splitlines(), 1) if '"design"' in row)
+    with pytest.raises(CaseFileError, match=rf"layer.json:{line}: a rock layer's 'design' needs "
+                                            "'layers', 'dn50_m'"):
+        read_layer_file(tmp_path)
     data = {k: v for k, v in good.items() if k != "slope"}
     (tmp_path / "layer.json").write_text(json.dumps(data))
     with pytest.raises(CaseFileError, match=r"layer.json: missing field\(s\): 'slope'"):
