@@ -288,3 +288,18 @@ def test_json_outputs_never_hold_nan_or_infinity(tmp_path):
     assert data == {"nan": None, "inf": None, "numpy": None, "fine": 1.5,
                     "array": [1.0, None, None], "nested": {"list": [None, [2.0, None]]}}
 
+
+
+def test_a_run_folder_without_frames_is_named_not_taken_for_a_pack(tmp_path, capsys):
+    """A run with [output] paraview = false wrote no bodies.pvd: riprap analyse says so (it was
+    read as a pack folder without its pack.toml) and writes nothing."""
+    from riprap.cli import main
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "summary.json").write_text(json.dumps({"case_file": str(tmp_path / "case.toml")}))
+    (run / "checkpoint.npz").write_bytes(b"")
+    assert main(["analyse", str(run), "--out", str(tmp_path / "analysis")]) == 2
+    err = capsys.readouterr().err
+    assert "a run folder without bodies.pvd" in err and "paraview = true" in err
+    assert not (tmp_path / "analysis").exists()

@@ -23,7 +23,8 @@ from riprap.io.body_forces import read_peak_fluid_forces
 from riprap.io.frame_contacts import read_unit_contacts_per_frame
 from riprap.io.output_folder import prepare_output_folder
 from riprap.io.csv_tables import write_columns_csv
-from riprap.workflows.layer_input import load_layer_state, load_run_case
+from riprap.workflows.layer_input import (load_layer_state, load_run_case,
+                                          refuse_run_without_frames)
 from riprap.workflows.per_wave_records import read_run_gauges, run_per_wave_table
 
 __all__ = ["analyse", "compare_layers"]
@@ -39,6 +40,7 @@ def analyse(path, *, out=None, frame: int = -1, reference_run=None,
     this many Dn is displaced (default 1)."""
     # A broken waves report or gauge file is refused before any work (and before the output
     # folder is made).
+    refuse_run_without_frames(path)
     waves = load_waves_report(path)
     if is_run_folder(path):
         case = load_run_case(path)

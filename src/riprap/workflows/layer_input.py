@@ -28,7 +28,8 @@ from riprap.io.analysis_input import (included_pack, is_run_folder, no_contact_r
                                       read_pvd_frames, run_case_file)
 from riprap.io.layer_file import CONTACTS_FILE_NAME, read_contact_table, read_layer_file
 
-__all__ = ["load_layer_state", "load_pack_state", "load_run_state", "load_run_case"]
+__all__ = ["load_layer_state", "load_pack_state", "load_run_state", "load_run_case",
+           "refuse_run_without_frames"]
 
 
 def load_layer_state(path, *, frame: int = -1, reference_run=None):
@@ -37,11 +38,24 @@ def load_layer_state(path, *, frame: int = -1, reference_run=None):
     (a run folder of the same bodies, e.g. a test series' first step): the displacements and the
     eroded area count from its frame 0 instead of the run's own."""
     path = Path(path)
-    if not path.exists():
-        raise CaseFileError(f"{path}: no such pack or run folder")
+    refuse_run_without_frames(path)
     if is_run_folder(path):
         return load_run_state(path, frame=frame, reference_run=reference_run)
     return load_pack_state(path)
+
+
+def refuse_run_without_frames(path) -> None:
+    """A clear error for a path the analysis cannot read: none there, or a run folder that wrote
+    no frames of its bodies (``[output] paraview = false``: no ``bodies.pvd``), which would
+    otherwise be taken for a pack folder without its ``pack.toml``."""
+    path = Path(path)
+    if not path.exists():
+        raise CaseFileError(f"{path}: no such pack or run folder")
+    if (path.is_dir() and not is_run_folder(path) and not (path / "pack.toml").is_file()
+            and (path / "summary.json").is_file() and (path / "checkpoint.npz").is_file()):
+        raise CaseFileError(f"{path}: a run folder without bodies.pvd (the run had [output] "
+                            "paraview = false): the analysis reads the bodies' poses from its "
+                            "frames; run the case again with paraview = true")
 
 
 def _case_parts(pack_file: Path):
