@@ -6,6 +6,7 @@ body_forces.csv is refused naming the file and the line, with nothing written.
 
 The end-to-end test runs examples/10_breakwater_test in smoke mode (RIPRAP_SMOKE=1, 0.01 s) once
 for the module and analyses it."""
+import html
 import json
 import math
 import os
@@ -386,3 +387,34 @@ def test_the_stability_report_passes_over_values_left_null():
                        "reflection": [{"incident_Hm0_m": None}, {"incident_Hm0_m": 0.98}]})
     assert mixed["Hm0_m"] == 0.98 and mixed["Tz_s"] is None and mixed["waves"] == 12
     assert mixed["stability_number"] == pytest.approx(0.98 / (1.4 * 0.563))
+
+
+def test_the_stability_section_of_rock_armour_gives_s_its_class_and_the_formulas():
+    """Rock armour (issue 55): the survey report's stability table shows S with its Rock Manual
+    class, P and the core, each formula's S with its cautions, the band and where it eroded."""
+    from riprap.analysis.rock_stability import RockSection, eroded_zone, rock_stability
+    from riprap.io.flume_report import stability_section
+
+    section = RockSection(filter_dn50=0.013, core_dn50=0.0084, core_note="the case's core")
+    rock = rock_stability(hs=0.06, spectral_period=1.3, waves=40, slope_cot=2.0,
+                          armour_density=2650.0, water_density=1000.0, nominal_diameter=0.03,
+                          damage=2.6, section=section)
+    x = [0.0, 0.01, 0.02, 0.03]
+    rock["eroded_zone"] = eroded_zone({"x_m": x, "before_z_m": [0.0, 0.1, 0.2, 0.3],
+                                       "after_z_m": [0.0, 0.09, 0.2, 0.3]},
+                                      nominal_diameter=0.03, still_water_level=0.15)
+    layer = {"flume_test": {"Hm0_m": 0.06, "Tz_s": 1.1, "waves": 40, "relative_density": 1.65,
+                            "nominal_diameter_m": 0.03, "stability_number": 1.21,
+                            "slope_cot": 2.0, "unit": "armour_stone", "rock": rock},
+             "units_displaced": [], "units": 90, "damage_number_nod": 0.0,
+             "eroded_area_m2": 0.0023, "damage_level_s": 2.6}
+    analysis = SimpleNamespace(layer=layer, units={}, flume=SimpleNamespace(rocking=None))
+    page = html.unescape(stability_section(analysis))
+    assert "2.60: start of damage (start 2, intermediate 4-6, failure 8 on this slope)" in page
+    assert "notional permeability P (Van der Meer 1988)" in page and "0.4: armour on a filter" in page
+    for name in ("Van der Meer (2021)", "Van Gent et al. (2003)", "Etemad-Shahidi et al. (2020)"):
+        assert f"{name}: S predicted for these waves" in page
+    assert "N = 40 is below Etemad-Shahidi et al. (2020)'s tested range 500-5000" in page
+    assert "the formulas' band" in page and "measured S is" in page
+    assert "deepest 0.33 D_n50 at x 0.010 m, 1.67 D_n50 below still water" in page
+    assert "Van der Meer</th>" not in page      # no "not computed" row for rock

@@ -223,6 +223,52 @@ def _still_water_ratio(test: dict) -> float:
     return 1.0 / test["relative_density"]
 
 
+def _rock_rows(rock: dict) -> list[str]:
+    """Rock armour's rows: S and its class, P and the core, the three formulas with their
+    cautions, where the profile eroded (``flume_test.rock``)."""
+    rows = []
+    damage = rock.get("S")
+    if damage is not None:
+        thresholds = rock.get("damage_class_thresholds") or {}
+        rows.append(_row("damage level S, its class (The Rock Manual, Table 5.22)",
+                         f"{damage:.2f}: {html.escape(str(rock.get('damage_class')))} (start "
+                         f"{thresholds.get('start', float('nan')):g}, intermediate "
+                         f"{'-'.join(f'{v:g}' for v in thresholds.get('intermediate', []))}, "
+                         f"failure {thresholds.get('failure', float('nan')):g} on this slope)"))
+    rows.append(_row("notional permeability P (Van der Meer 1988)",
+                     f"{rock['notional_permeability']:g}: "
+                     f"{html.escape(str(rock.get('notional_permeability_reason')))}; core: "
+                     f"{html.escape(str(rock.get('core')))}"))
+    for caution in rock.get("cautions", []):
+        rows.append(_row("caution", html.escape(caution)))
+    for formula in rock.get("formulas", []):
+        value = (f"{formula['S']:.3g}" if formula.get("S") is not None else
+                 f"<span class='missing'>not computed: "
+                 f"{html.escape(str(formula.get('not_computed')))}</span>")
+        cautions = "; ".join(formula.get("cautions", []))
+        rows.append(_row(f"{formula['name']}: S predicted for these waves",
+                         value + (f" <span class='note'>({html.escape(cautions)})</span>"
+                                  if cautions else "")))
+    if rock.get("formula_band_S"):
+        low, high = rock["formula_band_S"]
+        where = rock.get("measured_against_band")
+        rows.append(_row("the formulas' band", f"S {low:.3g}-{high:.3g}"
+                         + (f"; measured S is {html.escape(where)} it" if where else "")))
+    zone = rock.get("eroded_zone") or {}
+    if "eroded_from_x_m" in zone:
+        level = zone.get("deepest_below_still_water_over_dn50")
+        rows.append(_row("where the profile eroded",
+                         f"x {zone['eroded_from_x_m']:.3f}-{zone['eroded_to_x_m']:.3f} m, "
+                         f"deepest {zone['deepest_depth_over_dn50']:.2f} D_n50 at x "
+                         f"{zone['deepest_x_m']:.3f} m"
+                         + ("" if level is None else
+                            f", {abs(level):.2f} D_n50 {'below' if level >= 0 else 'above'} "
+                            "still water")))
+    elif zone.get("note"):
+        rows.append(_row("where the profile eroded", html.escape(zone["note"])))
+    return rows
+
+
 def stability_section(analysis) -> str:
     """The stability section of the report (empty for a run without waves)."""
     test = analysis.layer.get("flume_test")
@@ -257,9 +303,12 @@ def stability_section(analysis) -> str:
         rows.append(_row("Hudson", "<span class='missing'>not computed: "
                          + html.escape(no_height or f"no K_D retrieved for {test['unit']} units")
                          + "</span>"))
+    rock = test.get("rock")
     if isinstance(cubes, dict):
         rows.append(_row("Van der Meer (1988), cubes: N_od predicted",
                          f"{cubes['N_od']:.2f} ({html.escape(cubes['meaning'])})"))
+    elif isinstance(rock, dict):
+        rows += _rock_rows(rock)
     else:
         why = (f"for rock and cubes only; this layer is of {test['unit']} units"
                if test.get("unit") not in ("cube", "antifer_cube") else

@@ -131,9 +131,8 @@ def _add_flume_test(path, waves: dict | None, analysis) -> LayerAnalysis:
 
 def _still_water_level(case) -> float | None:
     spec = case.waves
-    if spec is None or "still_water_level" not in spec.parameters:
-        return None
-    return float(spec.parameters["still_water_level"])
+    level = getattr(spec, "still_water_level", None) if spec is not None else None
+    return float(level) if level is not None else None
 
 
 def _rock_section(case, layer) -> RockSection:
